@@ -1,0 +1,8 @@
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace mufric::app {
+// Each adds its subcommand(s) to the application; the callbacks print and may throw mufric::Error.
+void add_surrogate_commands(CLI::App& app);
+void add_bench_command(CLI::App& app);
+}  // namespace mufric::app

@@ -1,0 +1,272 @@
+// train, eval, predict, describe, law, dataset from-model.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "app/commands.hpp"
+#include "common/dataset_file.hpp"
+#include "common/error.hpp"
+#include "common/units.hpp"
+#include "surrogate/accuracy.hpp"
+#include "surrogate/empirical_laws.hpp"
+#include "surrogate/gp_training.hpp"
+#include "surrogate/model_file.hpp"
+
+namespace mufric::app {
+namespace {
+
+std::string theta_text(const Eigen::VectorXd& theta) {
+  std::string text;
+  for (Eigen::Index i = 0; i < theta.size(); ++i) {
+    char part[32];
+    std::snprintf(part, sizeof part, "%s%.3g", i ? " " : "", std::exp(theta(i)));
+    text += part;
+  }
+  return text;
+}
+
+void print_training_report(const GaussianProcess& gp, const GpTrainingReport& report) {
+  const auto& s = gp.state();
+  std::printf("restarts (hyper-parameters: signal variance, length scales..., noise variance)\n");
+  for (size_t i = 0; i < report.starts.size(); ++i) {
+    const auto& start = report.starts[i];
+    std::printf("  start %zu%s  LML %14.6f  %4d evaluations  %6.2f s  %s\n      from [%s]\n      to   [%s]\n", i,
+                static_cast<int>(i) == report.best_start ? "*" : " ", start.log_marginal_likelihood, start.evaluations,
+                start.seconds, start.outcome.c_str(), theta_text(start.initial_log).c_str(),
+                theta_text(start.final_log).c_str());
+  }
+  std::printf("best: start %d, log marginal likelihood %.6f\n", report.best_start, s.summary.log_marginal_likelihood);
+  std::printf("hyper-parameters:\n  signal variance %.6g (normalised mu units)\n", s.hyper.signal_variance);
+  for (size_t j = 0; j < s.inputs.size(); ++j) {
+    const auto& input = s.inputs[j];
+    const double l = s.hyper.length_scales(static_cast<Eigen::Index>(j));
+    const QuantityKind kind = input.kind();
+    const double physical = l * (input.hi - input.lo);
+    const double human = kind == QuantityKind::temperature ? physical : si_to_human(physical, kind);
+    std::printf("  length scale %-18s %.6g box widths = %.4g %s\n", input.name.c_str(), l, human,
+                std::string(kind == QuantityKind::temperature ? "K" : human_unit(kind)).c_str());
+  }
+  if (s.hyper.noise_term) std::printf("  noise variance %.6g\n", s.hyper.noise_variance);
+  if (s.jitter > 0) std::printf("  jitter %.3g\n", s.jitter);
+  const auto& t = s.summary;
+  std::printf("cross-validation (leave-one-out, closed form): mean relative error %.4f %%, max %.4f %%, "
+              "RMSE %.4g, 95 %% interval coverage %.1f %%\n",
+              100 * t.loo_mean_relative_error, 100 * t.loo_max_relative_error, t.loo_rmse, 100 * t.loo_coverage_95);
+  for (const auto& w : report.warnings) std::printf("warning: %s\n", w.c_str());
+}
+
+void add_train(CLI::App& app) {
+  struct Options {
+    std::string data, out;
+    GpTrainingOptions gp;
+    bool no_noise = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("train", "Fit a Gaussian-process surrogate (RBF-ARD kernel) to a dataset");
+  cmd->add_option("--data", o->data, "Dataset: mufric HDF5 file, or CSV with header like contact_pressure[MPa],...,mu")
+      ->required();
+  cmd->add_option("--out", o->out, "Model file to write (HDF5)")->required();
+  cmd->add_option("--restarts", o->gp.restarts, "Optimiser starts after the first (log-uniform in the bounds)")
+      ->capture_default_str()->check(CLI::Range(0, 1000));
+  cmd->add_option("--seed", o->gp.seed, "Seed of the restart points")->capture_default_str();
+  cmd->add_option("--threads", o->gp.threads, "Starts run in parallel on this many threads (0: all cores)")
+      ->capture_default_str();
+  cmd->add_option("--max-evaluations", o->gp.max_evaluations, "LML evaluations per start")->capture_default_str();
+  cmd->add_flag("--no-noise", o->no_noise, "No white-noise term (interpolate exactly)");
+  cmd->footer("Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
+              "cross-validated error. Bounds: signal variance 1e-3..1e5, length scales 1e-2..1e3 box widths,\n"
+              "noise variance 1e-10..1e-1 (outputs normalised to zero mean and unit variance).");
+  cmd->callback([o] {
+    o->gp.noise_term = !o->no_noise;
+    const Dataset dataset = read_dataset(o->data);
+    const TrainingSet data = training_set(dataset, o->data);
+    std::printf("training data: %s (%lld converged of %lld samples, %zu inputs)\n", o->data.c_str(),
+                static_cast<long long>(data.x.rows()), static_cast<long long>(dataset.size()), data.inputs.size());
+    GpTrainingReport report;
+    const GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
+    print_training_report(gp, report);
+    save_model(o->out, gp);
+    std::printf("wrote %s (gp, %lld training points) in %.2f s\n", o->out.c_str(),
+                static_cast<long long>(data.x.rows()), report.seconds);
+  });
+}
+
+void add_eval(CLI::App& app) {
+  struct Options {
+    std::string model, test;
+    double level = 0.95;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("eval", "Held-out accuracy of a model on a test dataset");
+  cmd->add_option("--model", o->model, "Model file or file:// URI")->required();
+  cmd->add_option("--test", o->test, "Test dataset (HDF5 or CSV), not used in training")->required();
+  cmd->add_option("--level", o->level, "Confidence level of the interval whose coverage is reported")
+      ->capture_default_str()->check(CLI::Range(0.5, 0.9999));
+  cmd->callback([o] {
+    const auto model = load_model(model_path_from_uri(o->model));
+    const TrainingSet test = training_set(read_dataset(o->test), o->test);
+    const AccuracyReport r = held_out_accuracy(*model, test, o->level);
+    std::printf("model %s (%s) on %s: %lld points (%lld outside the training box)\n", o->model.c_str(),
+                std::string(model->kind()).c_str(), o->test.c_str(), r.points, r.extrapolated);
+    std::printf("mean relative error %.4f %%\nmax relative error  %.4f %%\nRMSE                %.4g\n"
+                "%.0f %% interval coverage %.1f %%\nevaluation          %.3g us per point (mean + interval)\n",
+                100 * r.mean_relative_error, 100 * r.max_relative_error, r.rmse, 100 * o->level, 100 * r.coverage,
+                1e6 * r.seconds_per_point);
+    if (!model->has_uncertainty()) std::printf("note: a %s model has no uncertainty: its interval has zero width\n",
+                                               std::string(model->kind()).c_str());
+  });
+}
+
+// --p/--v/--T/--angle map onto the model's named inputs.
+const std::map<std::string, std::string> kInputFlags{{"contact_pressure", "--p"},
+                                                     {"sliding_velocity", "--v"},
+                                                     {"temperature", "--T"},
+                                                     {"fibre_angle", "--angle"}};
+
+void add_predict(CLI::App& app) {
+  struct Options {
+    std::string model;
+    std::map<std::string, std::string> values;  // flag → text
+    double level = 0.95;
+    bool gradient = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("predict", "One friction coefficient with its confidence interval, human units");
+  cmd->add_option("--model", o->model, "Model file or file:// URI")->required();
+  for (const auto& [input, flag] : kInputFlags) {
+    cmd->add_option(flag, o->values[flag],
+                    "The " + input + " with its unit, e.g. " + std::string(example_quantity(kind_of_input(input))));
+  }
+  cmd->add_option("--level", o->level, "Confidence level of the interval")->capture_default_str()
+      ->check(CLI::Range(0.5, 0.9999));
+  cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput");
+  cmd->callback([o] {
+    const auto model = load_model(model_path_from_uri(o->model));
+    const auto& inputs = model->inputs();
+    QueryBatch x(1, static_cast<Eigen::Index>(inputs.size()));
+    for (size_t j = 0; j < inputs.size(); ++j) {
+      const auto flag_it = kInputFlags.find(inputs[j].name);
+      if (flag_it == kInputFlags.end()) throw Error("model input '" + inputs[j].name + "' has no command-line flag");
+      const std::string& text = o->values[flag_it->second];
+      if (text.empty()) throw Error(flag_it->second + " is required: the model's input " + inputs[j].name + " (e.g. " +
+                                    flag_it->second + " " + std::string(example_quantity(inputs[j].kind())) + ")");
+      x(0, static_cast<Eigen::Index>(j)) = parse_quantity(text, inputs[j].kind(), flag_it->second);
+    }
+    for (const auto& [input, flag] : kInputFlags) {
+      const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });
+      if (!used && !o->values[flag].empty()) throw Error(flag + " was given but the model has no input " + input);
+    }
+    const Evaluation e = model->evaluate(x, {.std = true, .ci_level = o->level, .gradient = o->gradient});
+    for (size_t j = 0; j < inputs.size(); ++j) {
+      std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(),
+                  format_human(x(0, static_cast<Eigen::Index>(j)), inputs[j].kind()).c_str());
+    }
+    std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s\n", e.mu(0), e.std(0),
+                100 * o->level, e.lo(0), e.hi(0), std::string(to_string(e.status[0])).c_str());
+    if (o->gradient) {
+      for (size_t j = 0; j < inputs.size(); ++j) {
+        std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(), e.gradient(0, static_cast<Eigen::Index>(j)),
+                    std::string(si_unit(inputs[j].kind())).c_str());
+      }
+    }
+  });
+}
+
+void add_describe(CLI::App& app) {
+  auto model_uri = std::make_shared<std::string>();
+  auto* cmd = app.add_subcommand("describe", "Inputs, units, training box and accuracy figures of a model file");
+  cmd->add_option("model", *model_uri, "Model file or file:// URI")->required();
+  cmd->callback([model_uri] {
+    const auto model = load_model(model_path_from_uri(*model_uri));
+    std::printf("%s: kind %s\ninputs (training box):\n", model_uri->c_str(), std::string(model->kind()).c_str());
+    for (const auto& input : model->inputs()) {
+      std::printf("  %-18s [%s, %s]  stored in %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
+                  format_human(input.hi, input.kind()).c_str(), input.unit.c_str());
+    }
+    std::printf("%s\n", model->summary().c_str());
+  });
+}
+
+void add_law(CLI::App& app) {
+  auto* law = app.add_subcommand("law", "Write an empirical friction law as a model file");
+  law->require_subcommand(1);
+  struct Options {
+    std::string out, csv;
+    double mu = 0.3;
+    int table = 4;
+  };
+  auto o = std::make_shared<Options>();
+  auto* coulomb = law->add_subcommand("coulomb", "Constant friction coefficient");
+  coulomb->add_option("--mu", o->mu, "The coefficient")->required()->check(CLI::Range(0.0, 10.0));
+  coulomb->add_option("--out", o->out, "Model file to write")->required();
+  coulomb->callback([o] {
+    save_model(o->out, CoulombLaw(o->mu));
+    std::printf("wrote %s (coulomb, mu = %g)\n", o->out.c_str(), o->mu);
+  });
+  auto* seward = law->add_subcommand("seward", "Seed 001 (Seward et al. 2022) MLR law mu(p, v, fibre angle)");
+  seward->add_option("--table", o->table, "2: apparent COF (Table 2), 4: adhesive COF (Table 4)")
+      ->capture_default_str()->check(CLI::IsMember({2, 4}));
+  seward->add_option("--out", o->out, "Model file to write")->required();
+  seward->callback([o] {
+    const MlrLaw law_model = o->table == 2 ? MlrLaw::seed001_table2() : MlrLaw::seed001_table4();
+    save_model(o->out, law_model);
+    std::printf("%s\nwrote %s\n", law_model.summary().c_str(), o->out.c_str());
+  });
+  auto* fit = law->add_subcommand("fit", "Least-squares MLR law per fibre angle from measurements");
+  fit->add_option("--csv", o->csv, "CSV: fibre_angle[deg],contact_pressure[MPa],sliding_velocity[m/min],mu")
+      ->required();
+  fit->add_option("--out", o->out, "Model file to write")->required();
+  fit->callback([o] {
+    MlrFitReport report;
+    const MlrLaw law_model = fit_mlr_law(o->csv, &report);
+    std::printf("%s\n", law_model.summary().c_str());
+    for (const auto& a : report.angles) {
+      std::printf("  fibre angle %7.2f deg: %lld samples, R^2 = %.4f\n", a.fibre_angle_deg, a.samples, a.r_squared);
+    }
+    save_model(o->out, law_model);
+    std::printf("wrote %s\n", o->out.c_str());
+  });
+}
+
+void add_dataset_from_model(CLI::App& app) {
+  auto* dataset = app.add_subcommand("dataset", "Training databases (HDF5)");
+  dataset->require_subcommand(1);
+  struct Options {
+    std::string model, out;
+    SamplingOptions sampling;
+  };
+  auto o = std::make_shared<Options>();
+  auto* from_model = dataset->add_subcommand(
+      "from-model", "Sample a model (e.g. an empirical law) on a Latin hypercube of its box into a dataset file");
+  from_model->add_option("--model", o->model, "Model file or file:// URI")->required();
+  from_model->add_option("--samples", o->sampling.samples, "Number of samples")->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
+  from_model->add_option("--seed", o->sampling.seed, "Random seed")->capture_default_str();
+  from_model->add_option("--noise", o->sampling.noise_std, "Std of additive Gaussian noise on mu")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  from_model->add_option("--out", o->out, "Dataset file to write (HDF5)")->required();
+  from_model->callback([o] {
+    const auto model = load_model(model_path_from_uri(o->model));
+    const Dataset data = sample_model(*model, o->sampling, "model:" + o->model);
+    write_dataset(o->out, data);
+    std::printf("wrote %s: %lld samples of %s (seed %llu, noise std %g)\n", o->out.c_str(),
+                static_cast<long long>(data.size()), o->model.c_str(),
+                static_cast<unsigned long long>(o->sampling.seed), o->sampling.noise_std);
+  });
+}
+
+}  // namespace
+
+void add_surrogate_commands(CLI::App& app) {
+  add_train(app);
+  add_eval(app);
+  add_predict(app);
+  add_describe(app);
+  add_law(app);
+  add_dataset_from_model(app);
+}
+
+}  // namespace mufric::app

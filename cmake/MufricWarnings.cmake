@@ -1,0 +1,15 @@
+# Compile options shared by every mufric target.
+add_library(mufric_options INTERFACE)
+target_compile_options(mufric_options INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion -Wnon-virtual-dtor
+  -Wold-style-cast -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2)
+if(MUFRIC_NATIVE)
+  # GCC 12 reports false -Wmaybe-uninitialized inside its own AVX-512 intrinsics when Eigen
+  # inlines them (GCC bug 105593); silenced for native builds only.
+  target_compile_options(mufric_options INTERFACE -march=native -Wno-maybe-uninitialized)
+endif()
+if(MUFRIC_SANITIZE)
+  target_compile_options(mufric_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
+                         -fno-sanitize-recover=undefined)
+  target_link_options(mufric_options INTERFACE -fsanitize=address,undefined)
+endif()

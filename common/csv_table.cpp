@@ -1,0 +1,126 @@
+#include "common/csv_table.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "common/units.hpp"
+
+namespace mufric {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  const auto end = s.find_last_not_of(" \t\r");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+// "name[unit]" or "name (unit)" or "name".
+CsvColumn parse_header_cell(const std::string& cell) {
+  for (const auto& [open, close] : {std::pair{'[', ']'}, std::pair{'(', ')'}}) {
+    const auto a = cell.find(open);
+    const auto b = cell.rfind(close);
+    if (a != std::string::npos && b != std::string::npos && b > a) {
+      return {trim(cell.substr(0, a)), trim(cell.substr(a + 1, b - a - 1))};
+    }
+  }
+  return {cell, ""};
+}
+
+}  // namespace
+
+size_t CsvTable::column(const std::string& name) const {
+  for (size_t i = 0; i < columns.size(); ++i) {
+    if (columns[i].name == name) return i;
+  }
+  std::string present;
+  for (const auto& c : columns) present += (present.empty() ? "" : ", ") + c.name;
+  throw Error(path + ": no column '" + name + "' (columns: " + present + ")");
+}
+
+bool CsvTable::has_column(const std::string& name) const {
+  for (const auto& c : columns) {
+    if (c.name == name) return true;
+  }
+  return false;
+}
+
+std::vector<double> CsvTable::si_column(const std::string& name) const {
+  const size_t j = column(name);
+  const QuantityKind kind = kind_of_input(name);
+  const std::string& unit = columns[j].unit;
+  if (unit.empty() && kind != QuantityKind::dimensionless) {
+    throw Error(path + ": column '" + name + "' has no unit in the header; write e.g. '" + name + "[" +
+                std::string(human_unit(kind)) + "]'");
+  }
+  UnitToSi map{kind, 1.0, 0.0};
+  if (!unit.empty()) {
+    try {
+      map = unit_to_si(unit);
+    } catch (const Error& e) {
+      throw Error(path + ": column '" + name + "': " + e.what());
+    }
+    if (kind != QuantityKind::dimensionless && map.kind != kind) {
+      throw Error(path + ": column '" + name + "' has unit '" + unit + "', a " + std::string(to_string(map.kind)) +
+                  "; expected a " + std::string(to_string(kind)));
+    }
+  }
+  std::vector<double> values;
+  values.reserve(rows.size());
+  for (const auto& row : rows) values.push_back(map.scale * row[j] + map.offset);
+  return values;
+}
+
+CsvTable read_csv_table(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open (no such file or not readable)");
+  CsvTable table;
+  table.path = path;
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    const std::string content = trim(line);
+    if (content.empty() || content.front() == '#') continue;
+    const auto cells = split(content);
+    if (table.columns.empty()) {
+      for (const auto& cell : cells) table.columns.push_back(parse_header_cell(cell));
+      continue;
+    }
+    if (cells.size() != table.columns.size()) {
+      throw Error(path + ": line " + std::to_string(line_number) + ": " + std::to_string(cells.size()) +
+                  " cells, the header has " + std::to_string(table.columns.size()));
+    }
+    std::vector<double> row(cells.size());
+    for (size_t j = 0; j < cells.size(); ++j) {
+      const std::string& cell = cells[j];
+      const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), row[j]);
+      if (ec != std::errc() || end != cell.data() + cell.size() || cell.empty()) {
+        throw Error(path + ": line " + std::to_string(line_number) + ", column '" + table.columns[j].name +
+                    "': '" + cell + "' is not a number");
+      }
+      if (!std::isfinite(row[j])) {
+        throw Error(path + ": line " + std::to_string(line_number) + ", column '" + table.columns[j].name +
+                    "': " + cell + " is not a finite number");
+      }
+    }
+    table.rows.push_back(std::move(row));
+    table.line_of_row.push_back(line_number);
+  }
+  if (table.columns.empty()) throw Error(path + ": empty file (no header line)");
+  return table;
+}
+
+}  // namespace mufric

@@ -1,0 +1,30 @@
+#pragma once
+// A numeric CSV table whose header names each column and its unit: "contact_pressure[MPa],mu".
+// Lines starting with '#' are comments. Errors name the file, line and column.
+#include <string>
+#include <vector>
+
+namespace mufric {
+
+struct CsvColumn {
+  std::string name;
+  std::string unit;  // as written in the header; empty when none was given
+};
+
+struct CsvTable {
+  std::string path;
+  std::vector<CsvColumn> columns;
+  std::vector<std::vector<double>> rows;  // raw values in the header's units
+  std::vector<int> line_of_row;           // 1-based line number in the file, for messages
+
+  // Index of the column called `name`; throws Error naming the file and the columns present.
+  size_t column(const std::string& name) const;
+  bool has_column(const std::string& name) const;
+  // Column values converted to SI using the header unit; throws if the unit is missing or unknown.
+  std::vector<double> si_column(const std::string& name) const;
+};
+
+// Parses `path`; every cell must be a finite number. Throws Error naming line and column.
+CsvTable read_csv_table(const std::string& path);
+
+}  // namespace mufric

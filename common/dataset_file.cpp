@@ -1,0 +1,178 @@
+#include "common/dataset_file.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <openssl/sha.h>
+
+#include "common/csv_table.hpp"
+#include "common/error.hpp"
+#include "common/version.hpp"
+
+namespace mufric {
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+Dataset read_hdf5_dataset(const std::string& path) {
+  const h5::Reader in(path, "dataset");
+  if (!in.has_attribute("/", "format") || in.string_attribute("/", "format") != kDatasetFormat) {
+    in.fail("/", "not a mufric dataset (attribute 'format' is not '" + std::string(kDatasetFormat) + "')");
+  }
+  const long long version = in.int_attribute("/", "schema_version");
+  if (version != kDatasetSchemaVersion) {
+    in.fail("/", "schema_version " + std::to_string(version) + " is not supported (this build reads " +
+                     std::to_string(kDatasetSchemaVersion) + ")");
+  }
+  Dataset d;
+  d.inputs = read_input_space(in);
+  const auto dims = static_cast<Eigen::Index>(d.inputs.size());
+  d.x = in.matrix("/samples/inputs");
+  if (d.x.cols() != dims && d.x.rows() > 0) {
+    in.fail("/samples/inputs", "has " + std::to_string(d.x.cols()) + " columns, " +
+                                   std::to_string(dims) + " inputs are declared");
+  }
+  const Eigen::Index n = d.x.rows();
+  d.mu = in.vector("/samples/mu", n);
+  d.status = in.ints("/samples/status");
+  if (static_cast<Eigen::Index>(d.status.size()) != n) in.fail("/samples/status", "length differs from /samples/inputs");
+  d.failure_reason = in.has("/samples/failure_reason") ? in.strings("/samples/failure_reason")
+                                                       : std::vector<std::string>(static_cast<size_t>(n));
+  if (static_cast<Eigen::Index>(d.failure_reason.size()) != n) {
+    in.fail("/samples/failure_reason", "length differs from /samples/inputs");
+  }
+  if (in.has("/samples/diagnostics")) {
+    H5::H5File file(path, H5F_ACC_RDONLY);
+    H5::Group group = file.openGroup("/samples/diagnostics");
+    for (hsize_t i = 0; i < group.getNumObjs(); ++i) {
+      const std::string name = group.getObjnameByIdx(i);
+      d.diagnostics[name] = in.vector("/samples/diagnostics/" + name, n);
+    }
+  }
+  if (in.has("/plan/inputs")) d.plan = in.matrix("/plan/inputs");
+  if (in.has_attribute("/", "source")) d.source = in.string_attribute("/", "source");
+  if (in.has_attribute("/", "scene_json")) d.scene_json = in.string_attribute("/", "scene_json");
+  if (in.has_attribute("/", "code_version")) d.code_version = in.string_attribute("/", "code_version");
+  if (in.has_attribute("/", "created_utc")) d.created_utc = in.string_attribute("/", "created_utc");
+  return d;
+}
+
+// CSV: every column but "mu" is an input, with its unit in the header; the box is the data's range.
+Dataset read_csv_dataset(const std::string& path) {
+  const CsvTable table = read_csv_table(path);
+  table.column("mu");
+  Dataset d;
+  d.source = "csv:" + std::filesystem::path(path).filename().string();
+  std::vector<std::vector<double>> columns;
+  for (const auto& c : table.columns) {
+    if (c.name == "mu") continue;
+    columns.push_back(table.si_column(c.name));
+    d.inputs.push_back({c.name, std::string(si_unit(kind_of_input(c.name))), 0.0, 0.0});
+  }
+  if (d.inputs.empty()) throw Error(path + ": no input columns besides 'mu'");
+  const auto n = static_cast<Eigen::Index>(table.rows.size());
+  const auto dims = static_cast<Eigen::Index>(d.inputs.size());
+  d.x.resize(n, dims);
+  for (Eigen::Index j = 0; j < dims; ++j) {
+    for (Eigen::Index i = 0; i < n; ++i) d.x(i, j) = columns[static_cast<size_t>(j)][static_cast<size_t>(i)];
+    if (n > 0) {
+      d.inputs[static_cast<size_t>(j)].lo = d.x.col(j).minCoeff();
+      d.inputs[static_cast<size_t>(j)].hi = d.x.col(j).maxCoeff();
+    }
+  }
+  const auto mu = table.si_column("mu");
+  d.mu = Eigen::Map<const Eigen::VectorXd>(mu.data(), n);
+  d.status.assign(static_cast<size_t>(n), static_cast<long long>(SampleStatus::converged));
+  d.failure_reason.assign(static_cast<size_t>(n), "");
+  d.plan = d.x;
+  return d;
+}
+
+}  // namespace
+
+Dataset read_dataset(const std::string& path) {
+  return ends_with(path, ".csv") ? read_csv_dataset(path) : read_hdf5_dataset(path);
+}
+
+void write_dataset(const std::string& path, const Dataset& d) {
+  const auto n = d.x.rows();
+  if (d.mu.size() != n || static_cast<Eigen::Index>(d.status.size()) != n ||
+      static_cast<Eigen::Index>(d.failure_reason.size()) != n) {
+    throw Error("write_dataset '" + path + "': samples arrays differ in length");
+  }
+  h5::Writer out(path);
+  out.string_attribute("/", "format", kDatasetFormat);
+  out.int_attribute("/", "schema_version", kDatasetSchemaVersion);
+  out.string_attribute("/", "code_version", d.code_version.empty() ? code_version() : d.code_version);
+  out.string_attribute("/", "created_utc", d.created_utc.empty() ? utc_timestamp() : d.created_utc);
+  out.string_attribute("/", "source", d.source);
+  out.string_attribute("/", "scene_json", d.scene_json);
+  out.string_attribute("/", "scene_sha256", sha256_hex(d.scene_json));
+  write_input_space(out, d.inputs);
+  out.group("/samples");
+  out.matrix("/samples/inputs", d.x);
+  out.doubles("/samples/mu", d.mu);
+  out.ints("/samples/status", d.status);
+  out.strings("/samples/failure_reason", d.failure_reason);
+  out.group("/samples/diagnostics");
+  for (const auto& [name, values] : d.diagnostics) out.doubles("/samples/diagnostics/" + name, values);
+  out.group("/plan");
+  out.matrix("/plan/inputs", d.plan);
+  out.commit();
+}
+
+TrainingSet training_set(const Dataset& d, const std::string& path) {
+  TrainingSet t;
+  t.inputs = d.inputs;
+  t.source_path = path;
+  t.source_hash = sha256_file(path);
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    if (d.status[static_cast<size_t>(i)] != static_cast<long long>(SampleStatus::converged)) continue;
+    for (Eigen::Index j = 0; j < d.x.cols(); ++j) {
+      if (!std::isfinite(d.x(i, j))) {
+        throw Error(path + ": sample row " + std::to_string(i) + ", input '" + d.inputs[static_cast<size_t>(j)].name +
+                    "' is not finite (" + std::to_string(d.x(i, j)) + ")");
+      }
+    }
+    if (!std::isfinite(d.mu(i))) {
+      throw Error(path + ": sample row " + std::to_string(i) + ", mu is not finite but the sample is marked converged");
+    }
+    rows.push_back(i);
+  }
+  if (rows.empty()) throw Error(path + ": no converged samples to train on");
+  t.x.resize(static_cast<Eigen::Index>(rows.size()), d.x.cols());
+  t.mu.resize(static_cast<Eigen::Index>(rows.size()));
+  for (size_t k = 0; k < rows.size(); ++k) {
+    t.x.row(static_cast<Eigen::Index>(k)) = d.x.row(rows[k]);
+    t.mu(static_cast<Eigen::Index>(k)) = d.mu(rows[k]);
+  }
+  return t;
+}
+
+std::string sha256_hex(const std::string& bytes) {
+  unsigned char digest[SHA256_DIGEST_LENGTH];
+  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
+  std::string hex;
+  for (unsigned char byte : digest) {
+    char part[3];
+    std::snprintf(part, sizeof part, "%02x", byte);
+    hex += part;
+  }
+  return hex;
+}
+
+std::string sha256_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open for hashing");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return sha256_hex(bytes.str());
+}
+
+}  // namespace mufric

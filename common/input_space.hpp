@@ -1,0 +1,41 @@
+#pragma once
+// Named, ordered model inputs with SI units and the box they were sampled from.
+#include <string>
+#include <vector>
+
+#include "common/units.hpp"
+
+namespace mufric {
+
+struct InputSpec {
+  std::string name;  // contact_pressure, sliding_velocity, temperature, fibre_angle, ...
+  std::string unit;  // SI symbol: Pa, m/s, K, rad
+  double lo = 0.0;   // training box, SI
+  double hi = 0.0;
+
+  QuantityKind kind() const { return kind_of_input(name); }
+  bool contains(double value) const { return value >= lo && value <= hi; }
+};
+
+using InputSpace = std::vector<InputSpec>;
+
+// The default parameter box of seed 000 section 4: p 300–1300 MPa, v 22.5–200 m/min, T 25–900 °C.
+inline InputSpace default_friction_box() {
+  return {{"contact_pressure", "Pa", 300e6, 1300e6},
+          {"sliding_velocity", "m/s", 22.5 / 60.0, 200.0 / 60.0},
+          {"temperature", "K", 25.0 + 273.15, 900.0 + 273.15}};
+}
+
+}  // namespace mufric
+
+namespace mufric {
+namespace h5 {
+class Reader;
+class Writer;
+}  // namespace h5
+
+// /inputs/{names, units, box_lo, box_hi} — shared by dataset and model files.
+void write_input_space(h5::Writer& out, const InputSpace& inputs);
+// Validates: equal lengths, at least one input, finite boxes with lo < hi, SI units for known names.
+InputSpace read_input_space(const h5::Reader& in);
+}  // namespace mufric

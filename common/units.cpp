@@ -1,0 +1,173 @@
+#include "common/units.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "common/error.hpp"
+
+namespace mufric {
+namespace {
+
+constexpr double kZeroCelsiusInKelvin = 273.15;
+constexpr double kPi = 3.14159265358979323846;
+
+struct UnitEntry {
+  std::string_view symbol;
+  UnitToSi to_si;
+};
+
+constexpr std::array kUnits{
+    UnitEntry{"Pa", {QuantityKind::pressure, 1.0, 0.0}},
+    UnitEntry{"kPa", {QuantityKind::pressure, 1e3, 0.0}},
+    UnitEntry{"MPa", {QuantityKind::pressure, 1e6, 0.0}},
+    UnitEntry{"GPa", {QuantityKind::pressure, 1e9, 0.0}},
+    UnitEntry{"N/mm2", {QuantityKind::pressure, 1e6, 0.0}},
+    UnitEntry{"m/s", {QuantityKind::velocity, 1.0, 0.0}},
+    UnitEntry{"m/min", {QuantityKind::velocity, 1.0 / 60.0, 0.0}},
+    UnitEntry{"mm/s", {QuantityKind::velocity, 1e-3, 0.0}},
+    UnitEntry{"mm/min", {QuantityKind::velocity, 1e-3 / 60.0, 0.0}},
+    UnitEntry{"K", {QuantityKind::temperature, 1.0, 0.0}},
+    UnitEntry{"C", {QuantityKind::temperature, 1.0, kZeroCelsiusInKelvin}},
+    UnitEntry{"degC", {QuantityKind::temperature, 1.0, kZeroCelsiusInKelvin}},
+    UnitEntry{"°C", {QuantityKind::temperature, 1.0, kZeroCelsiusInKelvin}},
+    UnitEntry{"rad", {QuantityKind::angle, 1.0, 0.0}},
+    UnitEntry{"deg", {QuantityKind::angle, kPi / 180.0, 0.0}},
+    UnitEntry{"°", {QuantityKind::angle, kPi / 180.0, 0.0}},
+    UnitEntry{"m", {QuantityKind::length, 1.0, 0.0}},
+    UnitEntry{"mm", {QuantityKind::length, 1e-3, 0.0}},
+    UnitEntry{"um", {QuantityKind::length, 1e-6, 0.0}},
+    UnitEntry{"µm", {QuantityKind::length, 1e-6, 0.0}},
+    UnitEntry{"nm", {QuantityKind::length, 1e-9, 0.0}},
+    UnitEntry{"s", {QuantityKind::time, 1.0, 0.0}},
+    UnitEntry{"ms", {QuantityKind::time, 1e-3, 0.0}},
+    UnitEntry{"us", {QuantityKind::time, 1e-6, 0.0}},
+    UnitEntry{"1", {QuantityKind::dimensionless, 1.0, 0.0}},
+};
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+}  // namespace
+
+std::string_view to_string(QuantityKind kind) {
+  switch (kind) {
+    case QuantityKind::pressure: return "pressure";
+    case QuantityKind::velocity: return "velocity";
+    case QuantityKind::temperature: return "temperature";
+    case QuantityKind::angle: return "angle";
+    case QuantityKind::length: return "length";
+    case QuantityKind::time: return "time";
+    case QuantityKind::dimensionless: return "dimensionless";
+  }
+  return "unknown";
+}
+
+std::string_view si_unit(QuantityKind kind) {
+  switch (kind) {
+    case QuantityKind::pressure: return "Pa";
+    case QuantityKind::velocity: return "m/s";
+    case QuantityKind::temperature: return "K";
+    case QuantityKind::angle: return "rad";
+    case QuantityKind::length: return "m";
+    case QuantityKind::time: return "s";
+    case QuantityKind::dimensionless: return "1";
+  }
+  return "1";
+}
+
+std::string_view human_unit(QuantityKind kind) {
+  switch (kind) {
+    case QuantityKind::pressure: return "MPa";
+    case QuantityKind::velocity: return "m/min";
+    case QuantityKind::temperature: return "°C";
+    case QuantityKind::angle: return "deg";
+    case QuantityKind::length: return "um";
+    case QuantityKind::time: return "s";
+    case QuantityKind::dimensionless: return "";
+  }
+  return "";
+}
+
+std::string_view example_quantity(QuantityKind kind) {
+  switch (kind) {
+    case QuantityKind::pressure: return "800MPa";
+    case QuantityKind::velocity: return "100m/min";
+    case QuantityKind::temperature: return "500C";
+    case QuantityKind::angle: return "90deg";
+    case QuantityKind::length: return "10um";
+    case QuantityKind::time: return "2.5e-7s";
+    case QuantityKind::dimensionless: return "0.3";
+  }
+  return "";
+}
+
+UnitToSi unit_to_si(std::string_view unit) {
+  unit = trim(unit);
+  for (const auto& entry : kUnits) {
+    if (entry.symbol == unit) return entry.to_si;
+  }
+  throw Error("unknown unit '" + std::string(unit) +
+              "' (known: Pa kPa MPa GPa, m/s m/min mm/s, K C degC, rad deg, m mm um nm, s ms us, 1)");
+}
+
+double parse_quantity(std::string_view text, QuantityKind expected, std::string_view field) {
+  const std::string_view trimmed = trim(text);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(trimmed.data(), trimmed.data() + trimmed.size(), value);
+  const std::string prefix = std::string(field) + ": '" + std::string(text) + "'";
+  if (ec != std::errc() || !std::isfinite(value)) {
+    throw Error(prefix + " is not a number with a unit (expected e.g. " +
+                std::string(example_quantity(expected)) + ")");
+  }
+  const std::string_view unit = trim(std::string_view(end, trimmed.data() + trimmed.size() - end));
+  if (unit.empty() && expected != QuantityKind::dimensionless) {
+    throw Error(prefix + " has no unit; a " + std::string(to_string(expected)) +
+                " needs one, e.g. " + std::string(example_quantity(expected)));
+  }
+  if (unit.empty()) return value;
+  UnitToSi map{};
+  try {
+    map = unit_to_si(unit);
+  } catch (const Error& e) {
+    throw Error(prefix + ": " + e.what());
+  }
+  if (map.kind != expected) {
+    throw Error(prefix + " is a " + std::string(to_string(map.kind)) + ", expected a " +
+                std::string(to_string(expected)) + " such as " +
+                std::string(example_quantity(expected)));
+  }
+  return map.scale * value + map.offset;
+}
+
+double si_to_human(double si_value, QuantityKind kind) {
+  switch (kind) {
+    case QuantityKind::pressure: return si_value / 1e6;
+    case QuantityKind::velocity: return si_value * 60.0;
+    case QuantityKind::temperature: return si_value - kZeroCelsiusInKelvin;
+    case QuantityKind::angle: return si_value * 180.0 / kPi;
+    case QuantityKind::length: return si_value * 1e6;
+    default: return si_value;
+  }
+}
+
+std::string format_human(double si_value, QuantityKind kind, int precision) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*g", precision, si_to_human(si_value, kind));
+  return std::string(text) + std::string(human_unit(kind));
+}
+
+QuantityKind kind_of_input(std::string_view input_name) {
+  if (input_name == "contact_pressure") return QuantityKind::pressure;
+  if (input_name == "sliding_velocity") return QuantityKind::velocity;
+  if (input_name == "temperature") return QuantityKind::temperature;
+  if (input_name == "fibre_angle") return QuantityKind::angle;
+  return QuantityKind::dimensionless;
+}
+
+}  // namespace mufric

@@ -1,0 +1,41 @@
+#pragma once
+// Physical quantities with explicit units at the human boundary (CLI, CSV headers, plots);
+// SI everywhere inside: Pa, m/s, K, rad, m, s.
+#include <string>
+#include <string_view>
+
+namespace mufric {
+
+enum class QuantityKind { pressure, velocity, temperature, angle, length, time, dimensionless };
+
+// An affine map from a unit to SI: si = scale * value + offset (offset only for °C).
+struct UnitToSi {
+  QuantityKind kind;
+  double scale;
+  double offset;
+};
+
+std::string_view to_string(QuantityKind kind);
+// The SI unit symbol stored in files: "Pa", "m/s", "K", "rad", "m", "s", "1".
+std::string_view si_unit(QuantityKind kind);
+// Example used in error messages, e.g. "800MPa".
+std::string_view example_quantity(QuantityKind kind);
+
+// Looks up a unit symbol ("MPa", "m/min", "C", "degC", "°C", "K", "deg", ...).
+// Throws Error naming the unit when it is unknown.
+UnitToSi unit_to_si(std::string_view unit);
+
+// Parses "800MPa", "800 MPa", "1.2e9Pa", "100m/min", "500C". A number without a unit, an unknown
+// unit, or a unit of another kind throws Error whose message starts with `field`.
+double parse_quantity(std::string_view text, QuantityKind expected, std::string_view field);
+
+// Formats an SI value in the unit people use for that kind (MPa, m/min, °C, deg).
+std::string format_human(double si_value, QuantityKind kind, int precision = 4);
+// The human unit used by format_human, e.g. "MPa".
+std::string_view human_unit(QuantityKind kind);
+double si_to_human(double si_value, QuantityKind kind);
+
+// The kind of a named model input (contact_pressure → pressure, ...); dimensionless if unknown.
+QuantityKind kind_of_input(std::string_view input_name);
+
+}  // namespace mufric

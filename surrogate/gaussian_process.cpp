@@ -1,0 +1,193 @@
+#include "surrogate/gaussian_process.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "surrogate/cholesky.hpp"
+
+namespace mufric {
+namespace {
+
+// Queries per block: the n × block kernel slab stays in L2 for n ≈ 1000 while the triangular solve
+// still runs as a matrix–matrix (level-3) operation.
+constexpr Eigen::Index kQueryBlock = 128;
+// Below this many queries a parallel region costs more than it saves.
+constexpr Eigen::Index kParallelThreshold = 2 * kQueryBlock;
+// A loaded model must reproduce its training outputs to this relative accuracy: K α = y.
+constexpr double kLoadResidualTolerance = 1e-6;
+
+}  // namespace
+
+Eigen::VectorXd GpHyperParameters::to_log() const {
+  Eigen::VectorXd theta(count());
+  theta(0) = std::log(signal_variance);
+  theta.segment(1, length_scales.size()) = length_scales.array().log();
+  if (noise_term) theta(theta.size() - 1) = std::log(noise_variance);
+  return theta;
+}
+
+GpHyperParameters GpHyperParameters::from_log(const Eigen::VectorXd& theta, Eigen::Index dims, bool noise_term) {
+  GpHyperParameters h;
+  h.signal_variance = std::exp(theta(0));
+  h.length_scales = theta.segment(1, dims).array().exp();
+  h.noise_term = noise_term;
+  h.noise_variance = noise_term ? std::exp(theta(dims + 1)) : 0.0;
+  return h;
+}
+
+Eigen::MatrixXd to_unit_box(const Eigen::MatrixXd& x, const InputSpace& inputs) {
+  Eigen::MatrixXd u(x.rows(), x.cols());
+  for (Eigen::Index j = 0; j < x.cols(); ++j) {
+    const InputSpec& input = inputs[static_cast<size_t>(j)];
+    u.col(j) = (x.col(j).array() - input.lo) / (input.hi - input.lo);
+  }
+  return u;
+}
+
+void rbf_signal_covariance(const Eigen::MatrixXd& x_unit, const GpHyperParameters& hyper, Eigen::MatrixXd& kf) {
+  const Eigen::Index n = x_unit.rows();
+  const Eigen::MatrixXd scaled = x_unit * hyper.length_scales.cwiseInverse().asDiagonal();
+  kf.resize(n, n);
+  Eigen::ArrayXd r2(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const Eigen::Index len = n - j;
+    r2.head(len).setZero();
+    for (Eigen::Index k = 0; k < scaled.cols(); ++k) {
+      r2.head(len) += (scaled.col(k).tail(len).array() - scaled(j, k)).square();
+    }
+    kf.col(j).tail(len) = hyper.signal_variance * (-0.5 * r2.head(len)).exp();
+  }
+}
+
+GaussianProcess::GaussianProcess(State state) : FrictionModel(state.inputs), state_(std::move(state)) {
+  const auto n = state_.x_train.rows();
+  const auto d = static_cast<Eigen::Index>(state_.inputs.size());
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw Error("Gaussian process: " + what);
+  };
+  require(n > 0, "no training points");
+  require(state_.x_train.cols() == d, "x_train has " + std::to_string(state_.x_train.cols()) + " columns for " +
+                                          std::to_string(d) + " inputs");
+  require(state_.y_train.size() == n, "y_train length differs from x_train rows");
+  require(state_.alpha.size() == n, "alpha length differs from the number of training points");
+  require(state_.cholesky.rows() == n && state_.cholesky.cols() == n, "cholesky factor is not n × n");
+  require(state_.hyper.length_scales.size() == d, "length_scales has the wrong length");
+  require(state_.hyper.length_scales.allFinite() && (state_.hyper.length_scales.array() > 0).all(),
+          "length_scales must be positive and finite");
+  require(std::isfinite(state_.hyper.signal_variance) && state_.hyper.signal_variance > 0, "signal_variance must be positive");
+  require(std::isfinite(state_.hyper.noise_variance) && state_.hyper.noise_variance >= 0, "noise_variance must be >= 0");
+  require(std::isfinite(state_.y_scale) && state_.y_scale > 0, "y_scale must be positive");
+  require(std::isfinite(state_.y_mean), "y_mean must be finite");
+  require(state_.alpha.allFinite() && state_.x_train.allFinite() && state_.y_train.allFinite(), "non-finite training data or alpha");
+
+  box_lo_.resize(d);
+  inverse_box_width_.resize(d);
+  for (Eigen::Index j = 0; j < d; ++j) {
+    box_lo_(j) = state_.inputs[static_cast<size_t>(j)].lo;
+    inverse_box_width_(j) = 1.0 / (state_.inputs[static_cast<size_t>(j)].hi - state_.inputs[static_cast<size_t>(j)].lo);
+  }
+  scaled_train_ = to_unit_box(state_.x_train, state_.inputs) * state_.hyper.length_scales.cwiseInverse().asDiagonal();
+  weights_ = state_.y_scale * state_.hyper.signal_variance * state_.alpha;
+  weights_by_input_ = scaled_train_.array().colwise() * weights_.array();
+}
+
+void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count,
+                                     const EvaluationRequest& what, Eigen::MatrixXd& k_block, Evaluation& out,
+                                     long long& clamped) const {
+  const Eigen::Index n = scaled_train_.rows();
+  const Eigen::Index d = scaled_train_.cols();
+  // Query coordinates in the same scaled space as the training inputs: ((x − lo)/width)/l.
+  const Eigen::MatrixXd q = ((x.middleRows(first, count).rowwise() - box_lo_).array().rowwise() *
+                             inverse_box_width_.array())
+                                .matrix() *
+                            state_.hyper.length_scales.cwiseInverse().asDiagonal();
+  // k_block(i, b) = exp(−½ |x_i − q_b|²): column b is the kernel vector of query b (without σ²).
+  k_block.resize(n, count);
+  for (Eigen::Index b = 0; b < count; ++b) {
+    auto column = k_block.col(b).array();
+    column = (scaled_train_.col(0).array() - q(b, 0)).square();
+    for (Eigen::Index k = 1; k < d; ++k) column += (scaled_train_.col(k).array() - q(b, k)).square();
+    column = (-0.5 * column).exp();
+  }
+  out.mu.segment(first, count).noalias() = k_block.transpose() * weights_;
+  out.mu.segment(first, count).array() += state_.y_mean;
+
+  if (what.gradient) {
+    // ∂μ/∂x_k = −Σ_i w_i k_i (q_k − s_ik) / (l_k · width_k)  with s = scaled training inputs.
+    const Eigen::MatrixXd weighted = k_block.transpose() * weights_by_input_;  // count × d
+    for (Eigen::Index k = 0; k < d; ++k) {
+      const double factor = inverse_box_width_(k) / state_.hyper.length_scales(k);
+      for (Eigen::Index b = 0; b < count; ++b) {
+        const double kw = out.mu(first + b) - state_.y_mean;
+        out.gradient(first + b, k) = -factor * (q(b, k) * kw - weighted(b, k));
+      }
+    }
+  }
+
+  if (what.std || what.ci_level > 0.0) {
+    // var_b = σ² + σn² − σ⁴ |L⁻¹ k̂_b|²  (R&W Algorithm 2.1, lines 5–6), in normalised units.
+    state_.cholesky.triangularView<Eigen::Lower>().solveInPlace(k_block);
+    const double s2 = state_.hyper.signal_variance;
+    const double prior = s2 + state_.hyper.noise_variance;
+    for (Eigen::Index b = 0; b < count; ++b) {
+      double variance = prior - s2 * s2 * k_block.col(b).squaredNorm();
+      if (variance < 0.0) {
+        variance = 0.0;
+        ++clamped;
+      }
+      out.std(first + b) = state_.y_scale * std::sqrt(variance);
+    }
+  }
+}
+
+void GaussianProcess::evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const {
+  const Eigen::Index m = x.rows();
+  out.mu.resize(m);
+  if (what.std || what.ci_level > 0.0) out.std.resize(m);
+  if (what.gradient) out.gradient.resize(m, x.cols());
+  const Eigen::Index blocks = (m + kQueryBlock - 1) / kQueryBlock;
+  if (m < kParallelThreshold) {
+    Eigen::MatrixXd k_block;
+    for (Eigen::Index block = 0; block < blocks; ++block) {
+      const Eigen::Index first = block * kQueryBlock;
+      evaluate_block(x, first, std::min(kQueryBlock, m - first), what, k_block, out, out.clamped_variances);
+    }
+    return;
+  }
+  long long clamped = 0;
+#pragma omp parallel reduction(+ : clamped)
+  {
+    Eigen::MatrixXd k_block;
+    // Each block writes disjoint rows of `out`; the clamp counter is per thread.
+#pragma omp for schedule(dynamic, 1)
+    for (Eigen::Index block = 0; block < blocks; ++block) {
+      const Eigen::Index first = block * kQueryBlock;
+      evaluate_block(x, first, std::min(kQueryBlock, m - first), what, k_block, out, clamped);
+    }
+  }
+  out.clamped_variances += clamped;
+}
+
+std::string GaussianProcess::summary() const {
+  std::ostringstream s;
+  const auto& h = state_.hyper;
+  s << "Gaussian process, RBF-ARD kernel, " << state_.x_train.rows() << " training points\n";
+  s << "  signal variance " << h.signal_variance << ", noise variance " << (h.noise_term ? h.noise_variance : 0.0)
+    << (h.noise_term ? "" : " (no noise term)") << ", jitter " << state_.jitter << "\n";
+  for (size_t j = 0; j < state_.inputs.size(); ++j) {
+    s << "  length scale " << state_.inputs[j].name << ": " << h.length_scales(static_cast<Eigen::Index>(j))
+      << " (box widths)\n";
+  }
+  const auto& t = state_.summary;
+  s << "  log marginal likelihood " << t.log_marginal_likelihood << "\n";
+  s << "  leave-one-out: mean relative error " << 100.0 * t.loo_mean_relative_error << " %, max "
+    << 100.0 * t.loo_max_relative_error << " %, RMSE " << t.loo_rmse << ", 95 % coverage "
+    << 100.0 * t.loo_coverage_95 << " %";
+  return s.str();
+}
+
+}  // namespace mufric

@@ -1,0 +1,92 @@
+#pragma once
+// Gaussian-process regression (Rasmussen & Williams 2006, Algorithm 2.1) with the scikit-learn
+// kernel convention k(x, x') = σ² exp(−½ Σᵢ ((xᵢ − x'ᵢ)/lᵢ)²) + σn² δ(x, x'), inputs scaled to the
+// unit box of the declared training box, outputs normalised by mean and (population) std.
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "surrogate/friction_model.hpp"
+
+namespace mufric {
+
+struct GpHyperParameters {
+  double signal_variance = 1.0;      // σ², in normalised-output units
+  Eigen::VectorXd length_scales;     // lᵢ, in unit-box coordinates
+  double noise_variance = 0.0;       // σn², 0 when the model has no white-noise term
+  bool noise_term = true;
+
+  // θ = [log σ², log l₁…l_d, (log σn²)] — the optimiser's coordinates.
+  Eigen::VectorXd to_log() const;
+  static GpHyperParameters from_log(const Eigen::VectorXd& theta, Eigen::Index dims, bool noise_term);
+  Eigen::Index count() const { return length_scales.size() + (noise_term ? 2 : 1); }
+};
+
+// Figures from training, stored in the model file and shown by `describe`.
+struct GpTrainingSummary {
+  double log_marginal_likelihood = 0.0;
+  double loo_mean_relative_error = 0.0;  // leave-one-out, closed form (R&W eq. 5.12)
+  double loo_max_relative_error = 0.0;
+  double loo_rmse = 0.0;                 // in μ units
+  double loo_coverage_95 = 0.0;          // fraction of samples inside their LOO 95 % interval
+  long long starts = 0;
+  long long best_start = 0;
+  double seconds = 0.0;
+  std::string dataset_path;
+  std::string dataset_sha256;
+  std::string code_version;
+  std::string created_utc;
+};
+
+class GaussianProcess final : public FrictionModel {
+ public:
+  struct State {
+    InputSpace inputs;
+    Eigen::MatrixXd x_train;  // n × d, SI
+    Eigen::VectorXd y_train;  // n, μ
+    double y_mean = 0.0;
+    double y_scale = 1.0;
+    GpHyperParameters hyper;
+    double jitter = 0.0;       // added to the diagonal beyond σn² when factorising
+    Eigen::VectorXd alpha;     // K⁻¹ (y − mean)/scale
+    Eigen::MatrixXd cholesky;  // lower factor of K, n × n
+    GpTrainingSummary summary;
+  };
+
+  // Takes a complete state (after training or loading) and precomputes the prediction caches.
+  explicit GaussianProcess(State state);
+
+  std::string_view kind() const override { return "gp"; }
+  bool has_uncertainty() const override { return true; }
+  void write(h5::Writer& out) const override;
+  std::string summary() const override;
+  const State& state() const { return state_; }
+
+  // Rebuilds a model from the file's groups; refuses inconsistent contents (names the field).
+  static GaussianProcess read(const h5::Reader& in, InputSpace inputs);
+
+  // Store the n × n factor in model files up to this size; larger models refactorise on load.
+  static constexpr Eigen::Index kStoreCholeskyUpTo = 2000;
+
+ protected:
+  void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const override;
+
+ private:
+  void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
+                      Eigen::MatrixXd& k_block, Evaluation& out, long long& clamped) const;
+
+  State state_;
+  Eigen::RowVectorXd box_lo_;
+  Eigen::RowVectorXd inverse_box_width_;
+  Eigen::MatrixXd scaled_train_;       // x_unit / l, n × d
+  Eigen::VectorXd weights_;            // y_scale σ² α: mean = y_mean + Σ weights_i exp(−½ r²)
+  Eigen::MatrixXd weights_by_input_;   // weights_ ∘ scaled_train_, for dμ/dx
+};
+
+// Unit-box coordinates of SI inputs: (x − lo) / (hi − lo) per input.
+Eigen::MatrixXd to_unit_box(const Eigen::MatrixXd& x, const InputSpace& inputs);
+
+// Lower triangle (and diagonal) of the signal covariance σ² exp(−½ r²) for unit-box inputs.
+void rbf_signal_covariance(const Eigen::MatrixXd& x_unit, const GpHyperParameters& hyper, Eigen::MatrixXd& kf);
+
+}  // namespace mufric

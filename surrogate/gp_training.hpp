@@ -1,0 +1,86 @@
+#pragma once
+// Hyper-parameter fitting by maximising the log marginal likelihood (R&W eq. 2.30, gradient
+// eq. 5.9) with NLopt's bounded L-BFGS from several deterministic starts.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "common/dataset_file.hpp"
+#include "surrogate/gaussian_process.hpp"
+
+namespace mufric {
+
+// Bounds on the hyper-parameters (not their logs), in normalised-output and unit-box units.
+struct GpBounds {
+  double signal_variance_lo = 1e-3, signal_variance_hi = 1e5;
+  double length_scale_lo = 1e-2, length_scale_hi = 1e3;
+  double noise_variance_lo = 1e-10, noise_variance_hi = 1e-1;
+};
+
+struct GpTrainingOptions {
+  int restarts = 4;            // starts after the first, as scikit-learn's n_restarts_optimizer
+  std::uint64_t seed = 0;      // restarts are drawn log-uniformly in the bounds from this seed
+  bool noise_term = true;
+  GpBounds bounds;
+  GpHyperParameters initial;   // first start; empty length_scales → 0.5 box widths, σ² = 1, σn² = 1e-5
+  int max_evaluations = 1000;  // per start
+  double relative_tolerance = 1e-9;  // on the LML (≈ scipy L-BFGS-B's default factr 1e7)
+  int threads = 0;             // starts run in parallel; 0 = all cores
+  bool optimise = true;        // false: use `initial` as given
+};
+
+struct GpStartReport {
+  Eigen::VectorXd initial_log;
+  Eigen::VectorXd final_log;
+  double log_marginal_likelihood = 0.0;
+  int evaluations = 0;
+  std::string outcome;  // NLopt's result, or why the start failed
+  double seconds = 0.0;
+  bool ok = false;
+};
+
+struct GpTrainingReport {
+  std::vector<GpStartReport> starts;
+  int best_start = -1;
+  double jitter = 0.0;
+  double seconds = 0.0;
+  std::vector<std::string> warnings;  // constant outputs, parameter at a bound, jitter added, ...
+};
+
+// Log marginal likelihood of normalised outputs y at unit-box inputs, and its gradient w.r.t. θ.
+class LogMarginalLikelihood {
+ public:
+  LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term);
+
+  struct Value {
+    bool ok = false;
+    double lml = 0.0;
+    Eigen::VectorXd gradient;  // w.r.t. θ = log hyper-parameters
+    double jitter = 0.0;
+    std::string reason;
+  };
+  Value operator()(const Eigen::VectorXd& theta, bool with_gradient);
+
+  // Factor and α at θ (for the final model); valid after a successful call.
+  const Eigen::MatrixXd& signal_covariance() const { return kf_; }
+
+ private:
+  const Eigen::MatrixXd& x_unit_;
+  const Eigen::VectorXd& y_;
+  bool noise_term_;
+  Eigen::MatrixXd kf_;      // σ² R, lower triangle
+  Eigen::MatrixXd factor_;  // L, then (LLᵀ)⁻¹
+  Eigen::MatrixXd scaled_;  // x_unit / l
+};
+
+// Fits a GP to the training set. Throws Error with a clear reason when no start succeeds.
+GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTrainingOptions& options,
+                                       GpTrainingReport* report = nullptr);
+
+// Leave-one-out figures in closed form from K⁻¹ (R&W eq. 5.12): μ₋ᵢ = yᵢ − αᵢ/[K⁻¹]ᵢᵢ, σ²₋ᵢ = 1/[K⁻¹]ᵢᵢ.
+void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summary);
+
+}  // namespace mufric

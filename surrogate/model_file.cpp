@@ -1,0 +1,222 @@
+#include "surrogate/model_file.hpp"
+
+#include <cmath>
+
+#include "common/error.hpp"
+#include "common/version.hpp"
+#include "surrogate/cholesky.hpp"
+#include "surrogate/empirical_laws.hpp"
+#include "surrogate/gaussian_process.hpp"
+
+namespace mufric {
+namespace {
+
+// A loaded GP must satisfy K α = y to this normwise backward error; a backward-stable solve gives
+// about n·ε, a flipped bit in α, L or x_train gives O(1).
+constexpr double kLoadBackwardErrorTolerance = 1e-8;
+
+std::vector<double> column(const std::vector<MlrRow>& rows, double MlrRow::*field) {
+  std::vector<double> values;
+  for (const auto& r : rows) values.push_back(r.*field);
+  return values;
+}
+
+}  // namespace
+
+void save_model(const std::string& path, const FrictionModel& model) {
+  h5::Writer out(path);
+  out.string_attribute("/", "format", kModelFormat);
+  out.int_attribute("/", "schema_version", kModelSchemaVersion);
+  out.string_attribute("/", "kind", std::string(model.kind()));
+  out.string_attribute("/", "code_version", code_version());
+  out.string_attribute("/", "created_utc", utc_timestamp());
+  write_input_space(out, model.inputs());
+  model.write(out);
+  out.commit();
+}
+
+std::unique_ptr<FrictionModel> load_model(const std::string& path) {
+  const h5::Reader in(path, "model");
+  if (!in.has_attribute("/", "format") || in.string_attribute("/", "format") != kModelFormat) {
+    in.fail("/", "not a mufric model (attribute 'format' is not '" + std::string(kModelFormat) + "')");
+  }
+  const long long version = in.int_attribute("/", "schema_version");
+  if (version != kModelSchemaVersion) {
+    in.fail("/", "schema_version " + std::to_string(version) + " is not supported (this build reads " +
+                     std::to_string(kModelSchemaVersion) + ")");
+  }
+  InputSpace inputs = read_input_space(in);
+  const std::string kind = in.string_attribute("/", "kind");
+  try {
+    if (kind == "gp") return std::make_unique<GaussianProcess>(GaussianProcess::read(in, std::move(inputs)));
+    if (kind == "mlr") return std::make_unique<MlrLaw>(MlrLaw::read(in, std::move(inputs)));
+    if (kind == "coulomb") return std::make_unique<CoulombLaw>(CoulombLaw::read(in, std::move(inputs)));
+  } catch (const H5::Exception& e) {
+    in.fail("/" + kind, "unreadable (" + e.getDetailMsg() + ")");
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    if (message.rfind("model '", 0) == 0) throw;
+    in.fail("/" + kind, message);
+  }
+  in.fail("/", "unknown model kind '" + kind + "' (known: gp, mlr, coulomb)");
+}
+
+std::string model_path_from_uri(const std::string& uri) {
+  const std::string file_scheme = "file://";
+  if (uri.rfind(file_scheme, 0) == 0) return uri.substr(file_scheme.size());
+  const auto scheme_end = uri.find("://");
+  if (scheme_end != std::string::npos) {
+    throw Error("model URI '" + uri + "': scheme '" + uri.substr(0, scheme_end) +
+                "' is not handled here; use file:///path/model.h5 or a plain path");
+  }
+  return uri;
+}
+
+// ---- Coulomb -------------------------------------------------------------------------------
+void CoulombLaw::write(h5::Writer& out) const {
+  out.group("/coulomb");
+  out.double_attribute("/coulomb", "mu", mu_);
+}
+
+CoulombLaw CoulombLaw::read(const h5::Reader& in, InputSpace inputs) {
+  return CoulombLaw(in.double_attribute("/coulomb", "mu"), std::move(inputs));
+}
+
+// ---- MLR -----------------------------------------------------------------------------------
+void MlrLaw::write(h5::Writer& out) const {
+  out.group("/mlr");
+  out.string_attribute("/mlr", "source", source_);
+  out.string_attribute("/mlr", "units", "mu = beta0 + beta1*v[m/min] + beta2*p[MPa]; angles in degrees");
+  out.doubles("/mlr/fibre_angle_deg", column(rows_, &MlrRow::fibre_angle_deg));
+  out.doubles("/mlr/beta0", column(rows_, &MlrRow::beta0));
+  out.doubles("/mlr/beta1_per_m_min", column(rows_, &MlrRow::beta1_per_m_min));
+  out.doubles("/mlr/beta2_per_mpa", column(rows_, &MlrRow::beta2_per_mpa));
+  out.doubles("/mlr/mu_min", column(rows_, &MlrRow::mu_min));
+  out.doubles("/mlr/mu_max", column(rows_, &MlrRow::mu_max));
+  out.doubles("/mlr/r_squared", column(rows_, &MlrRow::r_squared));
+}
+
+MlrLaw MlrLaw::read(const h5::Reader& in, InputSpace inputs) {
+  const auto angles = in.doubles("/mlr/fibre_angle_deg");
+  const auto k = static_cast<Eigen::Index>(angles.size());
+  const Eigen::VectorXd b0 = in.vector("/mlr/beta0", k), b1 = in.vector("/mlr/beta1_per_m_min", k),
+                        b2 = in.vector("/mlr/beta2_per_mpa", k), lo = in.vector("/mlr/mu_min", k),
+                        hi = in.vector("/mlr/mu_max", k), r2 = in.vector("/mlr/r_squared", k);
+  std::vector<MlrRow> rows;
+  for (Eigen::Index i = 0; i < k; ++i) {
+    rows.push_back({angles[static_cast<size_t>(i)], b0(i), b1(i), b2(i), lo(i), hi(i), r2(i)});
+  }
+  return MlrLaw(std::move(rows), in.string_attribute("/mlr", "source"), std::move(inputs));
+}
+
+// ---- Gaussian process ----------------------------------------------------------------------
+void GaussianProcess::write(h5::Writer& out) const {
+  const auto& s = state_;
+  out.group("/gp");
+  out.string_attribute("/gp", "kernel", "constant*RBF(ARD)+white; inputs scaled to the unit box, outputs (mu-mean)/scale");
+  out.double_attribute("/gp", "y_mean", s.y_mean);
+  out.double_attribute("/gp", "y_scale", s.y_scale);
+  out.double_attribute("/gp", "signal_variance", s.hyper.signal_variance);
+  out.double_attribute("/gp", "noise_variance", s.hyper.noise_variance);
+  out.int_attribute("/gp", "noise_term", s.hyper.noise_term ? 1 : 0);
+  out.double_attribute("/gp", "jitter", s.jitter);
+  out.doubles("/gp/length_scales", s.hyper.length_scales);
+  out.matrix("/gp/x_train", s.x_train);
+  out.doubles("/gp/y_train", s.y_train);
+  out.doubles("/gp/alpha", s.alpha);
+  if (s.x_train.rows() <= kStoreCholeskyUpTo) out.matrix("/gp/cholesky_lower", s.cholesky);
+  out.group("/gp/training");
+  const auto& t = s.summary;
+  out.double_attribute("/gp/training", "log_marginal_likelihood", t.log_marginal_likelihood);
+  out.double_attribute("/gp/training", "loo_mean_relative_error", t.loo_mean_relative_error);
+  out.double_attribute("/gp/training", "loo_max_relative_error", t.loo_max_relative_error);
+  out.double_attribute("/gp/training", "loo_rmse", t.loo_rmse);
+  out.double_attribute("/gp/training", "loo_coverage_95", t.loo_coverage_95);
+  out.int_attribute("/gp/training", "starts", t.starts);
+  out.int_attribute("/gp/training", "best_start", t.best_start);
+  out.double_attribute("/gp/training", "seconds", t.seconds);
+  out.string_attribute("/gp/training", "dataset_path", t.dataset_path);
+  out.string_attribute("/gp/training", "dataset_sha256", t.dataset_sha256);
+  out.string_attribute("/gp/training", "code_version", t.code_version);
+  out.string_attribute("/gp/training", "created_utc", t.created_utc);
+}
+
+GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
+  State s;
+  s.inputs = std::move(inputs);
+  const auto d = static_cast<Eigen::Index>(s.inputs.size());
+  s.x_train = in.matrix("/gp/x_train");
+  if (s.x_train.cols() != d) {
+    in.fail("/gp/x_train", "has " + std::to_string(s.x_train.cols()) + " columns for " + std::to_string(d) + " inputs");
+  }
+  const Eigen::Index n = s.x_train.rows();
+  if (n == 0) in.fail("/gp/x_train", "no training points");
+  if (!s.x_train.allFinite()) in.fail("/gp/x_train", "contains non-finite values");
+  s.y_train = in.vector("/gp/y_train", n);
+  s.alpha = in.vector("/gp/alpha", n);
+  if (!s.alpha.allFinite()) in.fail("/gp/alpha", "contains non-finite values");
+  s.y_mean = in.double_attribute("/gp", "y_mean");
+  s.y_scale = in.double_attribute("/gp", "y_scale");
+  s.hyper.signal_variance = in.double_attribute("/gp", "signal_variance");
+  s.hyper.noise_variance = in.double_attribute("/gp", "noise_variance");
+  s.hyper.noise_term = in.int_attribute("/gp", "noise_term") != 0;
+  s.hyper.length_scales = in.vector("/gp/length_scales", d);
+  s.jitter = in.double_attribute("/gp", "jitter");
+  if (!(s.hyper.length_scales.array() > 0).all() || !s.hyper.length_scales.allFinite()) {
+    in.fail("/gp/length_scales", "must be positive and finite");
+  }
+  if (!(s.hyper.signal_variance > 0) || !std::isfinite(s.hyper.signal_variance)) {
+    in.fail("/gp", "attribute signal_variance must be positive and finite");
+  }
+  if (!(s.hyper.noise_variance >= 0) || !std::isfinite(s.hyper.noise_variance)) {
+    in.fail("/gp", "attribute noise_variance must be >= 0 and finite");
+  }
+  if (!(s.jitter >= 0) || !std::isfinite(s.jitter)) in.fail("/gp", "attribute jitter must be >= 0 and finite");
+  if (!(s.y_scale > 0) || !std::isfinite(s.y_scale)) in.fail("/gp", "attribute y_scale must be positive and finite");
+
+  Eigen::MatrixXd kf;
+  rbf_signal_covariance(to_unit_box(s.x_train, s.inputs), s.hyper, kf);
+  const double diagonal = s.hyper.noise_variance + s.jitter;
+  if (in.has("/gp/cholesky_lower")) {
+    s.cholesky = in.matrix("/gp/cholesky_lower");
+    if (s.cholesky.rows() != n || s.cholesky.cols() != n) in.fail("/gp/cholesky_lower", "is not n × n");
+    if (!s.cholesky.allFinite() || !(s.cholesky.diagonal().array() > 0).all()) {
+      in.fail("/gp/cholesky_lower", "is not a valid Cholesky factor (non-finite or non-positive diagonal)");
+    }
+  } else {
+    const auto chol = cholesky_with_jitter(kf, diagonal, s.cholesky);
+    if (!chol.ok || chol.jitter > 0.0) in.fail("/gp", "covariance cannot be refactorised with the stored jitter");
+  }
+  // Consistency: K α = y and L Lᵀ α = y, both O(n²).
+  const Eigen::VectorXd y = (s.y_train.array() - s.y_mean) / s.y_scale;
+  Eigen::VectorXd k_alpha = kf.selfadjointView<Eigen::Lower>() * s.alpha;
+  k_alpha += diagonal * s.alpha;
+  const double scale = kf.norm() * s.alpha.norm() + y.norm();
+  if ((k_alpha - y).norm() > kLoadBackwardErrorTolerance * scale) {
+    in.fail("/gp/alpha", "is inconsistent with x_train, y_train and the hyper-parameters (K·alpha != y)");
+  }
+  const Eigen::VectorXd lt_alpha = s.cholesky.transpose().triangularView<Eigen::Upper>() * s.alpha;
+  const Eigen::VectorXd l_lt_alpha = s.cholesky.triangularView<Eigen::Lower>() * lt_alpha;
+  if ((l_lt_alpha - y).norm() > kLoadBackwardErrorTolerance * scale) {
+    in.fail("/gp/cholesky_lower", "is inconsistent with alpha (L·Lᵀ·alpha != y)");
+  }
+  auto& t = s.summary;
+  const std::string g = "/gp/training";
+  if (in.has(g)) {
+    t.log_marginal_likelihood = in.double_attribute(g, "log_marginal_likelihood");
+    t.loo_mean_relative_error = in.double_attribute(g, "loo_mean_relative_error");
+    t.loo_max_relative_error = in.double_attribute(g, "loo_max_relative_error");
+    t.loo_rmse = in.double_attribute(g, "loo_rmse");
+    t.loo_coverage_95 = in.double_attribute(g, "loo_coverage_95");
+    t.starts = in.int_attribute(g, "starts");
+    t.best_start = in.int_attribute(g, "best_start");
+    t.seconds = in.double_attribute(g, "seconds");
+    t.dataset_path = in.string_attribute(g, "dataset_path");
+    t.dataset_sha256 = in.string_attribute(g, "dataset_sha256");
+    t.code_version = in.string_attribute(g, "code_version");
+    t.created_utc = in.string_attribute(g, "created_utc");
+  }
+  return GaussianProcess(std::move(s));
+}
+
+}  // namespace mufric

@@ -1,0 +1,23 @@
+#pragma once
+// Model files (ARCHITECTURE.md "Model"): one HDF5 file per model, self-describing and versioned.
+//   /  attributes format = "mufric-model", schema_version, kind (gp | mlr | coulomb),
+//      code_version, created_utc;   /inputs (names, SI units, box);   /<kind> the model's own data.
+// Loading validates everything and refuses a corrupt or incompatible file naming the field.
+#include <memory>
+#include <string>
+
+#include "surrogate/friction_model.hpp"
+
+namespace mufric {
+
+inline constexpr long long kModelSchemaVersion = 1;
+inline constexpr const char* kModelFormat = "mufric-model";
+
+// Writes atomically (temporary file + rename).
+void save_model(const std::string& path, const FrictionModel& model);
+std::unique_ptr<FrictionModel> load_model(const std::string& path);
+
+// "file:///abs/model.h5", "file://rel/model.h5" or a plain path → the path; other schemes throw.
+std::string model_path_from_uri(const std::string& uri);
+
+}  // namespace mufric
