@@ -145,20 +145,20 @@ double parse_quantity(std::string_view text, QuantityKind expected, std::string_
   return map.scale * value + map.offset;
 }
 
-double si_to_human(double si_value, QuantityKind kind) {
+double si_to_human(double value_si, QuantityKind kind) {
   switch (kind) {
-    case QuantityKind::pressure: return si_value / 1e6;
-    case QuantityKind::velocity: return si_value * 60.0;
-    case QuantityKind::temperature: return si_value - kZeroCelsiusInKelvin;
-    case QuantityKind::angle: return si_value * 180.0 / kPi;
-    case QuantityKind::length: return si_value * 1e6;
-    default: return si_value;
+    case QuantityKind::pressure: return value_si / 1e6;
+    case QuantityKind::velocity: return value_si * 60.0;
+    case QuantityKind::temperature: return value_si - kZeroCelsiusInKelvin;
+    case QuantityKind::angle: return value_si * 180.0 / kPi;
+    case QuantityKind::length: return value_si * 1e6;
+    default: return value_si;
   }
 }
 
-std::string format_human(double si_value, QuantityKind kind, int precision) {
+std::string format_human(double value_si, QuantityKind kind, int precision) {
   char text[64];
-  std::snprintf(text, sizeof text, "%.*g", precision, si_to_human(si_value, kind));
+  std::snprintf(text, sizeof text, "%.*g", precision, si_to_human(value_si, kind));
   return std::string(text) + std::string(human_unit(kind));
 }
 

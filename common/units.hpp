@@ -30,10 +30,10 @@ UnitToSi unit_to_si(std::string_view unit);
 double parse_quantity(std::string_view text, QuantityKind expected, std::string_view field);
 
 // Formats an SI value in the unit people use for that kind (MPa, m/min, °C, deg).
-std::string format_human(double si_value, QuantityKind kind, int precision = 4);
+std::string format_human(double value_si, QuantityKind kind, int precision = 4);
 // The human unit used by format_human, e.g. "MPa".
 std::string_view human_unit(QuantityKind kind);
-double si_to_human(double si_value, QuantityKind kind);
+double si_to_human(double value_si, QuantityKind kind);
 
 // The kind of a named model input (contact_pressure → pressure, ...); dimensionless if unknown.
 QuantityKind kind_of_input(std::string_view input_name);

@@ -28,10 +28,14 @@ constexpr double kRelativeErrorFloor = 1e-12;
 constexpr double kAtBoundLog = 1e-2;
 constexpr double kZ95 = 1.959963984540054;
 
+// The best point is tracked here rather than trusted from NLopt's return: with jitter the LML is
+// slightly discontinuous and L-BFGS may end in NLOPT_FAILURE after having found a good point.
 struct StartContext {
   LogMarginalLikelihood* lml;
   int evaluations = 0;
   std::string last_failure;
+  double best_lml = kFailedLml;
+  Eigen::VectorXd best_theta;
 };
 
 double nlopt_objective(unsigned p, const double* x, double* grad, void* data) {
@@ -45,6 +49,10 @@ double nlopt_objective(unsigned p, const double* x, double* grad, void* data) {
     return kFailedLml;
   }
   if (grad) std::copy(value.gradient.data(), value.gradient.data() + p, grad);
+  if (value.lml > ctx->best_lml) {
+    ctx->best_lml = value.lml;
+    ctx->best_theta = theta;
+  }
   return value.lml;
 }
 
@@ -92,7 +100,7 @@ GpStartReport run_start(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y,
   GpStartReport report;
   report.initial_log = start;
   LogMarginalLikelihood lml(x_unit, y, options.noise_term);
-  StartContext ctx{&lml, 0, {}};
+  StartContext ctx{&lml, 0, {}, kFailedLml, start};
   Eigen::VectorXd theta = start;
   double best = kFailedLml;
   if (options.optimise) {
@@ -106,7 +114,12 @@ GpStartReport run_start(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y,
     const nlopt_result result = nlopt_optimize(opt, theta.data(), &best);
     nlopt_destroy(opt);
     report.outcome = nlopt_outcome(result);
-    report.ok = result > 0 && best > kFailedLml;
+    if (ctx.best_lml > best || !std::isfinite(best)) {
+      best = ctx.best_lml;
+      theta = ctx.best_theta;
+    }
+    report.ok = best > kFailedLml;
+    if (report.ok && result < 0) report.outcome += " (best evaluated point kept)";
   } else {
     const auto value = lml(theta, false);
     ctx.evaluations = 1;

@@ -12,8 +12,35 @@ namespace mufric {
 namespace {
 
 // A loaded GP must satisfy K α = y to this normwise backward error; a backward-stable solve gives
-// about n·ε, a flipped bit in α, L or x_train gives O(1).
+// about n·ε, a flipped bit in α, L or x_train gives O(1). Lenient when α is large (ill-conditioned K),
+// hence the entry-wise factor check below when the factor is stored.
 constexpr double kLoadBackwardErrorTolerance = 1e-8;
+// Entries of L Lᵀ must match the kernel rebuilt from x_train and the hyper-parameters to this
+// fraction of the diagonal; roundoff of a Cholesky factorisation is about n·ε.
+constexpr double kFactorEntryTolerance = 1e-8;
+// α recomputed from the stored factor must match the stored α this closely (same algorithm).
+constexpr double kAlphaRecomputeTolerance = 1e-10;
+
+// Compares (L Lᵀ)ᵢⱼ with Kᵢⱼ on the sub-diagonal and three full columns: O(n²), and any change of
+// a hyper-parameter or a training input moves some of these entries.
+bool factor_matches_kernel(const Eigen::MatrixXd& l, const Eigen::MatrixXd& kf, double diagonal) {
+  const Eigen::Index n = l.rows();
+  const double tolerance = kFactorEntryTolerance * (kf(0, 0) + diagonal);
+  auto entry_ok = [&](Eigen::Index i, Eigen::Index j) {  // i ≥ j
+    const double llt = l.row(i).head(j + 1).dot(l.row(j).head(j + 1));
+    const double k = kf(i, j) + (i == j ? diagonal : 0.0);
+    return std::abs(llt - k) <= tolerance;
+  };
+  for (Eigen::Index i = 1; i < n; ++i) {
+    if (!entry_ok(i, i - 1)) return false;
+  }
+  for (const Eigen::Index j : {Eigen::Index{0}, n / 2, n - 1}) {
+    for (Eigen::Index i = j; i < n; ++i) {
+      if (!entry_ok(i, j)) return false;
+    }
+  }
+  return true;
+}
 
 std::vector<double> column(const std::vector<MlrRow>& rows, double MlrRow::*field) {
   std::vector<double> values;
@@ -183,6 +210,9 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
     if (!s.cholesky.allFinite() || !(s.cholesky.diagonal().array() > 0).all()) {
       in.fail("/gp/cholesky_lower", "is not a valid Cholesky factor (non-finite or non-positive diagonal)");
     }
+    if (!factor_matches_kernel(s.cholesky, kf, diagonal)) {
+      in.fail("/gp/cholesky_lower", "is inconsistent with x_train and the hyper-parameters (L·Lᵀ != K)");
+    }
   } else {
     const auto chol = cholesky_with_jitter(kf, diagonal, s.cholesky);
     if (!chol.ok || chol.jitter > 0.0) in.fail("/gp", "covariance cannot be refactorised with the stored jitter");
@@ -195,10 +225,10 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
   if ((k_alpha - y).norm() > kLoadBackwardErrorTolerance * scale) {
     in.fail("/gp/alpha", "is inconsistent with x_train, y_train and the hyper-parameters (K·alpha != y)");
   }
-  const Eigen::VectorXd lt_alpha = s.cholesky.transpose().triangularView<Eigen::Upper>() * s.alpha;
-  const Eigen::VectorXd l_lt_alpha = s.cholesky.triangularView<Eigen::Lower>() * lt_alpha;
-  if ((l_lt_alpha - y).norm() > kLoadBackwardErrorTolerance * scale) {
-    in.fail("/gp/cholesky_lower", "is inconsistent with alpha (L·Lᵀ·alpha != y)");
+  Eigen::VectorXd recomputed = s.cholesky.triangularView<Eigen::Lower>().solve(y);
+  s.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(recomputed);
+  if ((recomputed - s.alpha).norm() > kAlphaRecomputeTolerance * s.alpha.norm()) {
+    in.fail("/gp/alpha", "is inconsistent with the Cholesky factor and y_train (alpha != K⁻¹y)");
   }
   auto& t = s.summary;
   const std::string g = "/gp/training";

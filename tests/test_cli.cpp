@@ -1,0 +1,113 @@
+// The mufric executable end to end: bad input ends with a one-line error naming the field, file or
+// row and a non-zero exit code; the happy path writes and reads real files.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+struct CommandResult {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult run(const std::string& arguments) {
+  const std::string command = std::string(MUFRIC_EXE) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string output;
+  std::array<char, 4096> buffer{};
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("mufric_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::filesystem::path dir_;
+};
+
+TEST_F(Cli, HelpExplainsTheSubcommands) {
+  const CommandResult r = run("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* word : {"train", "eval", "predict", "law", "dataset", "bench", "800MPa"}) {
+    EXPECT_NE(r.output.find(word), std::string::npos) << word;
+  }
+  EXPECT_EQ(run("train --help").exit_code, 0);
+}
+
+TEST_F(Cli, LawPredictTrainEvalChain) {
+  ASSERT_EQ(run("law seward --table 4 --out " + path("law.h5")).exit_code, 0);
+  CommandResult r = run("predict --model " + path("law.h5") + " --p 80MPa --v 10m/min --angle 90deg");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Table 4, 90°: 0.149911 + 0.013133·10 − 0.000753·80 = 0.221001
+  EXPECT_NE(r.output.find("mu = 0.221001"), std::string::npos) << r.output;
+  ASSERT_EQ(run("dataset from-model --model " + path("law.h5") + " --samples 120 --out " + path("db.h5")).exit_code, 0);
+  ASSERT_EQ(run("dataset from-model --model " + path("law.h5") + " --samples 50 --seed 5 --out " + path("t.h5")).exit_code, 0);
+  r = run("train --data " + path("db.h5") + " --out " + path("gp.h5") + " --restarts 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("log marginal likelihood"), std::string::npos);
+  EXPECT_NE(r.output.find("leave-one-out"), std::string::npos);
+  EXPECT_NE(r.output.find("start 1"), std::string::npos);
+  r = run("eval --model file://" + path("gp.h5") + " --test " + path("t.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("95 % interval coverage"), std::string::npos);
+  r = run("predict --model " + path("gp.h5") + " --p 80MPa --v 10m/min --angle 90deg");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("95 % interval ["), std::string::npos);
+}
+
+TEST_F(Cli, NumberWithoutUnitNamesTheFlag) {
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("c.h5")).exit_code, 0);
+  const CommandResult r = run("predict --model " + path("c.h5") + " --p 800 --v 100m/min --T 500C");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--p: '800' has no unit"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, UnknownUnitAndMissingInputAreNamed) {
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("c.h5")).exit_code, 0);
+  CommandResult r = run("predict --model " + path("c.h5") + " --p 800MPa --v 100furlong/min --T 500C");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--v"), std::string::npos);
+  EXPECT_NE(r.output.find("unknown unit"), std::string::npos);
+  r = run("predict --model " + path("c.h5") + " --p 800MPa --v 100m/min");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--T is required"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, MissingFileIsNamed) {
+  const CommandResult r = run("train --data " + path("nope.h5") + " --out " + path("m.h5"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("nope.h5': no such file"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, NaNInATrainingRowIsNamedByLine) {
+  std::ofstream(path("d.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n"
+                                  "800,100,500,0.3\n900,120,nan,0.31\n";
+  const CommandResult r = run("train --data " + path("d.csv") + " --out " + path("m.h5"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("line 3, column 'temperature'"), std::string::npos) << r.output;
+  // One line: the error is the whole message.
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+TEST_F(Cli, CorruptModelIsRefused) {
+  std::ofstream(path("bad.h5")) << "not a model";
+  const CommandResult r = run("predict --model " + path("bad.h5") + " --p 800MPa --v 100m/min --T 500C");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("not an HDF5 file"), std::string::npos) << r.output;
+}
+
+}  // namespace

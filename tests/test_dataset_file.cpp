@@ -1,0 +1,108 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "common/dataset_file.hpp"
+#include "common/error.hpp"
+
+namespace mufric {
+namespace {
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("mufric_ds_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+Eigen::VectorXd values(std::initializer_list<double> list) {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(list.size()));
+  Eigen::Index i = 0;
+  for (double x : list) v(i++) = x;
+  return v;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(DatasetFile, RoundTripKeepsFailuresAndTrainingSetSkipsThem) {
+  Dataset d;
+  d.inputs = default_friction_box();
+  d.x.resize(3, 3);
+  d.x << 400e6, 1.0, 500.0, 500e6, 1.5, 600.0, 600e6, 2.0, 700.0;
+  d.mu = values({0.3, std::nan(""), 0.25});
+  d.status = {0, 1, 0};
+  d.failure_reason = {"", "Newton diverged at step 12", ""};
+  d.diagnostics["wall_time_s"] = values({1.0, 2.0, 3.0});
+  d.plan = d.x;
+  d.source = "unit test";
+  const std::string path = temp_path("d.h5");
+  write_dataset(path, d);
+  const Dataset r = read_dataset(path);
+  EXPECT_EQ(r.x, d.x);
+  EXPECT_EQ(r.status, d.status);
+  EXPECT_EQ(r.failure_reason[1], "Newton diverged at step 12");
+  EXPECT_EQ(r.diagnostics.at("wall_time_s"), d.diagnostics.at("wall_time_s"));
+  EXPECT_EQ(r.inputs[0].name, "contact_pressure");
+  const TrainingSet t = training_set(r, path);
+  EXPECT_EQ(t.x.rows(), 2);
+  EXPECT_EQ(t.mu(1), 0.25);
+  EXPECT_EQ(t.source_hash.size(), 64u);
+  std::filesystem::remove(path);
+}
+
+TEST(DatasetFile, CsvWithUnitsConvertsToSi) {
+  const std::string path = temp_path("d.csv");
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n800,120,500,0.3\n900,60,25,0.4\n";
+  const Dataset d = read_dataset(path);
+  EXPECT_DOUBLE_EQ(d.x(0, 0), 800e6);
+  EXPECT_DOUBLE_EQ(d.x(0, 1), 2.0);
+  EXPECT_DOUBLE_EQ(d.x(1, 2), 298.15);
+  EXPECT_DOUBLE_EQ(d.inputs[2].lo, 298.15);
+  std::filesystem::remove(path);
+}
+
+TEST(DatasetFile, CsvErrorsNameLineAndColumn) {
+  const std::string path = temp_path("bad.csv");
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],mu\n800,120,0.3\n900,nan,0.4\n";
+  EXPECT_NE(error_of([&] { read_dataset(path); }).find("line 3, column 'sliding_velocity'"), std::string::npos);
+  std::ofstream(path) << "contact_pressure,mu\n800,0.3\n";
+  EXPECT_NE(error_of([&] { read_dataset(path); }).find("column 'contact_pressure' has no unit"), std::string::npos);
+  std::ofstream(path) << "contact_pressure[psi],mu\n800,0.3\n";
+  EXPECT_NE(error_of([&] { read_dataset(path); }).find("unknown unit 'psi'"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(DatasetFile, NonFiniteConvergedSampleIsNamedByRow) {
+  Dataset d;
+  d.inputs = default_friction_box();
+  d.x = h5::RowMatrix::Constant(2, 3, 500.0);
+  d.x(1, 2) = std::nan("");
+  d.mu = values({0.3, 0.3});
+  d.status = {0, 0};
+  d.failure_reason = {"", ""};
+  const std::string path = temp_path("nan.h5");
+  write_dataset(path, d);
+  const std::string m = error_of([&] { training_set(read_dataset(path), path); });
+  EXPECT_NE(m.find("sample row 1, input 'temperature'"), std::string::npos) << m;
+  std::filesystem::remove(path);
+}
+
+TEST(DatasetFile, ModelFileIsNotADataset) {
+  const std::string path = temp_path("x.h5");
+  { H5::H5File f(path, H5F_ACC_TRUNC); }
+  EXPECT_NE(error_of([&] { read_dataset(path); }).find("not a mufric dataset"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(DatasetFile, Sha256OfKnownVector) {
+  EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+}
+
+}  // namespace
+}  // namespace mufric

@@ -1,0 +1,218 @@
+// The GP against independent answers: dense LU formulas, finite differences, brute-force search
+// and brute-force leave-one-out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "gp_test_data.hpp"
+#include "surrogate/gp_training.hpp"
+
+namespace mufric {
+namespace {
+
+GpTrainingOptions fixed(double s2, Eigen::VectorXd lengths, double noise) {
+  GpTrainingOptions o;
+  o.optimise = false;
+  o.initial.signal_variance = s2;
+  o.initial.length_scales = std::move(lengths);
+  o.initial.noise_variance = noise;
+  o.noise_term = noise > 0.0;
+  return o;
+}
+
+// K computed element by element with the textbook formula, no shared code with the library.
+Eigen::MatrixXd dense_covariance(const Eigen::MatrixXd& u, const GpHyperParameters& h, double diagonal) {
+  const Eigen::Index n = u.rows();
+  Eigen::MatrixXd k(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j) {
+      double r2 = 0.0;
+      for (Eigen::Index c = 0; c < u.cols(); ++c) r2 += std::pow((u(i, c) - u(j, c)) / h.length_scales(c), 2);
+      k(i, j) = h.signal_variance * std::exp(-0.5 * r2) + (i == j ? diagonal : 0.0);
+    }
+  }
+  return k;
+}
+
+double dense_lml(const Eigen::MatrixXd& u, const Eigen::VectorXd& y, const GpHyperParameters& h) {
+  const Eigen::MatrixXd k = dense_covariance(u, h, h.noise_variance);
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(k);
+  const double log_det = lu.matrixLU().diagonal().array().abs().log().sum();
+  return -0.5 * y.dot(lu.solve(y)) - 0.5 * log_det - 0.5 * static_cast<double>(y.size()) * std::log(2 * std::numbers::pi);
+}
+
+TEST(GpVerification, LogMarginalLikelihoodMatchesDenseLuFormula) {
+  const TrainingSet data = test::smooth_training_set(40, 3);
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  const Eigen::VectorXd y = (data.mu.array() - data.mu.mean()) / 0.05;
+  for (const bool noise : {true, false}) {
+    LogMarginalLikelihood lml(u, y, noise);
+    GpHyperParameters h;
+    h.signal_variance = 2.5;
+    h.length_scales = Eigen::Vector3d(0.7, 0.4, 1.3);
+    h.noise_variance = noise ? 1e-3 : 0.0;
+    h.noise_term = noise;
+    const auto value = lml(h.to_log(), false);
+    ASSERT_TRUE(value.ok) << value.reason;
+    EXPECT_EQ(value.jitter, 0.0);
+    EXPECT_NEAR(value.lml, dense_lml(u, y, h), 1e-8 * std::abs(value.lml));
+  }
+}
+
+TEST(GpVerification, GradientMatchesCentralFiniteDifferences) {
+  const TrainingSet data = test::smooth_training_set(35, 5);
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  const Eigen::VectorXd y = (data.mu.array() - data.mu.mean()) / 0.05;
+  LogMarginalLikelihood lml(u, y, true);
+  const Eigen::VectorXd theta = (Eigen::VectorXd(5) << std::log(1.7), std::log(0.6), std::log(0.9), std::log(0.5),
+                                 std::log(2e-3)).finished();
+  const auto value = lml(theta, true);
+  ASSERT_TRUE(value.ok);
+  constexpr double step = 1e-5;
+  for (Eigen::Index i = 0; i < theta.size(); ++i) {
+    Eigen::VectorXd plus = theta, minus = theta;
+    plus(i) += step;
+    minus(i) -= step;
+    const double fd = (lml(plus, false).lml - lml(minus, false).lml) / (2 * step);
+    EXPECT_NEAR(value.gradient(i), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "parameter " << i;
+  }
+}
+
+TEST(GpVerification, PredictionMatchesDenseFormulaWithExplicitInverse) {
+  const TrainingSet data = test::smooth_training_set(40, 11);
+  const Eigen::Vector3d lengths(0.8, 0.5, 0.9);
+  const GaussianProcess gp = train_gaussian_process(data, fixed(3.0, lengths, 1e-4));
+  const auto& s = gp.state();
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  const Eigen::MatrixXd k = dense_covariance(u, s.hyper, s.hyper.noise_variance + s.jitter);
+  const Eigen::MatrixXd k_inv = k.fullPivLu().inverse();
+  const Eigen::VectorXd y = (data.mu.array() - s.y_mean) / s.y_scale;
+
+  const TrainingSet queries = test::smooth_training_set(25, 99);
+  const Evaluation e = gp.evaluate(queries.x, {.std = true, .ci_level = 0.9, .gradient = false});
+  const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
+  for (Eigen::Index q = 0; q < uq.rows(); ++q) {
+    Eigen::VectorXd kq(u.rows());
+    for (Eigen::Index i = 0; i < u.rows(); ++i) {
+      double r2 = 0.0;
+      for (Eigen::Index c = 0; c < 3; ++c) r2 += std::pow((uq(q, c) - u(i, c)) / lengths(c), 2);
+      kq(i) = 3.0 * std::exp(-0.5 * r2);
+    }
+    const double mean = s.y_mean + s.y_scale * kq.dot(k_inv * y);
+    const double var = 3.0 + 1e-4 - kq.dot(k_inv * kq);
+    EXPECT_NEAR(e.mu(q), mean, 1e-9);
+    EXPECT_NEAR(e.std(q), s.y_scale * std::sqrt(var), 1e-8);
+    const double z90 = 1.6448536269514722;
+    EXPECT_NEAR(e.hi(q) - e.lo(q), 2 * z90 * e.std(q), 1e-12);
+  }
+}
+
+TEST(GpVerification, MeanGradientMatchesFiniteDifferences) {
+  const TrainingSet data = test::smooth_training_set(50, 21);
+  const GaussianProcess gp = train_gaussian_process(data, fixed(2.0, Eigen::Vector3d(0.6, 0.7, 0.8), 1e-5));
+  const TrainingSet queries = test::smooth_training_set(8, 77);
+  const Evaluation e = gp.evaluate(queries.x, {.std = false, .ci_level = 0.0, .gradient = true});
+  for (Eigen::Index q = 0; q < queries.x.rows(); ++q) {
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const auto& in = data.inputs[static_cast<size_t>(c)];
+      const double h = 1e-6 * (in.hi - in.lo);
+      QueryBatch plus = queries.x.row(q), minus = queries.x.row(q);
+      plus(0, c) += h;
+      minus(0, c) -= h;
+      const double fd = (gp.evaluate(plus, {}).mu(0) - gp.evaluate(minus, {}).mu(0)) / (2 * h);
+      EXPECT_NEAR(e.gradient(q, c), fd, 1e-6 * std::abs(fd) + 1e-9 / (in.hi - in.lo)) << "point " << q << " input " << c;
+    }
+  }
+}
+
+TEST(GpVerification, OptimiserBeatsBruteForceGridSearch) {
+  // Two hyper-parameters (σ², one length scale) on a 1-D problem: a 80 × 80 grid over the bounds
+  // is an independent answer the optimiser must match or beat.
+  TrainingSet data;
+  data.inputs = {{"x", "1", 0.0, 1.0}};
+  const Eigen::Index n = 25;
+  data.x.resize(n, 1);
+  data.mu.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    data.x(i, 0) = static_cast<double>(i) / static_cast<double>(n - 1);
+    data.mu(i) = std::sin(5.0 * data.x(i, 0)) + 0.3 * data.x(i, 0);
+  }
+  GpTrainingOptions options;
+  options.noise_term = false;
+  options.restarts = 3;
+  GpTrainingReport report;
+  const GaussianProcess gp = train_gaussian_process(data, options, &report);
+  const double optimised = gp.state().summary.log_marginal_likelihood;
+
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  const Eigen::VectorXd y = (data.mu.array() - gp.state().y_mean) / gp.state().y_scale;
+  LogMarginalLikelihood lml(u, y, false);
+  double best_grid = -1e300;
+  for (int a = 0; a < 80; ++a) {
+    for (int b = 0; b < 80; ++b) {
+      const double log_s2 = std::log(1e-3) + (std::log(1e5) - std::log(1e-3)) * a / 79.0;
+      const double log_l = std::log(1e-2) + (std::log(1e3) - std::log(1e-2)) * b / 79.0;
+      const auto value = lml(Eigen::Vector2d(log_s2, log_l), false);
+      if (value.ok && value.jitter == 0.0) best_grid = std::max(best_grid, value.lml);
+    }
+  }
+  EXPECT_GE(optimised, best_grid - 1e-6);
+}
+
+TEST(GpVerification, ClosedFormLeaveOneOutEqualsBruteForceRefits) {
+  const TrainingSet data = test::smooth_training_set(30, 8);
+  const Eigen::Vector3d lengths(0.5, 0.6, 0.7);
+  const GaussianProcess gp = train_gaussian_process(data, fixed(1.5, lengths, 1e-4));
+  double brute_sum = 0.0;
+  for (Eigen::Index i = 0; i < 30; ++i) {
+    TrainingSet rest = data;
+    rest.x.resize(29, 3);
+    rest.mu.resize(29);
+    for (Eigen::Index r = 0, k = 0; r < 30; ++r) {
+      if (r == i) continue;
+      rest.x.row(k) = data.x.row(r);
+      rest.mu(k++) = data.mu(r);
+    }
+    // Same normalisation as the full model, so the prior is identical.
+    GaussianProcess::State s = gp.state();
+    const Eigen::MatrixXd u = to_unit_box(rest.x, data.inputs);
+    const Eigen::MatrixXd k = dense_covariance(u, s.hyper, s.hyper.noise_variance);
+    const Eigen::VectorXd y = (rest.mu.array() - s.y_mean) / s.y_scale;
+    const Eigen::MatrixXd ui = to_unit_box(data.x.row(i), data.inputs);
+    Eigen::VectorXd kq(29);
+    for (Eigen::Index r = 0; r < 29; ++r) {
+      kq(r) = 1.5 * std::exp(-0.5 * ((ui.row(0) - u.row(r)).array() / lengths.transpose().array()).square().sum());
+    }
+    const double prediction = s.y_mean + s.y_scale * kq.dot(k.ldlt().solve(y));
+    brute_sum += std::abs(prediction - data.mu(i)) / std::abs(data.mu(i));
+  }
+  EXPECT_NEAR(gp.state().summary.loo_mean_relative_error, brute_sum / 30.0, 1e-9);
+}
+
+TEST(GpVerification, BatchedParallelEqualsPointByPoint) {
+  const TrainingSet data = test::smooth_training_set(120, 4);
+  const GaussianProcess gp = train_gaussian_process(data, fixed(2.0, Eigen::Vector3d(0.5, 0.5, 0.5), 1e-4));
+  const TrainingSet queries = test::smooth_training_set(1000, 12);
+  const EvaluationRequest what{.std = true, .ci_level = 0.95, .gradient = true};
+  const Evaluation batch = gp.evaluate(queries.x, what);
+  for (Eigen::Index q = 0; q < 1000; q += 37) {
+    const Evaluation one = gp.evaluate(queries.x.row(q), what);
+    EXPECT_NEAR(batch.mu(q), one.mu(0), 1e-13);
+    EXPECT_NEAR(batch.std(q), one.std(0), 1e-13);
+    EXPECT_NEAR((batch.gradient.row(q) - one.gradient.row(0)).norm(), 0.0, 1e-12 * one.gradient.norm());
+  }
+}
+
+TEST(GpVerification, MeanOnlyRequestComputesNoVariance) {
+  const TrainingSet data = test::smooth_training_set(60, 4);
+  const GaussianProcess gp = train_gaussian_process(data, fixed(2.0, Eigen::Vector3d(0.5, 0.5, 0.5), 1e-4));
+  const Evaluation e = gp.evaluate(data.x, {});
+  EXPECT_EQ(e.std.size(), 0);
+  EXPECT_EQ(e.lo.size(), 0);
+  EXPECT_EQ(e.gradient.size(), 0);
+  EXPECT_EQ(e.mu.size(), 60);
+}
+
+}  // namespace
+}  // namespace mufric

@@ -1,0 +1,191 @@
+// Model files: bit-for-bit round trips; corrupt, truncated and incompatible files are refused by name.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "common/error.hpp"
+#include "gp_test_data.hpp"
+#include "surrogate/empirical_laws.hpp"
+#include "surrogate/gp_training.hpp"
+#include "surrogate/model_file.hpp"
+
+namespace mufric {
+namespace {
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("mufric_test_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
+}
+
+std::string load_error(const std::string& path) {
+  try {
+    load_model(path);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+GaussianProcess small_gp(Eigen::Index n = 60) {
+  GpTrainingOptions options;
+  options.restarts = 1;
+  return train_gaussian_process(test::smooth_training_set(n, 2), options);
+}
+
+TEST(ModelFile, GaussianProcessRoundTripsBitForBit) {
+  const GaussianProcess gp = small_gp();
+  const std::string path = temp_path("gp.h5");
+  save_model(path, gp);
+  const auto loaded = load_model(path);
+  ASSERT_EQ(loaded->kind(), "gp");
+  const auto& a = gp.state();
+  const auto& b = dynamic_cast<const GaussianProcess&>(*loaded).state();
+  EXPECT_TRUE(bitwise_equal(a.x_train, b.x_train));
+  EXPECT_TRUE(bitwise_equal(a.y_train, b.y_train));
+  EXPECT_TRUE(bitwise_equal(a.alpha, b.alpha));
+  EXPECT_TRUE(bitwise_equal(a.cholesky, b.cholesky));
+  EXPECT_TRUE(bitwise_equal(a.hyper.length_scales, b.hyper.length_scales));
+  EXPECT_EQ(std::memcmp(&a.hyper.signal_variance, &b.hyper.signal_variance, sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(&a.hyper.noise_variance, &b.hyper.noise_variance, sizeof(double)), 0);
+  EXPECT_EQ(a.y_mean, b.y_mean);
+  EXPECT_EQ(a.y_scale, b.y_scale);
+  EXPECT_EQ(a.summary.log_marginal_likelihood, b.summary.log_marginal_likelihood);
+  const TrainingSet q = test::smooth_training_set(300, 9);
+  const EvaluationRequest what{.std = true, .ci_level = 0.95, .gradient = true};
+  const Evaluation e1 = gp.evaluate(q.x, what), e2 = loaded->evaluate(q.x, what);
+  EXPECT_TRUE(bitwise_equal(e1.mu, e2.mu));
+  EXPECT_TRUE(bitwise_equal(e1.std, e2.std));
+  EXPECT_TRUE(bitwise_equal(e1.gradient, e2.gradient));
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, LargeModelWithoutStoredFactorIsRefactorisedOnLoad) {
+  GpTrainingOptions options;
+  options.optimise = false;
+  options.initial.length_scales = Eigen::Vector3d(0.7, 0.7, 0.7);
+  options.initial.noise_variance = 1e-6;
+  const GaussianProcess gp = train_gaussian_process(test::smooth_training_set(GaussianProcess::kStoreCholeskyUpTo + 1, 4), options);
+  const std::string path = temp_path("big.h5");
+  save_model(path, gp);
+  const auto loaded = load_model(path);
+  const TrainingSet q = test::smooth_training_set(50, 9);
+  const Evaluation e1 = gp.evaluate(q.x, {.std = true}), e2 = loaded->evaluate(q.x, {.std = true});
+  EXPECT_LT((e1.mu - e2.mu).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((e1.std - e2.std).cwiseAbs().maxCoeff(), 1e-9);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, LawsRoundTrip) {
+  const std::string path = temp_path("law.h5");
+  save_model(path, MlrLaw::seed001_table4());
+  const auto law = load_model(path);
+  ASSERT_EQ(law->kind(), "mlr");
+  const auto& rows = dynamic_cast<const MlrLaw&>(*law).rows();
+  ASSERT_EQ(rows.size(), 8u);
+  EXPECT_EQ(rows[4].beta1_per_m_min, 0.013133);
+  save_model(path, CoulombLaw(0.37));
+  EXPECT_EQ(dynamic_cast<const CoulombLaw&>(*load_model(path)).mu(), 0.37);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, MissingFileIsNamed) {
+  EXPECT_NE(load_error("/nonexistent/model.h5").find("/nonexistent/model.h5': no such file"), std::string::npos);
+}
+
+TEST(ModelFile, TruncatedFileIsRefused) {
+  const std::string path = temp_path("trunc.h5");
+  save_model(path, small_gp());
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+  const std::string message = load_error(path);
+  EXPECT_FALSE(message.empty());
+  EXPECT_NE(message.find(path), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, TextFileIsNotHdf5) {
+  const std::string path = temp_path("text.h5");
+  std::ofstream(path) << "contact_pressure,mu\n1,2\n";
+  EXPECT_NE(load_error(path).find("not an HDF5 file"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+// Overwrites a dataset of an existing file in place, as a flipped bit or a bad tool would.
+void overwrite_doubles(const std::string& path, const std::string& dataset, const std::vector<double>& values) {
+  H5::H5File file(path, H5F_ACC_RDWR);
+  file.openDataSet(dataset).write(values.data(), H5::PredType::NATIVE_DOUBLE);
+}
+
+TEST(ModelFile, CorruptAlphaIsRefusedNamingTheField) {
+  const std::string path = temp_path("alpha.h5");
+  const GaussianProcess gp = small_gp();
+  save_model(path, gp);
+  std::vector<double> alpha(gp.state().alpha.data(), gp.state().alpha.data() + gp.state().alpha.size());
+  alpha[7] *= 1.001;
+  overwrite_doubles(path, "/gp/alpha", alpha);
+  EXPECT_NE(load_error(path).find("/gp/alpha"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, CorruptLengthScaleIsDetectedThroughAlpha) {
+  const std::string path = temp_path("length.h5");
+  const GaussianProcess gp = small_gp();
+  save_model(path, gp);
+  const auto& l = gp.state().hyper.length_scales;
+  overwrite_doubles(path, "/gp/length_scales", {l(0) * 1.01, l(1), l(2)});
+  EXPECT_NE(load_error(path).find("inconsistent"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, NegativeLengthScaleIsNamed) {
+  const std::string path = temp_path("neg.h5");
+  save_model(path, small_gp());
+  overwrite_doubles(path, "/gp/length_scales", {-1.0, 1.0, 1.0});
+  EXPECT_NE(load_error(path).find("/gp/length_scales"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, IncompatibleSchemaVersionAndUnknownKindAreRefused) {
+  const std::string path = temp_path("schema.h5");
+  save_model(path, CoulombLaw(0.2));
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    long long version = 99;
+    file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
+  }
+  EXPECT_NE(load_error(path).find("schema_version 99"), std::string::npos);
+  save_model(path, CoulombLaw(0.2));
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    file.removeAttr("kind");
+    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+    file.createAttribute("kind", type, H5::DataSpace(H5S_SCALAR)).write(type, std::string("neural"));
+  }
+  EXPECT_NE(load_error(path).find("unknown model kind 'neural'"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, MissingDatasetIsNamed) {
+  const std::string path = temp_path("missing.h5");
+  save_model(path, small_gp(30));
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    file.unlink("/gp/y_train");
+  }
+  EXPECT_NE(load_error(path).find("/gp/y_train: missing"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, UriSchemes) {
+  EXPECT_EQ(model_path_from_uri("file:///tmp/m.h5"), "/tmp/m.h5");
+  EXPECT_EQ(model_path_from_uri("m.h5"), "m.h5");
+  EXPECT_THROW(model_path_from_uri("s3://bucket/m.h5"), Error);
+}
+
+}  // namespace
+}  // namespace mufric

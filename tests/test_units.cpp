@@ -1,0 +1,48 @@
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "common/units.hpp"
+
+namespace mufric {
+namespace {
+
+TEST(Units, ParsesHumanQuantitiesToSi) {
+  EXPECT_DOUBLE_EQ(parse_quantity("800MPa", QuantityKind::pressure, "--p"), 800e6);
+  EXPECT_DOUBLE_EQ(parse_quantity(" 1.3 GPa", QuantityKind::pressure, "--p"), 1.3e9);
+  EXPECT_DOUBLE_EQ(parse_quantity("120m/min", QuantityKind::velocity, "--v"), 2.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("500C", QuantityKind::temperature, "--T"), 773.15);
+  EXPECT_DOUBLE_EQ(parse_quantity("25°C", QuantityKind::temperature, "--T"), 298.15);
+  EXPECT_DOUBLE_EQ(parse_quantity("300K", QuantityKind::temperature, "--T"), 300.0);
+  EXPECT_NEAR(parse_quantity("90deg", QuantityKind::angle, "--angle"), 1.5707963267948966, 1e-15);
+}
+
+std::string message_of(const std::string& text, QuantityKind kind) {
+  try {
+    parse_quantity(text, kind, "--p");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Units, NumberWithoutUnitIsAnErrorNamingTheField) {
+  const std::string m = message_of("800", QuantityKind::pressure);
+  EXPECT_NE(m.find("--p"), std::string::npos);
+  EXPECT_NE(m.find("no unit"), std::string::npos);
+}
+
+TEST(Units, UnknownAndWrongKindUnitsAreErrors) {
+  EXPECT_NE(message_of("800psi", QuantityKind::pressure).find("unknown unit 'psi'"), std::string::npos);
+  EXPECT_NE(message_of("800m/s", QuantityKind::pressure).find("is a velocity, expected a pressure"), std::string::npos);
+  EXPECT_NE(message_of("abc", QuantityKind::pressure).find("not a number"), std::string::npos);
+  EXPECT_NE(message_of("nanMPa", QuantityKind::pressure).find("not a number"), std::string::npos);
+}
+
+TEST(Units, FormatsInHumanUnits) {
+  EXPECT_EQ(format_human(800e6, QuantityKind::pressure), "800MPa");
+  EXPECT_EQ(format_human(2.0, QuantityKind::velocity), "120m/min");
+  EXPECT_EQ(format_human(773.15, QuantityKind::temperature), "500°C");
+}
+
+}  // namespace
+}  // namespace mufric
