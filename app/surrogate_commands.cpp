@@ -33,9 +33,11 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
   std::printf("restarts (hyper-parameters: signal variance, length scales..., noise variance)\n");
   for (size_t i = 0; i < report.starts.size(); ++i) {
     const auto& start = report.starts[i];
-    std::printf("  start %zu%s  LML %14.6f  %4d evaluations  %6.2f s  %s\n      from [%s]\n      to   [%s]\n", i,
-                static_cast<int>(i) == report.best_start ? "*" : " ", start.log_marginal_likelihood, start.evaluations,
-                start.seconds, start.outcome.c_str(), theta_text(start.initial_log).c_str(),
+    std::printf("  start %zu%s  LML %14.6f  %4d evaluations (+%d on a subset)  %6.2f s  %s\n      from [%s]\n"
+                "      to   [%s]\n",
+                i, static_cast<int>(i) == report.best_start ? "*" : " ", start.log_marginal_likelihood,
+                start.evaluations, start.subset_evaluations, start.seconds, start.outcome.c_str(),
+                theta_text(start.initial_log).c_str(),
                 theta_text(start.final_log).c_str());
   }
   std::printf("best: start %d, log marginal likelihood %.6f\n", report.best_start, s.summary.log_marginal_likelihood);
@@ -75,10 +77,14 @@ void add_train(CLI::App& app) {
   cmd->add_option("--threads", o->gp.threads, "Starts run in parallel on this many threads (0: all cores)")
       ->capture_default_str();
   cmd->add_option("--max-evaluations", o->gp.max_evaluations, "LML evaluations per start")->capture_default_str();
+  cmd->add_option("--subset", o->gp.subset_size,
+                  "Each start first climbs the LML of a random subset of this many points, then all data "
+                  "(0: off; used when the data have more than twice as many points)")
+      ->capture_default_str()->check(CLI::Range(0, 1000000));
   cmd->add_flag("--no-noise", o->no_noise, "No white-noise term (interpolate exactly)");
   cmd->footer("Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
               "cross-validated error. Bounds: signal variance 1e-3..1e5, length scales 1e-2..1e3 box widths,\n"
-              "noise variance 1e-10..1e-1 (outputs normalised to zero mean and unit variance).");
+              "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).");
   cmd->callback([o] {
     o->gp.noise_term = !o->no_noise;
     const Dataset dataset = read_dataset(o->data);

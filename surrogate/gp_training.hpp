@@ -17,7 +17,7 @@ namespace mufric {
 struct GpBounds {
   double signal_variance_lo = 1e-3, signal_variance_hi = 1e5;
   double length_scale_lo = 1e-2, length_scale_hi = 1e3;
-  double noise_variance_lo = 1e-10, noise_variance_hi = 1e-1;
+  double noise_variance_lo = 1e-6, noise_variance_hi = 1e-1;
 };
 
 struct GpTrainingOptions {
@@ -26,8 +26,14 @@ struct GpTrainingOptions {
   bool noise_term = true;
   GpBounds bounds;
   GpHyperParameters initial;   // first start; empty length_scales → 0.5 box widths, σ² = 1, σn² = 1e-5
-  int max_evaluations = 1000;  // per start
+  int max_evaluations = 1000;  // per start and stage
+  // Each start first optimises on a random subset of this many points when n > 2 × subset_size
+  // (0: never), then on all data.
+  Eigen::Index subset_size = 256;
   double relative_tolerance = 1e-9;  // on the LML (≈ scipy L-BFGS-B's default factr 1e7)
+  // Absolute LML change that ends a run: a likelihood ratio of e^1e-5 is statistically void, and
+  // near the optimum the LML's own rounding noise is of this size.
+  double absolute_tolerance = 1e-5;
   int threads = 0;             // starts run in parallel; 0 = all cores
   bool optimise = true;        // false: use `initial` as given
 };
@@ -36,7 +42,8 @@ struct GpStartReport {
   Eigen::VectorXd initial_log;
   Eigen::VectorXd final_log;
   double log_marginal_likelihood = 0.0;
-  int evaluations = 0;
+  int evaluations = 0;         // full-data LML evaluations
+  int subset_evaluations = 0;  // evaluations of the subset stage (each ~(n/m)³ cheaper)
   std::string outcome;  // NLopt's result, or why the start failed
   double seconds = 0.0;
   bool ok = false;
