@@ -5,6 +5,7 @@
 extern "C" {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 void dpotri_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const int* lda, int* info);
 int openblas_get_num_threads(void);
 void openblas_set_num_threads(int);
 }
@@ -58,6 +59,15 @@ bool inverse_from_cholesky(Eigen::MatrixXd& lower) {
   if (n == 0) return true;
   int info = 0;
   dpotri_("L", &n, lower.data(), &n, &info);
+  return info == 0;
+}
+
+bool invert_lower_triangular(Eigen::MatrixXd& lower) {
+  const int n = static_cast<int>(lower.rows());
+  if (n == 0) return true;
+  int info = 0;
+  dtrtri_("L", "N", &n, lower.data(), &n, &info);
+  lower.triangularView<Eigen::StrictlyUpper>().setZero();
   return info == 0;
 }
 

@@ -26,6 +26,9 @@ CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diago
 // Overwrites the lower factor L with the lower triangle of (L Lᵀ)⁻¹ (LAPACK dpotri).
 bool inverse_from_cholesky(Eigen::MatrixXd& lower);
 
+// Overwrites the lower-triangular `lower` with its inverse (LAPACK dtrtri); false if singular.
+bool invert_lower_triangular(Eigen::MatrixXd& lower);
+
 // Limits OpenBLAS to one thread while the caller runs its own parallel loop; restores on exit.
 class SingleThreadedBlas {
  public:

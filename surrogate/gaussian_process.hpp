@@ -68,14 +68,23 @@ class GaussianProcess final : public FrictionModel {
   // Store the n × n factor in model files up to this size; larger models refactorise on load.
   static constexpr Eigen::Index kStoreCholeskyUpTo = 2000;
 
+
  protected:
   void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const override;
 
  private:
   void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
-                      Eigen::MatrixXd& k_block, Evaluation& out, long long& clamped) const;
+                      Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block, Evaluation& out, long long& clamped) const;
+
+  // |L⁻¹ k_b|² for each column k_b of a few kernel vectors, reading each row of L⁻¹ once.
+  Eigen::RowVectorXd squared_norms_row_by_row(const Eigen::MatrixXd& kernels) const;
 
   State state_;
+  // L⁻¹, row-major. The same n²/2 multiply-adds per query as a triangular solve with L, but without
+  // its chain of dependent steps: a block of queries is a triangular matrix product, and one query
+  // is a streaming matrix–vector product whose rows two cores split between their own L2 caches.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse_factor_;
+  Eigen::Index row_split_ = 0;  // rows [0, split) and [split, n) hold equal halves of the entries
   Eigen::RowVectorXd box_lo_;
   Eigen::RowVectorXd inverse_box_width_;
   Eigen::MatrixXd scaled_train_;       // x_unit / l, n × d
@@ -85,6 +94,9 @@ class GaussianProcess final : public FrictionModel {
 
 // Unit-box coordinates of SI inputs: (x − lo) / (hi − lo) per input.
 Eigen::MatrixXd to_unit_box(const Eigen::MatrixXd& x, const InputSpace& inputs);
+
+// Overwrites scaled squared distances r² with exp(−½ r²), floored at 1e-150 (never subnormal).
+void rbf_correlation_in_place(Eigen::Ref<Eigen::ArrayXd> values);
 
 // Lower triangle (and diagonal) of the signal covariance σ² exp(−½ r²) for unit-box inputs.
 void rbf_signal_covariance(const Eigen::MatrixXd& x_unit, const GpHyperParameters& hyper, Eigen::MatrixXd& kf);
