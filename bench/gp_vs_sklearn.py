@@ -111,7 +111,7 @@ def main():
     parser.add_argument("--mufric", default="build/app/mufric")
     parser.add_argument("--n", type=int, default=900, help="training size of the side-by-side comparison")
     parser.add_argument("--restarts", type=int, default=4, help="starts after the first, both codes")
-    parser.add_argument("--sizes", default="100,300,900,2000,3000", help="training sizes of the sweep")
+    parser.add_argument("--sizes", default="100,300,600,900,2000,3000", help="training sizes of the sweep")
     parser.add_argument("--sweep-restarts", type=int, default=2)
     parser.add_argument("--test", type=int, default=2000, help="held-out points")
     parser.add_argument("--out", default="bench/results", help="folder for the JSON and the plot")
@@ -120,7 +120,7 @@ def main():
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(2026)
-    results = {"n": args.n, "restarts": args.restarts, "machine": os.uname().nodename, "date": time.strftime("%Y-%m-%d"),
+    results = {"test": args.test, "n": args.n, "restarts": args.restarts, "sweep_restarts": args.sweep_restarts, "machine": os.uname().nodename, "date": time.strftime("%Y-%m-%d"),
                "cpu": subprocess.run("lscpu | sed -n 's/Model name: *//p'", shell=True, capture_output=True,
                                      text=True).stdout.strip(), "nproc": os.cpu_count()}
 
@@ -176,7 +176,7 @@ def main():
 def report(r):
     s = r["side_by_side"]
     print(f"\n### Side by side ({r['date']}, {r['cpu']}, {r['nproc']} cores): n = {s['n']}, {r['restarts'] + 1} starts, "
-          f"held-out {2000} points\n")
+          f"held-out {r['test']} points\n")
     print("| | mufric | scikit-learn | ratio |\n|---|---|---|---|")
     print(f"| fit time | {s['mufric_fit_s']:.2f} s | {s['sklearn_fit_s']:.2f} s | {s['sklearn_fit_s'] / s['mufric_fit_s']:.1f}x |")
     print(f"| final log marginal likelihood | {s['mufric_lml']:.4f} | {s['sklearn_lml']:.4f} | "
@@ -212,8 +212,7 @@ def plot(r, path):
             a.annotate(str(w["n"]), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
     a.set_xlabel("fit time [s]")
     a.set_ylabel("held-out mean relative error [%]")
-    a.set_title(f"Run time against error ({r['sweep_restarts'] if 'sweep_restarts' in r else ''}"
-                f"same starts, labels = training size)")
+    a.set_title(f"Run time against error ({r['sweep_restarts'] + 1} starts each; labels: training size)")
     a.grid(True, which="both", alpha=0.3)
     a.legend()
     n = [w["n"] for w in sweep]

@@ -21,14 +21,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 Dataset read_hdf5_dataset(const std::string& path) {
   const h5::Reader in(path, "dataset");
-  if (!in.has_attribute("/", "format") || in.string_attribute("/", "format") != kDatasetFormat) {
-    in.fail("/", "not a mufric dataset (attribute 'format' is not '" + std::string(kDatasetFormat) + "')");
-  }
-  const long long version = in.int_attribute("/", "schema_version");
-  if (version != kDatasetSchemaVersion) {
-    in.fail("/", "schema_version " + std::to_string(version) + " is not supported (this build reads " +
-                     std::to_string(kDatasetSchemaVersion) + ")");
-  }
+  in.require_format(kDatasetFormat, kDatasetSchemaVersion, "mufric dataset");
   Dataset d;
   d.inputs = read_input_space(in);
   const auto dims = static_cast<Eigen::Index>(d.inputs.size());

@@ -1,5 +1,6 @@
 #include "common/h5_file.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -89,50 +90,50 @@ bool Reader::has_attribute(const std::string& object, const std::string& name) c
   return object_for_attribute(object, storage).attrExists(name);
 }
 
-std::string Reader::string_attribute(const std::string& object, const std::string& name) const {
+H5::Attribute Reader::open_attribute(const std::string& object, const std::string& name,
+                                     std::initializer_list<H5T_class_t> classes, const std::string& expected) const {
   H5::Group storage;
   H5::H5Object& owner = object_for_attribute(object, storage);
   if (!owner.attrExists(name)) fail(object, "missing attribute '" + name + "'");
   try {
     H5::Attribute attribute = owner.openAttribute(name);
-    if (attribute.getTypeClass() != H5T_STRING) fail(object, "attribute '" + name + "' is not a string");
-    std::string value;
-    attribute.read(attribute.getStrType(), value);
-    return value;
+    const H5T_class_t found = attribute.getTypeClass();
+    if (std::find(classes.begin(), classes.end(), found) == classes.end()) {
+      fail(object, "attribute '" + name + "' is not " + expected);
+    }
+    return attribute;
   } catch (const H5::Exception& e) {
     fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
   }
+}
+
+std::string Reader::string_attribute(const std::string& object, const std::string& name) const {
+  H5::Attribute attribute = open_attribute(object, name, {H5T_STRING}, "a string");
+  std::string value;
+  attribute.read(attribute.getStrType(), value);
+  return value;
 }
 
 double Reader::double_attribute(const std::string& object, const std::string& name) const {
-  H5::Group storage;
-  H5::H5Object& owner = object_for_attribute(object, storage);
-  if (!owner.attrExists(name)) fail(object, "missing attribute '" + name + "'");
-  try {
-    H5::Attribute attribute = owner.openAttribute(name);
-    if (attribute.getTypeClass() != H5T_FLOAT && attribute.getTypeClass() != H5T_INTEGER) {
-      fail(object, "attribute '" + name + "' is not a number");
-    }
-    double value = 0.0;
-    attribute.read(H5::PredType::NATIVE_DOUBLE, &value);
-    return value;
-  } catch (const H5::Exception& e) {
-    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
-  }
+  double value = 0.0;
+  open_attribute(object, name, {H5T_FLOAT, H5T_INTEGER}, "a number").read(H5::PredType::NATIVE_DOUBLE, &value);
+  return value;
 }
 
 long long Reader::int_attribute(const std::string& object, const std::string& name) const {
-  H5::Group storage;
-  H5::H5Object& owner = object_for_attribute(object, storage);
-  if (!owner.attrExists(name)) fail(object, "missing attribute '" + name + "'");
-  try {
-    H5::Attribute attribute = owner.openAttribute(name);
-    if (attribute.getTypeClass() != H5T_INTEGER) fail(object, "attribute '" + name + "' is not an integer");
-    long long value = 0;
-    attribute.read(H5::PredType::NATIVE_LLONG, &value);
-    return value;
-  } catch (const H5::Exception& e) {
-    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
+  long long value = 0;
+  open_attribute(object, name, {H5T_INTEGER}, "an integer").read(H5::PredType::NATIVE_LLONG, &value);
+  return value;
+}
+
+void Reader::require_format(const std::string& format, long long version, const std::string& kind_of_file) const {
+  if (!has_attribute("/", "format") || string_attribute("/", "format") != format) {
+    fail("/", "not a " + kind_of_file + " (attribute 'format' is not '" + format + "')");
+  }
+  const long long found = int_attribute("/", "schema_version");
+  if (found != version) {
+    fail("/", "schema_version " + std::to_string(found) + " is not supported (this build reads " +
+                  std::to_string(version) + ")");
   }
 }
 

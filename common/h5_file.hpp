@@ -33,11 +33,17 @@ class Reader {
   // Reads exactly `expected` values or throws naming the dataset and both sizes.
   Eigen::VectorXd vector(const std::string& dataset, Eigen::Index expected) const;
 
+  // Refuses a file whose root attributes 'format' and 'schema_version' are not `format`, `version`.
+  void require_format(const std::string& format, long long version, const std::string& kind_of_file) const;
+
   [[noreturn]] void fail(const std::string& object, const std::string& problem) const;
 
  private:
   H5::DataSet open_dataset(const std::string& dataset) const;
   H5::H5Object& object_for_attribute(const std::string& object, H5::Group& group_storage) const;
+  // Opens an existing attribute of `object` whose type class is one of `classes`, or fails naming it.
+  H5::Attribute open_attribute(const std::string& object, const std::string& name, std::initializer_list<H5T_class_t> classes,
+                               const std::string& expected) const;
   std::string path_;
   std::string what_;
   mutable H5::H5File file_;

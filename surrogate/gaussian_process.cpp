@@ -116,6 +116,15 @@ GaussianProcess::GaussianProcess(State state) : FrictionModel(state.inputs), sta
   weights_by_input_ = scaled_train_.array().colwise() * weights_.array();
 }
 
+void GaussianProcess::correlations_with_training(const Eigen::RowVectorXd& scaled_query,
+                                                 Eigen::Ref<Eigen::ArrayXd> correlation) const {
+  correlation = (scaled_train_.col(0).array() - scaled_query(0)).square();
+  for (Eigen::Index k = 1; k < scaled_train_.cols(); ++k) {
+    correlation += (scaled_train_.col(k).array() - scaled_query(k)).square();
+  }
+  rbf_correlation_in_place(correlation);
+}
+
 void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count,
                                      const EvaluationRequest& what, Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block,
                                      Evaluation& out, long long& clamped) const {
@@ -128,23 +137,19 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
                             state_.hyper.length_scales.cwiseInverse().asDiagonal();
   const bool need_std = what.std || what.ci_level > 0.0;
   if (!need_std && !what.gradient) {
-    // Mean only: distance, exponential and dot product per query, in L1, no kernel block stored.
-    Eigen::ArrayXd r2(n);
+    // Mean only: correlations and dot product per query, in L1, no kernel block stored.
+    Eigen::ArrayXd correlation(n);
     for (Eigen::Index b = 0; b < count; ++b) {
-      r2 = (scaled_train_.col(0).array() - q(b, 0)).square();
-      for (Eigen::Index k = 1; k < d; ++k) r2 += (scaled_train_.col(k).array() - q(b, k)).square();
-      rbf_correlation_in_place(r2);
-      out.mu(first + b) = state_.y_mean + (r2 * weights_.array()).sum();
+      correlations_with_training(q.row(b), correlation);
+      out.mu(first + b) = state_.y_mean + (correlation * weights_.array()).sum();
     }
     return;
   }
-  // k_block(i, b) = exp(−½ |x_i − q_b|²): column b is the kernel vector of query b (without σ²).
+  // Column b of k_block is the correlation vector of query b with every training point.
   k_block.resize(n, count);
   for (Eigen::Index b = 0; b < count; ++b) {
     Eigen::Map<Eigen::ArrayXd> column(k_block.col(b).data(), n);
-    column = (scaled_train_.col(0).array() - q(b, 0)).square();
-    for (Eigen::Index k = 1; k < d; ++k) column += (scaled_train_.col(k).array() - q(b, k)).square();
-    rbf_correlation_in_place(column);
+    correlations_with_training(q.row(b), column);
   }
   out.mu.segment(first, count).noalias() = k_block.transpose() * weights_;
   out.mu.segment(first, count).array() += state_.y_mean;

@@ -76,6 +76,8 @@ class GaussianProcess final : public FrictionModel {
   void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
                       Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block, Evaluation& out, long long& clamped) const;
 
+  // exp(−½ |s_i − q|²) for every scaled training input s_i and a scaled query q.
+  void correlations_with_training(const Eigen::RowVectorXd& scaled_query, Eigen::Ref<Eigen::ArrayXd> correlation) const;
   // |L⁻¹ k_b|² for each column k_b of a few kernel vectors, reading each row of L⁻¹ once.
   Eigen::RowVectorXd squared_norms_row_by_row(const Eigen::MatrixXd& kernels) const;
 

@@ -42,6 +42,23 @@ bool factor_matches_kernel(const Eigen::MatrixXd& l, const Eigen::MatrixXd& kf, 
   return true;
 }
 
+// The fields of /gp/training, written and read from the same tables so the two cannot drift apart.
+constexpr std::pair<const char*, double GpTrainingSummary::*> kSummaryNumbers[] = {
+    {"log_marginal_likelihood", &GpTrainingSummary::log_marginal_likelihood},
+    {"loo_mean_relative_error", &GpTrainingSummary::loo_mean_relative_error},
+    {"loo_max_relative_error", &GpTrainingSummary::loo_max_relative_error},
+    {"loo_rmse", &GpTrainingSummary::loo_rmse},
+    {"loo_coverage_95", &GpTrainingSummary::loo_coverage_95},
+    {"seconds", &GpTrainingSummary::seconds}};
+constexpr std::pair<const char*, long long GpTrainingSummary::*> kSummaryCounts[] = {
+    {"starts", &GpTrainingSummary::starts}, {"best_start", &GpTrainingSummary::best_start}};
+constexpr std::pair<const char*, std::string GpTrainingSummary::*> kSummaryTexts[] = {
+    {"dataset_path", &GpTrainingSummary::dataset_path},
+    {"dataset_sha256", &GpTrainingSummary::dataset_sha256},
+    {"code_version", &GpTrainingSummary::code_version},
+    {"created_utc", &GpTrainingSummary::created_utc}};
+constexpr const char* kSummaryGroup = "/gp/training";
+
 std::vector<double> column(const std::vector<MlrRow>& rows, double MlrRow::*field) {
   std::vector<double> values;
   for (const auto& r : rows) values.push_back(r.*field);
@@ -64,14 +81,7 @@ void save_model(const std::string& path, const FrictionModel& model) {
 
 std::unique_ptr<FrictionModel> load_model(const std::string& path) {
   const h5::Reader in(path, "model");
-  if (!in.has_attribute("/", "format") || in.string_attribute("/", "format") != kModelFormat) {
-    in.fail("/", "not a mufric model (attribute 'format' is not '" + std::string(kModelFormat) + "')");
-  }
-  const long long version = in.int_attribute("/", "schema_version");
-  if (version != kModelSchemaVersion) {
-    in.fail("/", "schema_version " + std::to_string(version) + " is not supported (this build reads " +
-                     std::to_string(kModelSchemaVersion) + ")");
-  }
+  in.require_format(kModelFormat, kModelSchemaVersion, "mufric model");
   InputSpace inputs = read_input_space(in);
   const std::string kind = in.string_attribute("/", "kind");
   try {
@@ -152,20 +162,10 @@ void GaussianProcess::write(h5::Writer& out) const {
   out.doubles("/gp/y_train", s.y_train);
   out.doubles("/gp/alpha", s.alpha);
   if (s.x_train.rows() <= kStoreCholeskyUpTo) out.matrix("/gp/cholesky_lower", s.cholesky);
-  out.group("/gp/training");
-  const auto& t = s.summary;
-  out.double_attribute("/gp/training", "log_marginal_likelihood", t.log_marginal_likelihood);
-  out.double_attribute("/gp/training", "loo_mean_relative_error", t.loo_mean_relative_error);
-  out.double_attribute("/gp/training", "loo_max_relative_error", t.loo_max_relative_error);
-  out.double_attribute("/gp/training", "loo_rmse", t.loo_rmse);
-  out.double_attribute("/gp/training", "loo_coverage_95", t.loo_coverage_95);
-  out.int_attribute("/gp/training", "starts", t.starts);
-  out.int_attribute("/gp/training", "best_start", t.best_start);
-  out.double_attribute("/gp/training", "seconds", t.seconds);
-  out.string_attribute("/gp/training", "dataset_path", t.dataset_path);
-  out.string_attribute("/gp/training", "dataset_sha256", t.dataset_sha256);
-  out.string_attribute("/gp/training", "code_version", t.code_version);
-  out.string_attribute("/gp/training", "created_utc", t.created_utc);
+  out.group(kSummaryGroup);
+  for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(kSummaryGroup, name, s.summary.*field);
+  for (const auto& [name, field] : kSummaryCounts) out.int_attribute(kSummaryGroup, name, s.summary.*field);
+  for (const auto& [name, field] : kSummaryTexts) out.string_attribute(kSummaryGroup, name, s.summary.*field);
 }
 
 GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
@@ -230,21 +230,10 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
   if ((recomputed - s.alpha).norm() > kAlphaRecomputeTolerance * s.alpha.norm()) {
     in.fail("/gp/alpha", "is inconsistent with the Cholesky factor and y_train (alpha != K⁻¹y)");
   }
-  auto& t = s.summary;
-  const std::string g = "/gp/training";
-  if (in.has(g)) {
-    t.log_marginal_likelihood = in.double_attribute(g, "log_marginal_likelihood");
-    t.loo_mean_relative_error = in.double_attribute(g, "loo_mean_relative_error");
-    t.loo_max_relative_error = in.double_attribute(g, "loo_max_relative_error");
-    t.loo_rmse = in.double_attribute(g, "loo_rmse");
-    t.loo_coverage_95 = in.double_attribute(g, "loo_coverage_95");
-    t.starts = in.int_attribute(g, "starts");
-    t.best_start = in.int_attribute(g, "best_start");
-    t.seconds = in.double_attribute(g, "seconds");
-    t.dataset_path = in.string_attribute(g, "dataset_path");
-    t.dataset_sha256 = in.string_attribute(g, "dataset_sha256");
-    t.code_version = in.string_attribute(g, "code_version");
-    t.created_utc = in.string_attribute(g, "created_utc");
+  if (in.has(kSummaryGroup)) {
+    for (const auto& [name, field] : kSummaryNumbers) s.summary.*field = in.double_attribute(kSummaryGroup, name);
+    for (const auto& [name, field] : kSummaryCounts) s.summary.*field = in.int_attribute(kSummaryGroup, name);
+    for (const auto& [name, field] : kSummaryTexts) s.summary.*field = in.string_attribute(kSummaryGroup, name);
   }
   return GaussianProcess(std::move(s));
 }

@@ -35,6 +35,16 @@ Eigen::MatrixXd dense_covariance(const Eigen::MatrixXd& u, const GpHyperParamete
   return k;
 }
 
+// σ² exp(−½ Σ ((q − xᵢ)/l)²) for every training row xᵢ of u.
+Eigen::VectorXd dense_kernel_vector(const Eigen::RowVectorXd& q, const Eigen::MatrixXd& u, const Eigen::VectorXd& lengths,
+                                    double s2) {
+  Eigen::VectorXd k(u.rows());
+  for (Eigen::Index i = 0; i < u.rows(); ++i) {
+    k(i) = s2 * std::exp(-0.5 * ((q - u.row(i)).array() / lengths.transpose().array()).square().sum());
+  }
+  return k;
+}
+
 double dense_lml(const Eigen::MatrixXd& u, const Eigen::VectorXd& y, const GpHyperParameters& h) {
   const Eigen::MatrixXd k = dense_covariance(u, h, h.noise_variance);
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(k);
@@ -93,12 +103,7 @@ TEST(GpVerification, PredictionMatchesDenseFormulaWithExplicitInverse) {
   const Evaluation e = gp.evaluate(queries.x, {.std = true, .ci_level = 0.9, .gradient = false});
   const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
   for (Eigen::Index q = 0; q < uq.rows(); ++q) {
-    Eigen::VectorXd kq(u.rows());
-    for (Eigen::Index i = 0; i < u.rows(); ++i) {
-      double r2 = 0.0;
-      for (Eigen::Index c = 0; c < 3; ++c) r2 += std::pow((uq(q, c) - u(i, c)) / lengths(c), 2);
-      kq(i) = 3.0 * std::exp(-0.5 * r2);
-    }
+    const Eigen::VectorXd kq = dense_kernel_vector(uq.row(q), u, lengths, 3.0);
     const double mean = s.y_mean + s.y_scale * kq.dot(k_inv * y);
     const double var = 3.0 + 1e-4 - kq.dot(k_inv * kq);
     EXPECT_NEAR(e.mu(q), mean, 1e-9);
@@ -180,10 +185,7 @@ TEST(GpVerification, ClosedFormLeaveOneOutEqualsBruteForceRefits) {
     const Eigen::MatrixXd k = dense_covariance(u, s.hyper, s.hyper.noise_variance);
     const Eigen::VectorXd y = (rest.mu.array() - s.y_mean) / s.y_scale;
     const Eigen::MatrixXd ui = to_unit_box(data.x.row(i), data.inputs);
-    Eigen::VectorXd kq(29);
-    for (Eigen::Index r = 0; r < 29; ++r) {
-      kq(r) = 1.5 * std::exp(-0.5 * ((ui.row(0) - u.row(r)).array() / lengths.transpose().array()).square().sum());
-    }
+    const Eigen::VectorXd kq = dense_kernel_vector(ui.row(0), u, lengths, 1.5);
     const double prediction = s.y_mean + s.y_scale * kq.dot(k.ldlt().solve(y));
     brute_sum += std::abs(prediction - data.mu(i)) / std::abs(data.mu(i));
   }
@@ -219,10 +221,7 @@ TEST(GpVerification, AllVariancePathsAgreeWithTheDenseFormula) {
   const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
   Eigen::VectorXd expected(40);
   for (Eigen::Index q = 0; q < 40; ++q) {
-    Eigen::VectorXd kq(500);
-    for (Eigen::Index i = 0; i < 500; ++i) {
-      kq(i) = 2.0 * std::exp(-0.5 * ((uq.row(q) - u.row(i)).array() / lengths.transpose().array()).square().sum());
-    }
+    const Eigen::VectorXd kq = dense_kernel_vector(uq.row(q), u, lengths, 2.0);
     expected(q) = s.y_scale * std::sqrt(2.0 + 1e-4 - kq.dot(k_llt.solve(kq)));
   }
   const Evaluation blocked = gp.evaluate(queries.x, {.std = true});
