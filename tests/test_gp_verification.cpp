@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "gp_test_data.hpp"
 #include "surrogate/gp_training.hpp"
@@ -163,6 +164,30 @@ TEST(GpVerification, OptimiserBeatsBruteForceGridSearch) {
     }
   }
   EXPECT_GE(optimised, best_grid - 1e-6);
+}
+
+TEST(GpVerification, SubsetStageFindsTheSameOptimumAsPlainMultiStart) {
+  // The subset stage, shared basins and not refining hopeless starts only make the search cheaper:
+  // the best LML must match plain full-data L-BFGS from the same starts.
+  TrainingSet data = test::smooth_training_set(700, 13);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 5e-4);
+  for (Eigen::Index i = 0; i < data.mu.size(); ++i) data.mu(i) += noise(rng);
+  GpTrainingOptions options;
+  options.restarts = 3;
+  GpTrainingReport fast_report, plain_report;
+  const GaussianProcess fast = train_gaussian_process(data, options, &fast_report);
+  options.subset_size = 0;
+  const GaussianProcess plain = train_gaussian_process(data, options, &plain_report);
+  EXPECT_NEAR(fast.state().summary.log_marginal_likelihood, plain.state().summary.log_marginal_likelihood, 1e-3);
+  int full_evaluations_fast = 0, full_evaluations_plain = 0;
+  for (const auto& s : fast_report.starts) {
+    full_evaluations_fast += s.evaluations;
+    EXPECT_GT(s.subset_evaluations, 0);
+    EXPECT_LE(s.log_marginal_likelihood, fast.state().summary.log_marginal_likelihood);
+  }
+  for (const auto& s : plain_report.starts) full_evaluations_plain += s.evaluations;
+  EXPECT_LT(full_evaluations_fast, full_evaluations_plain);
 }
 
 TEST(GpVerification, ClosedFormLeaveOneOutEqualsBruteForceRefits) {
