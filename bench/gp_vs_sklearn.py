@@ -137,7 +137,7 @@ def main():
             write_csv(tmp / "train.csv", raw, mu)
             model = tmp / "model.h5"
             m = mufric_fit(args.mufric, tmp / "train.csv", model, restarts)
-            row = {"n": n, "mufric_fit_s": m["fit_s"], "mufric_train_wall_s": m["wall_s"], "mufric_lml": m["lml"],
+            row = {"n": n, "mufric_train_log": m["log"], "mufric_fit_s": m["fit_s"], "mufric_train_wall_s": m["wall_s"], "mufric_lml": m["lml"],
                    "mufric_error": mufric_error(args.mufric, model, tmp / "test.csv")}
             lo, hi = raw.min(0), raw.max(0)  # mufric's box for a CSV: the data's range
             gp, fit_s = sklearn_fit(unit_box(raw, lo, hi), mu, restarts)
@@ -158,13 +158,11 @@ def main():
                             "sklearn_single_mean_us": 1e6 * per_point(lambda: gp.predict(one), 1, args.seconds),
                             "sklearn_single_std_us": 1e6 * per_point(lambda: gp.predict(one, return_std=True), 1,
                                                                      args.seconds)})
-            print(json.dumps(row), flush=True)
-            return row, m["log"]
+            print(json.dumps({k: v for k, v in row.items() if k != "mufric_train_log"}), flush=True)
+            return row,
 
         print(f"== side by side: n = {args.n}, {args.restarts + 1} starts each", flush=True)
-        main_row, train_log = compare(args.n, args.restarts, True)
-        results["side_by_side"] = main_row
-        results["mufric_train_log"] = train_log
+        results["side_by_side"] = compare(args.n, args.restarts, True)[0]
         print(f"== sweep: sizes {args.sizes}, {args.sweep_restarts + 1} starts each", flush=True)
         results["sweep"] = [compare(int(n), args.sweep_restarts, False)[0] for n in args.sizes.split(",")]
 
