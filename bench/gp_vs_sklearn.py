@@ -159,12 +159,12 @@ def main():
                             "sklearn_single_std_us": 1e6 * per_point(lambda: gp.predict(one, return_std=True), 1,
                                                                      args.seconds)})
             print(json.dumps({k: v for k, v in row.items() if k != "mufric_train_log"}), flush=True)
-            return row,
+            return row
 
         print(f"== side by side: n = {args.n}, {args.restarts + 1} starts each", flush=True)
-        results["side_by_side"] = compare(args.n, args.restarts, True)[0]
+        results["side_by_side"] = compare(args.n, args.restarts, True)
         print(f"== sweep: sizes {args.sizes}, {args.sweep_restarts + 1} starts each", flush=True)
-        results["sweep"] = [compare(int(n), args.sweep_restarts, False)[0] for n in args.sizes.split(",")]
+        results["sweep"] = [compare(int(n), args.sweep_restarts, False) for n in args.sizes.split(",")]
 
     (out_dir / "gp_vs_sklearn.json").write_text(json.dumps(results, indent=1))
     report(results)
