@@ -116,9 +116,15 @@ def main():
     parser.add_argument("--test", type=int, default=2000, help="held-out points")
     parser.add_argument("--out", default="bench/results", help="folder for the JSON and the plot")
     parser.add_argument("--seconds", type=float, default=1.0, help="minimum timing per prediction measurement")
+    parser.add_argument("--replot", action="store_true", help="only redraw the tables and plot from the stored JSON")
     args = parser.parse_args()
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
+    if args.replot:
+        results = json.loads((out_dir / "gp_vs_sklearn.json").read_text())
+        report(results)
+        plot(results, out_dir / "gp_vs_sklearn.png")
+        return 0
     rng = np.random.default_rng(2026)
     results = {"test": args.test, "n": args.n, "restarts": args.restarts, "sweep_restarts": args.sweep_restarts, "machine": os.uname().nodename, "date": time.strftime("%Y-%m-%d"),
                "cpu": subprocess.run("lscpu | sed -n 's/Model name: *//p'", shell=True, capture_output=True,
@@ -214,14 +220,17 @@ def plot(r, path):
     a.grid(True, which="both", alpha=0.3)
     a.legend()
     n = [w["n"] for w in sweep]
-    b.loglog(n, [w["mufric_mean_us"] for w in sweep], "o-", label="mufric mean, 10k batch")
-    b.loglog(n, [w["mufric_std_us"] for w in sweep], "s-", label="mufric mean+std, 10k batch")
-    b.loglog(n, [w["mufric_single_std_us"] for w in sweep], "^-", label="mufric single point +std")
+    series = [("mufric_mean_us", "o-", "tab:blue", "mufric mean, 10k batch"),
+              ("mufric_std_us", "s-", "tab:green", "mufric mean+std, 10k batch"),
+              ("mufric_single_std_us", "^-", "tab:red", "mufric single point +std")]
+    for key, style, colour, label in series:
+        b.loglog(n, [w[key] for w in sweep], style, color=colour, label=label)
     s = r["side_by_side"]
-    b.loglog([s["n"]], [s["sklearn_mean_us"]], "o", color="tab:orange", label="scikit-learn mean, 10k batch")
-    b.loglog([s["n"]], [s["sklearn_std_us"]], "s", color="tab:orange", mfc="none", label="scikit-learn mean+std")
-    b.loglog([s["n"]], [s["sklearn_single_std_us"]], "^", color="tab:orange", mfc="none",
-             label="scikit-learn single +std")
+    peer = "black"
+    b.loglog([s["n"]], [s["sklearn_mean_us"]], "o", color=peer, mfc="none", label="scikit-learn mean, 10k batch")
+    b.loglog([s["n"]], [s["sklearn_std_us"]], "s", color=peer, mfc="none", label="scikit-learn mean+std, 10k batch")
+    b.loglog([s["n"]], [s["sklearn_single_std_us"]], "^", color=peer, mfc="none", label="scikit-learn single +std")
+    b.axhline(20.0, color="tab:red", linestyle=":", linewidth=1, label="goal: single point +std 20 us")
     b.set_xlabel("training points")
     b.set_ylabel("time per point [us]")
     b.set_title("Prediction cost per point")
