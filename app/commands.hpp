@@ -5,4 +5,5 @@ namespace mufric::app {
 // Each adds its subcommand(s) to the application; the callbacks print and may throw mufric::Error.
 void add_surrogate_commands(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_service_commands(CLI::App& app);
 }  // namespace mufric::app

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   mufric::app::add_surrogate_commands(app);
   mufric::app::add_bench_command(app);
+  mufric::app::add_service_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

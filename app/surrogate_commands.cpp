@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "client/friction_client.hpp"
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
@@ -141,7 +142,7 @@ void add_predict(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("predict", "One friction coefficient with its confidence interval, human units");
-  cmd->add_option("--model", o->model, "Model file or file:// URI")->required();
+  cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), or grpc://host:port/model")->required();
   for (const auto& [input, flag] : kInputFlags) {
     cmd->add_option(flag, o->values[flag],
                     "The " + input + " with its unit, e.g. " + std::string(example_quantity(kind_of_input(input))));
@@ -150,31 +151,38 @@ void add_predict(CLI::App& app) {
       ->check(CLI::Range(0.5, 0.9999));
   cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput");
   cmd->callback([o] {
-    const auto model = load_model(model_path_from_uri(o->model));
-    const auto& inputs = model->inputs();
-    QueryBatch x(1, static_cast<Eigen::Index>(inputs.size()));
+    const auto client = client::connect(o->model);
+    const client::ModelInfo info = client->describe();
+    const InputSpace& inputs = info.inputs;
+    std::vector<double> values(inputs.size());
+    client::Block block{.points = 1};
     for (size_t j = 0; j < inputs.size(); ++j) {
       const auto flag_it = kInputFlags.find(inputs[j].name);
       if (flag_it == kInputFlags.end()) throw Error("model input '" + inputs[j].name + "' has no command-line flag");
       const std::string& text = o->values[flag_it->second];
       if (text.empty()) throw Error(flag_it->second + " is required: the model's input " + inputs[j].name + " (e.g. " +
                                     flag_it->second + " " + std::string(example_quantity(inputs[j].kind())) + ")");
-      x(0, static_cast<Eigen::Index>(j)) = parse_quantity(text, inputs[j].kind(), flag_it->second);
+      values[j] = parse_quantity(text, inputs[j].kind(), flag_it->second);
+      const std::string& name = inputs[j].name;
+      const double* value = &values[j];
+      if (name == "contact_pressure") block.contact_pressure = value;
+      if (name == "sliding_velocity") block.sliding_velocity = value;
+      if (name == "temperature") block.temperature = value;
+      if (name == "fibre_angle") block.fibre_angle = value;
     }
     for (const auto& [input, flag] : kInputFlags) {
       const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });
       if (!used && !o->values[flag].empty()) throw Error(flag + " was given but the model has no input " + input);
     }
-    const Evaluation e = model->evaluate(x, {.std = true, .ci_level = o->level, .gradient = o->gradient});
+    const client::Answer a = client->evaluate(block, {.std = true, .ci_level = o->level, .gradient = o->gradient});
     for (size_t j = 0; j < inputs.size(); ++j) {
-      std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(),
-                  format_human(x(0, static_cast<Eigen::Index>(j)), inputs[j].kind()).c_str());
+      std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(values[j], inputs[j].kind()).c_str());
     }
-    std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s\n", e.mu(0), e.std(0),
-                100 * o->level, e.lo(0), e.hi(0), std::string(to_string(e.status[0])).c_str());
+    std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s\n", a.mu[0], a.std[0], 100 * o->level,
+                a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str());
     if (o->gradient) {
       for (size_t j = 0; j < inputs.size(); ++j) {
-        std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(), e.gradient(0, static_cast<Eigen::Index>(j)),
+        std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(), a.gradient[j],
                     std::string(si_unit(inputs[j].kind())).c_str());
       }
     }

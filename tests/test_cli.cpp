@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -101,6 +104,39 @@ TEST_F(Cli, NaNInATrainingRowIsNamedByLine) {
   EXPECT_NE(r.output.find("line 3, column 'temperature'"), std::string::npos) << r.output;
   // One line: the error is the whole message.
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
+  std::filesystem::create_directories(path("models"));
+  ASSERT_EQ(run("law seward --table 4 --out " + path("models/law.h5")).exit_code, 0);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string log = path("serve.log");
+    freopen(log.c_str(), "w", stderr);
+    execl(MUFRIC_EXE, MUFRIC_EXE, "serve", "--models", path("models").c_str(), "--listen", "127.0.0.1:0",
+          "--ready-file", path("address").c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::string address;
+  for (int i = 0; i < 100 && address.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::ifstream(path("address")) >> address;
+  }
+  ASSERT_FALSE(address.empty()) << "server did not start";
+  const CommandResult r = run("predict --model grpc://" + address + "/law --p 80MPa --v 10m/min --angle 90deg");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("mu = 0.221001"), std::string::npos) << r.output;
+  const CommandResult missing = run("predict --model grpc://" + address + "/other --p 80MPa --v 10m/min --angle 90deg");
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("NOT_FOUND"), std::string::npos) << missing.output;
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  std::ifstream log(path("serve.log"));
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("SIGTERM: draining"), std::string::npos) << text;
 }
 
 TEST_F(Cli, CorruptModelIsRefused) {

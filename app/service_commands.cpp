@@ -1,0 +1,29 @@
+// serve: the gRPC friction service.
+#include <memory>
+
+#include "app/commands.hpp"
+#include "server/server.hpp"
+
+namespace mufric::app {
+
+void add_service_commands(CLI::App& app) {
+  auto o = std::make_shared<server::ServerOptions>();
+  auto* cmd = app.add_subcommand("serve", "Serve every model file (*.h5) of a directory over gRPC");
+  cmd->add_option("--models", o->models_directory, "Directory of model files; the name of a model is its file stem")
+      ->required();
+  cmd->add_option("--listen", o->listen, "Address to listen on (port 0: any free port)")->capture_default_str();
+  cmd->add_option("--poll", o->poll_seconds, "Seconds between rescans of the directory for new or changed files")
+      ->capture_default_str()->check(CLI::Range(0.05, 3600.0));
+  cmd->add_option("--max-message-mb", o->max_message_mb, "Largest request or response, MB")->capture_default_str()
+      ->check(CLI::Range(1, 2000));
+  cmd->add_option("--max-points", o->max_points, "Most points in one request")->capture_default_str()
+      ->check(CLI::Range(1LL, 100'000'000LL));
+  cmd->add_option("--drain", o->drain_seconds, "Seconds requests in flight get on SIGTERM")->capture_default_str();
+  cmd->add_option("--ready-file", o->ready_file, "Write the bound address here once serving (for scripts)");
+  cmd->footer("Plaintext; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"
+              "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
+              "server reflection are on. Logs go to stderr, one line per event.");
+  cmd->callback([o] { server::run_server(*o); });
+}
+
+}  // namespace mufric::app

@@ -1,0 +1,177 @@
+#include "client/friction_client.hpp"
+
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+#include "common/error.hpp"
+#include "mufric/v1/friction.grpc.pb.h"
+#include "surrogate/gaussian_process.hpp"
+#include "surrogate/model_file.hpp"
+
+namespace mufric::client {
+namespace {
+
+const double* input_pointer(const Block& block, const std::string& name) {
+  if (name == "contact_pressure") return block.contact_pressure;
+  if (name == "sliding_velocity") return block.sliding_velocity;
+  if (name == "temperature") return block.temperature;
+  if (name == "fibre_angle") return block.fibre_angle;
+  return nullptr;
+}
+
+class InProcessClient final : public FrictionClient {
+ public:
+  explicit InProcessClient(const std::string& path) : path_(path), model_(load_model(path)) {}
+
+  Answer evaluate(const Block& block, const EvaluationRequest& what) override {
+    const auto& inputs = model_->inputs();
+    QueryBatch x(static_cast<Eigen::Index>(block.points), static_cast<Eigen::Index>(inputs.size()));
+    for (size_t j = 0; j < inputs.size(); ++j) {
+      const double* values = input_pointer(block, inputs[j].name);
+      if (values == nullptr) throw Error("model '" + path_ + "' needs input " + inputs[j].name + ", which was not given");
+      x.col(static_cast<Eigen::Index>(j)) = Eigen::Map<const Eigen::VectorXd>(values, x.rows());
+    }
+    const Evaluation e = model_->evaluate(x, what);
+    Answer a;
+    a.model = path_;
+    a.mu.assign(e.mu.data(), e.mu.data() + e.mu.size());
+    a.std.assign(e.std.data(), e.std.data() + e.std.size());
+    a.lo.assign(e.lo.data(), e.lo.data() + e.lo.size());
+    a.hi.assign(e.hi.data(), e.hi.data() + e.hi.size());
+    if (what.gradient) {
+      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
+      a.gradient.assign(rows.data(), rows.data() + rows.size());
+      for (const auto& input : inputs) a.gradient_inputs.push_back(input.name);
+    }
+    a.status = e.status;
+    return a;
+  }
+
+  ModelInfo describe() override {
+    return {path_, "", std::string(model_->kind()), model_->inputs(), model_->has_uncertainty(), model_->summary()};
+  }
+
+ private:
+  std::string path_;
+  std::unique_ptr<FrictionModel> model_;
+};
+
+class GrpcClient final : public FrictionClient {
+ public:
+  GrpcClient(const std::string& target, std::string model, const Options& options)
+      : model_(std::move(model)), options_(options) {
+    grpc::ChannelArguments arguments;
+    arguments.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
+    arguments.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
+    // gRPC's own reconnect backoff starts at 1 s; a restarting server should be found again within
+    // the client's retry schedule, so the channel redials on the same time scale.
+    const int backoff_ms = std::max(1, static_cast<int>(1000.0 * options.first_backoff_seconds));
+    arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, backoff_ms);
+    arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, backoff_ms);
+    arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, backoff_ms << options.retries);
+    channel_ = grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments);
+    stub_ = mufric::v1::FrictionService::NewStub(channel_);
+  }
+
+  Answer evaluate(const Block& block, const EvaluationRequest& what) override {
+    Answer answer;
+    const auto chunk = static_cast<size_t>(std::max<long long>(1, options_.chunk_points));
+    for (size_t first = 0; first < block.points || first == 0; first += chunk) {
+      const size_t count = std::min(chunk, block.points - first);
+      mufric::v1::EvaluateRequest request;
+      request.set_model(model_);
+      auto add = [&](const double* values, google::protobuf::RepeatedField<double>* field) {
+        if (values) field->Assign(values + first, values + first + count);
+      };
+      add(block.contact_pressure, request.mutable_contact_pressure());
+      add(block.sliding_velocity, request.mutable_sliding_velocity());
+      add(block.temperature, request.mutable_temperature());
+      add(block.fibre_angle, request.mutable_fibre_angle());
+      request.set_std(what.std);
+      request.set_ci_level(what.ci_level);
+      request.set_gradient(what.gradient);
+      mufric::v1::EvaluateResponse response;
+      call("Evaluate", [&](grpc::ClientContext* context) { return stub_->Evaluate(context, request, &response); });
+      answer.model = response.model();
+      answer.version = response.version();
+      answer.mu.insert(answer.mu.end(), response.mu().begin(), response.mu().end());
+      answer.std.insert(answer.std.end(), response.std().begin(), response.std().end());
+      answer.lo.insert(answer.lo.end(), response.lo().begin(), response.lo().end());
+      answer.hi.insert(answer.hi.end(), response.hi().begin(), response.hi().end());
+      answer.gradient.insert(answer.gradient.end(), response.gradient().begin(), response.gradient().end());
+      answer.gradient_inputs.assign(response.gradient_inputs().begin(), response.gradient_inputs().end());
+      for (const int s : response.status()) answer.status.push_back(static_cast<PointStatus>(s));
+      if (block.points == 0) break;
+    }
+    return answer;
+  }
+
+  ModelInfo describe() override {
+    mufric::v1::DescribeModelRequest request;
+    request.set_model(model_);
+    mufric::v1::ModelDescription d;
+    call("DescribeModel", [&](grpc::ClientContext* context) { return stub_->DescribeModel(context, request, &d); });
+    ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary()};
+    for (const auto& input : d.inputs()) info.inputs.push_back({input.name(), input.unit(), input.lo(), input.hi()});
+    return info;
+  }
+
+ private:
+  // Deadline on every attempt; UNAVAILABLE (server restarting, not yet up) is retried with backoff.
+  template <typename Rpc>
+  void call(const char* method, Rpc rpc) {
+    double backoff = options_.first_backoff_seconds;
+    for (int attempt = 0;; ++attempt) {
+      grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() +
+                           std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                               std::chrono::duration<double>(options_.deadline_seconds)));
+      const grpc::Status status = rpc(&context);
+      if (status.ok()) return;
+      if (status.error_code() == grpc::StatusCode::UNAVAILABLE && attempt < options_.retries) {
+        std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
+        backoff *= 2.0;
+        continue;
+      }
+      throw Error(std::string(method) + " on model '" + model_ + "' failed (" + code_name(status.error_code()) +
+                  "): " + status.error_message());
+    }
+  }
+
+  static std::string code_name(grpc::StatusCode code) {
+    switch (code) {
+      case grpc::StatusCode::NOT_FOUND: return "NOT_FOUND";
+      case grpc::StatusCode::INVALID_ARGUMENT: return "INVALID_ARGUMENT";
+      case grpc::StatusCode::RESOURCE_EXHAUSTED: return "RESOURCE_EXHAUSTED";
+      case grpc::StatusCode::UNAVAILABLE: return "UNAVAILABLE";
+      case grpc::StatusCode::DEADLINE_EXCEEDED: return "DEADLINE_EXCEEDED";
+      case grpc::StatusCode::UNAUTHENTICATED: return "UNAUTHENTICATED";
+      default: return "status " + std::to_string(static_cast<int>(code));
+    }
+  }
+
+  std::string model_;
+  Options options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<mufric::v1::FrictionService::Stub> stub_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options) {
+  const std::string grpc_scheme = "grpc://";
+  if (uri.rfind(grpc_scheme, 0) == 0) {
+    const std::string rest = uri.substr(grpc_scheme.size());
+    const auto slash = rest.find('/');
+    if (slash == std::string::npos || slash + 1 == rest.size()) {
+      throw Error("model URI '" + uri + "': expected grpc://host:port/model");
+    }
+    return std::make_unique<GrpcClient>(rest.substr(0, slash), rest.substr(slash + 1), options);
+  }
+  return std::make_unique<InProcessClient>(model_path_from_uri(uri));
+}
+
+}  // namespace mufric::client

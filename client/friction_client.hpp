@@ -1,0 +1,56 @@
+#pragma once
+// The meso-code side: one interface, two transports chosen by URI.
+//   grpc://host:port/model   a mufric server (channel reuse, deadlines, retry with backoff on
+//                            UNAVAILABLE, automatic chunking under the message limit)
+//   file:///path/model.h5    the same model evaluated in-process, no server (or a plain path)
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "surrogate/friction_model.hpp"
+
+namespace mufric::client {
+
+// One block of contact points, structure-of-arrays, SI; null for inputs not sent.
+struct Block {
+  size_t points = 0;
+  const double* contact_pressure = nullptr;  // Pa
+  const double* sliding_velocity = nullptr;  // m/s
+  const double* temperature = nullptr;       // K
+  const double* fibre_angle = nullptr;       // rad
+};
+
+struct Answer {
+  std::string model, version;
+  std::vector<double> mu, std, lo, hi;  // std/lo/hi empty unless requested
+  std::vector<double> gradient;         // row-major points × gradient_inputs, if requested
+  std::vector<std::string> gradient_inputs;
+  std::vector<PointStatus> status;
+};
+
+struct ModelInfo {
+  std::string name, version, kind;
+  InputSpace inputs;
+  bool has_uncertainty = false;
+  std::string summary;
+};
+
+struct Options {
+  double deadline_seconds = 30.0;   // per call
+  int retries = 4;                  // on UNAVAILABLE, with exponential backoff
+  double first_backoff_seconds = 0.05;
+  long long chunk_points = 65536;   // larger blocks are split into several calls
+  int max_message_mb = 64;
+};
+
+class FrictionClient {
+ public:
+  virtual ~FrictionClient() = default;
+  // Throws mufric::Error naming the problem (unknown model, missing input, server error).
+  virtual Answer evaluate(const Block& block, const EvaluationRequest& what) = 0;
+  virtual ModelInfo describe() = 0;
+};
+
+std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options = {});
+
+}  // namespace mufric::client

@@ -1,0 +1,181 @@
+#include "server/friction_service.hpp"
+
+#include <cmath>
+#include <exception>
+
+#include "surrogate/gaussian_process.hpp"
+
+namespace mufric::server {
+namespace {
+
+using mufric::v1::EvaluateRequest;
+
+const google::protobuf::RepeatedField<double>* input_array(const EvaluateRequest& request, const std::string& name) {
+  if (name == "contact_pressure") return &request.contact_pressure();
+  if (name == "sliding_velocity") return &request.sliding_velocity();
+  if (name == "temperature") return &request.temperature();
+  if (name == "fibre_angle") return &request.fibre_angle();
+  return nullptr;
+}
+
+constexpr const char* kWireInputs[] = {"contact_pressure", "sliding_velocity", "temperature", "fibre_angle"};
+
+}  // namespace
+
+grpc::Status batch_from_request(const EvaluateRequest& request, const InputSpace& inputs, long long max_points,
+                                QueryBatch& batch, std::vector<std::string>& ignored) {
+  long long points = -1;
+  std::string first_name;
+  for (const auto& input : inputs) {
+    const auto* array = input_array(request, input.name);
+    if (array == nullptr) {
+      return {grpc::StatusCode::INVALID_ARGUMENT,
+              "the model needs input '" + input.name + "', which the wire contract does not carry"};
+    }
+    if (array->empty()) {
+      return {grpc::StatusCode::INVALID_ARGUMENT, "field " + input.name + " is empty; the model '" + request.model() +
+                                                      "' needs it (one value per point)"};
+    }
+    if (points < 0) {
+      points = array->size();
+      first_name = input.name;
+    } else if (array->size() != points) {
+      return {grpc::StatusCode::INVALID_ARGUMENT, "field " + input.name + " has " + std::to_string(array->size()) +
+                                                      " values but " + first_name + " has " + std::to_string(points)};
+    }
+  }
+  if (points > max_points) {
+    return {grpc::StatusCode::RESOURCE_EXHAUSTED, std::to_string(points) + " points exceed the server's limit of " +
+                                                      std::to_string(max_points) + " per request (--max-points); split the block"};
+  }
+  batch.resize(points, static_cast<Eigen::Index>(inputs.size()));
+  for (size_t j = 0; j < inputs.size(); ++j) {
+    const auto* array = input_array(request, inputs[j].name);
+    batch.col(static_cast<Eigen::Index>(j)) = Eigen::Map<const Eigen::VectorXd>(array->data(), points);
+  }
+  for (const char* name : kWireInputs) {
+    const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == name; });
+    if (!used && !input_array(request, name)->empty()) ignored.emplace_back(name);
+  }
+  return grpc::Status::OK;
+}
+
+void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
+  const FrictionModel& model = *served.model;
+  out.set_name(served.name);
+  out.set_version(served.version);
+  out.set_kind(std::string(model.kind()));
+  for (const auto& input : model.inputs()) {
+    auto* d = out.add_inputs();
+    d->set_name(input.name);
+    d->set_unit(input.unit);
+    d->set_lo(input.lo);
+    d->set_hi(input.hi);
+  }
+  out.set_has_uncertainty(model.has_uncertainty());
+  if (const auto* gp = dynamic_cast<const GaussianProcess*>(&model)) {
+    const auto& state = gp->state();
+    out.set_training_points(static_cast<uint64_t>(state.x_train.rows()));
+    out.set_loo_mean_relative_error(state.summary.loo_mean_relative_error);
+    out.set_loo_max_relative_error(state.summary.loo_max_relative_error);
+    out.set_loo_coverage_95(state.summary.loo_coverage_95);
+  }
+  out.set_summary(model.summary());
+}
+
+grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
+  const auto served = registry_.find(request.model());
+  if (!served) {
+    return {grpc::StatusCode::NOT_FOUND, "model '" + request.model() + "' is not served; serving: " + registry_.names()};
+  }
+  if (!request.version().empty() && request.version() != served->version) {
+    return {grpc::StatusCode::NOT_FOUND, "model '" + request.model() + "' version " + request.version() +
+                                             " is not served; the current version is " + served->version};
+  }
+  if (request.ci_level() != 0.0 && !(request.ci_level() > 0.0 && request.ci_level() < 1.0)) {
+    return {grpc::StatusCode::INVALID_ARGUMENT, "field ci_level must lie in (0, 1) or be 0, got " +
+                                                    std::to_string(request.ci_level())};
+  }
+  const FrictionModel& model = *served->model;
+  QueryBatch batch;
+  std::vector<std::string> ignored;
+  grpc::Status status = batch_from_request(request, model.inputs(), limits_.max_points_per_request, batch, ignored);
+  if (!status.ok()) return status;
+  const Evaluation e =
+      model.evaluate(batch, {.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()});
+  const auto n = static_cast<int>(batch.rows());
+  response.set_model(served->name);
+  response.set_version(served->version);
+  response.mutable_mu()->Assign(e.mu.data(), e.mu.data() + n);
+  if (request.std()) response.mutable_std()->Assign(e.std.data(), e.std.data() + n);
+  if (request.ci_level() > 0.0) {
+    response.mutable_lo()->Assign(e.lo.data(), e.lo.data() + n);
+    response.mutable_hi()->Assign(e.hi.data(), e.hi.data() + n);
+  }
+  if (request.gradient()) {
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
+    response.mutable_gradient()->Assign(rows.data(), rows.data() + rows.size());
+    for (const auto& input : model.inputs()) response.add_gradient_inputs(input.name);
+  }
+  auto* statuses = response.mutable_status();
+  statuses->Reserve(n);
+  uint64_t extrapolated = 0, invalid = 0;
+  for (const PointStatus s : e.status) {
+    statuses->Add(static_cast<int>(s));
+    extrapolated += s == PointStatus::extrapolated;
+    invalid += s == PointStatus::invalid_input;
+  }
+  response.set_extrapolated_points(extrapolated);
+  response.set_invalid_points(invalid);
+  for (auto& name : ignored) response.add_ignored_inputs(std::move(name));
+  counters_.points += n;
+  return grpc::Status::OK;
+}
+
+grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
+                                                    mufric::v1::EvaluateResponse* response) {
+  ++counters_.requests;
+  grpc::Status status;
+  try {
+    status = evaluate(*request, *response);
+  } catch (const std::exception& e) {
+    status = grpc::Status(grpc::StatusCode::INTERNAL, std::string("evaluation failed: ") + e.what());
+  }
+  if (!status.ok()) ++counters_.errors;
+  auto* reactor = context->DefaultReactor();
+  reactor->Finish(status);
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContext* context,
+                                                      const mufric::v1::ListModelsRequest*,
+                                                      mufric::v1::ListModelsResponse* response) {
+  ++counters_.requests;
+  for (const auto& served : registry_.all()) {
+    auto* m = response->add_models();
+    m->set_name(served->name);
+    m->set_version(served->version);
+    m->set_kind(std::string(served->model->kind()));
+  }
+  auto* reactor = context->DefaultReactor();
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* FrictionService::DescribeModel(grpc::CallbackServerContext* context,
+                                                         const mufric::v1::DescribeModelRequest* request,
+                                                         mufric::v1::ModelDescription* response) {
+  ++counters_.requests;
+  auto* reactor = context->DefaultReactor();
+  const auto served = registry_.find(request->model());
+  if (!served) {
+    ++counters_.errors;
+    reactor->Finish({grpc::StatusCode::NOT_FOUND, "model '" + request->model() + "' is not served; serving: " + registry_.names()});
+    return reactor;
+  }
+  describe(*served, *response);
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
+}  // namespace mufric::server

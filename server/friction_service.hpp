@@ -1,0 +1,48 @@
+#pragma once
+// The gRPC FrictionService (callback API) over a ModelRegistry.
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "mufric/v1/friction.grpc.pb.h"
+#include "server/model_registry.hpp"
+
+namespace mufric::server {
+
+struct ServiceLimits {
+  long long max_points_per_request = 1'000'000;
+};
+
+// Copies the request's packed arrays into a batch in the model's input order. Unequal lengths or a
+// missing input give INVALID_ARGUMENT naming the field; inputs the model does not use are listed.
+grpc::Status batch_from_request(const mufric::v1::EvaluateRequest& request, const InputSpace& inputs,
+                                long long max_points, QueryBatch& batch, std::vector<std::string>& ignored);
+
+void describe(const ServedModel& served, mufric::v1::ModelDescription& out);
+
+class FrictionService final : public mufric::v1::FrictionService::CallbackService {
+ public:
+  FrictionService(const ModelRegistry& registry, ServiceLimits limits) : registry_(registry), limits_(limits) {}
+
+  grpc::ServerUnaryReactor* Evaluate(grpc::CallbackServerContext* context, const mufric::v1::EvaluateRequest* request,
+                                     mufric::v1::EvaluateResponse* response) override;
+  grpc::ServerUnaryReactor* ListModels(grpc::CallbackServerContext* context, const mufric::v1::ListModelsRequest* request,
+                                       mufric::v1::ListModelsResponse* response) override;
+  grpc::ServerUnaryReactor* DescribeModel(grpc::CallbackServerContext* context,
+                                          const mufric::v1::DescribeModelRequest* request,
+                                          mufric::v1::ModelDescription* response) override;
+
+  struct Counters {
+    std::atomic<long long> requests{0}, points{0}, errors{0};
+  };
+  const Counters& counters() const { return counters_; }
+
+ private:
+  grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
+
+  const ModelRegistry& registry_;
+  ServiceLimits limits_;
+  Counters counters_;
+};
+
+}  // namespace mufric::server

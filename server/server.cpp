@@ -1,0 +1,99 @@
+#include "server/server.hpp"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <signal.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "common/error.hpp"
+#include "common/version.hpp"
+#include "server/friction_service.hpp"
+
+namespace mufric::server {
+namespace {
+
+void log_line(const std::string& level, const std::string& message) {
+  std::fprintf(stderr, "%s level=%s msg=\"%s\"\n", utc_timestamp().c_str(), level.c_str(), message.c_str());
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+void run_server(const ServerOptions& options) {
+  if (!std::filesystem::is_directory(options.models_directory)) {
+    throw Error("--models: '" + options.models_directory + "' is not a directory");
+  }
+  // Signals are taken synchronously by one thread; every other thread, gRPC's included, has them blocked.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  ModelRegistry registry(options.models_directory, log_line);
+  registry.refresh();
+  FrictionService service(registry, {.max_points_per_request = options.max_points});
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  int bound_port = 0;
+  builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &bound_port);
+  builder.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
+  builder.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  if (!server || bound_port == 0) throw Error("--listen: cannot listen on '" + options.listen + "'");
+  const std::string host = options.listen.substr(0, options.listen.rfind(':'));
+  const std::string address = host + ":" + std::to_string(bound_port);
+  log_line("info", "mufric " + code_version() + " serving " + registry.names() + " on " + address + " (plaintext)");
+  if (!options.ready_file.empty()) std::ofstream(options.ready_file) << address << "\n";
+
+  std::mutex mutex;
+  std::condition_variable wake;
+  bool stopping = false;
+  std::thread poller([&] {
+    std::unique_lock lock(mutex);
+    while (!stopping) {
+      wake.wait_for(lock, std::chrono::duration<double>(options.poll_seconds));
+      if (stopping) break;
+      lock.unlock();
+      registry.refresh();
+      lock.lock();
+    }
+  });
+  while (true) {
+    int signal_number = 0;
+    sigwait(&signals, &signal_number);
+    if (signal_number == SIGHUP) {
+      log_line("info", "SIGHUP: reloading models");
+      registry.refresh();
+      continue;
+    }
+    log_line("info", std::string(signal_number == SIGTERM ? "SIGTERM" : "SIGINT") + ": draining");
+    break;
+  }
+  {
+    std::lock_guard lock(mutex);
+    stopping = true;
+  }
+  wake.notify_all();
+  poller.join();
+  server->Shutdown(std::chrono::system_clock::now() +
+                   std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                       std::chrono::duration<double>(options.drain_seconds)));
+  const auto& c = service.counters();
+  log_line("info", "stopped after " + std::to_string(c.requests.load()) + " requests, " + std::to_string(c.points.load()) +
+                       " points, " + std::to_string(c.errors.load()) + " errors");
+}
+
+}  // namespace mufric::server

@@ -1,0 +1,262 @@
+// Server and C++ client end to end on loopback: same answers as in-process, per-point statuses,
+// every malformed-request case, hot reload under load with zero failed requests, reconnection
+// after a server restart, and the standard health service.
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <thread>
+
+#include "client/friction_client.hpp"
+#include "common/error.hpp"
+#include "gp_test_data.hpp"
+#include "server/friction_service.hpp"
+#include "surrogate/empirical_laws.hpp"
+#include "surrogate/gp_training.hpp"
+#include "surrogate/model_file.hpp"
+
+namespace mufric {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A FrictionService on 127.0.0.1 with its own model directory.
+class LoopbackServer {
+ public:
+  explicit LoopbackServer(const fs::path& directory, int port = 0, long long max_points = 1'000'000)
+      : registry_(directory, [](const std::string&, const std::string&) {}), service_(registry_, {max_points}) {
+    registry_.refresh();
+    grpc::EnableDefaultHealthCheckService(true);
+    grpc::ServerBuilder builder;
+    builder.AddListeningPort("127.0.0.1:" + std::to_string(port), grpc::InsecureServerCredentials(), &port_);
+    builder.RegisterService(&service_);
+    server_ = builder.BuildAndStart();
+  }
+  ~LoopbackServer() { server_->Shutdown(); }
+  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  int port() const { return port_; }
+  server::ModelRegistry& registry() { return registry_; }
+
+ private:
+  server::ModelRegistry registry_;
+  server::FrictionService service_;
+  int port_ = 0;
+  std::unique_ptr<grpc::Server> server_;
+};
+
+class Service : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("mufric_service_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    GpTrainingOptions options;
+    options.optimise = false;
+    options.initial.signal_variance = 2.0;
+    options.initial.length_scales = Eigen::Vector3d(0.6, 0.7, 0.8);
+    options.initial.noise_variance = 1e-4;
+    save_model((dir_ / "gp.h5").string(), train_gaussian_process(test::smooth_training_set(200, 3), options));
+    save_model((dir_ / "coulomb.h5").string(), CoulombLaw(0.3));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+struct Points {
+  std::vector<double> p, v, t;
+  client::Block block() const { return {p.size(), p.data(), v.data(), t.data(), nullptr}; }
+};
+
+Points random_points(size_t n) {
+  const TrainingSet s = test::smooth_training_set(static_cast<Eigen::Index>(n), 21);
+  Points pts;
+  for (Eigen::Index i = 0; i < s.x.rows(); ++i) {
+    pts.p.push_back(s.x(i, 0));
+    pts.v.push_back(s.x(i, 1));
+    pts.t.push_back(s.x(i, 2));
+  }
+  return pts;
+}
+
+TEST_F(Service, GrpcAnswersEqualInProcessAnswersAcrossChunks) {
+  LoopbackServer server(dir_);
+  client::Options options;
+  options.chunk_points = 300;  // 1000 points → 4 calls
+  const auto remote = client::connect("grpc://" + server.address() + "/gp", options);
+  const auto local = client::connect("file://" + (dir_ / "gp.h5").string());
+  const Points pts = random_points(1000);
+  const EvaluationRequest what{.std = true, .ci_level = 0.95, .gradient = true};
+  const client::Answer a = remote->evaluate(pts.block(), what), b = local->evaluate(pts.block(), what);
+  ASSERT_EQ(a.mu.size(), 1000u);
+  EXPECT_EQ(a.mu, b.mu);
+  EXPECT_EQ(a.std, b.std);
+  EXPECT_EQ(a.lo, b.lo);
+  EXPECT_EQ(a.hi, b.hi);
+  EXPECT_EQ(a.gradient, b.gradient);
+  EXPECT_EQ(a.gradient_inputs, (std::vector<std::string>{"contact_pressure", "sliding_velocity", "temperature"}));
+  EXPECT_EQ(a.model, "gp");
+  EXPECT_EQ(a.version.size(), 16u);
+  EXPECT_EQ(remote->describe().inputs.size(), 3u);
+}
+
+TEST_F(Service, BadPointsGetTheirStatusAndNeverPoisonTheBlock) {
+  LoopbackServer server(dir_);
+  const auto remote = client::connect("grpc://" + server.address() + "/gp");
+  Points pts = random_points(4);
+  pts.p[1] = std::numeric_limits<double>::quiet_NaN();
+  pts.v[2] = -1.0;
+  pts.t[3] = 5000.0;  // outside the training box
+  const client::Answer a = remote->evaluate(pts.block(), {.std = true, .ci_level = 0.9});
+  EXPECT_EQ(a.status, (std::vector<PointStatus>{PointStatus::ok, PointStatus::invalid_input, PointStatus::invalid_input,
+                                                PointStatus::extrapolated}));
+  EXPECT_TRUE(std::isfinite(a.mu[0]) && std::isfinite(a.mu[3]));
+  EXPECT_TRUE(std::isnan(a.mu[1]) && std::isnan(a.std[2]) && std::isnan(a.lo[1]));
+}
+
+grpc::Status raw_evaluate(const std::string& address, const mufric::v1::EvaluateRequest& request) {
+  auto stub = mufric::v1::FrictionService::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  mufric::v1::EvaluateResponse response;
+  return stub->Evaluate(&context, request, &response);
+}
+
+TEST_F(Service, MalformedRequestsAreRefusedNamingTheProblem) {
+  LoopbackServer server(dir_, 0, 1000);
+  mufric::v1::EvaluateRequest request;
+  request.set_model("gp");
+  for (int i = 0; i < 3; ++i) request.add_contact_pressure(500e6);
+  for (int i = 0; i < 2; ++i) request.add_sliding_velocity(1.0);
+  for (int i = 0; i < 3; ++i) request.add_temperature(600.0);
+  grpc::Status s = raw_evaluate(server.address(), request);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(s.error_message().find("sliding_velocity has 2 values but contact_pressure has 3"), std::string::npos)
+      << s.error_message();
+
+  request.clear_sliding_velocity();
+  s = raw_evaluate(server.address(), request);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(s.error_message().find("sliding_velocity is empty"), std::string::npos) << s.error_message();
+
+  request.set_model("nope");
+  s = raw_evaluate(server.address(), request);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_NE(s.error_message().find("serving: coulomb, gp"), std::string::npos) << s.error_message();
+
+  mufric::v1::EvaluateRequest big;
+  big.set_model("coulomb");
+  for (int i = 0; i < 1001; ++i) {
+    big.add_contact_pressure(500e6);
+    big.add_sliding_velocity(1.0);
+    big.add_temperature(600.0);
+  }
+  s = raw_evaluate(server.address(), big);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(s.error_message().find("limit of 1000"), std::string::npos) << s.error_message();
+
+  big.set_ci_level(1.5);
+  s = raw_evaluate(server.address(), big);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(s.error_message().find("ci_level"), std::string::npos);
+}
+
+TEST_F(Service, HotReloadUnderLoadFailsNoRequestAndRefusesABadFile) {
+  LoopbackServer server(dir_);
+  const auto remote = client::connect("grpc://" + server.address() + "/coulomb");
+  const Points pts = random_points(64);
+  std::atomic<bool> done{false};
+  std::atomic<long long> calls{0}, failures{0};
+  std::vector<std::thread> load;
+  for (int t = 0; t < 4; ++t) {
+    load.emplace_back([&] {
+      const auto c = client::connect("grpc://" + server.address() + "/coulomb");
+      while (!done) {
+        try {
+          const auto a = c->evaluate(pts.block(), {});
+          if (a.mu.size() != 64 || !(a.mu[0] >= 0.3 && a.mu[0] <= 0.32)) ++failures;
+        } catch (const Error&) {
+          ++failures;
+        }
+        ++calls;
+      }
+    });
+  }
+  for (int k = 1; k <= 20; ++k) {
+    save_model((dir_ / "coulomb.h5").string(), CoulombLaw(0.3 + 0.001 * k));  // atomic rename
+    server.registry().refresh();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  { std::ofstream((dir_ / "coulomb.h5").string()) << "not a model any more"; }
+  server.registry().refresh();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  done = true;
+  for (auto& t : load) t.join();
+  EXPECT_GT(calls.load(), 50);
+  EXPECT_EQ(failures.load(), 0);
+  // The bad file was refused: the last good version (μ = 0.32) keeps serving.
+  EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.32);
+}
+
+TEST_F(Service, ClientReconnectsAfterTheServerRestarts) {
+  auto server = std::make_unique<LoopbackServer>(dir_);
+  const int port = server->port();
+  const auto remote = client::connect("grpc://127.0.0.1:" + std::to_string(port) + "/coulomb");
+  const Points pts = random_points(8);
+  EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.3);
+  server.reset();  // killed
+  std::thread restart([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    server = std::make_unique<LoopbackServer>(dir_, port);
+  });
+  // The call made while the server is down is retried with backoff until the new one is up.
+  double mu = 0.0;
+  std::string error;
+  try {
+    mu = remote->evaluate(pts.block(), {}).mu[0];
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  restart.join();
+  EXPECT_EQ(error, "");
+  EXPECT_DOUBLE_EQ(mu, 0.3);
+}
+
+TEST_F(Service, StandardHealthServiceAnswersServing) {
+  LoopbackServer server(dir_);
+  auto channel = grpc::CreateChannel(server.address(), grpc::InsecureChannelCredentials());
+  grpc::ClientContext context;
+  grpc::ByteBuffer response;
+  // grpc.health.v1.Health/Check with an empty HealthCheckRequest (service ""): SERVING is 08 01.
+  grpc::GenericStub stub(channel);
+  grpc::Slice empty_request("", 0);
+  grpc::ByteBuffer request(&empty_request, 1);
+  std::mutex m;
+  std::condition_variable cv;
+  bool finished = false;
+  grpc::Status status;
+  stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request, &response,
+                 [&](grpc::Status s) {
+                   std::lock_guard lock(m);
+                   status = s;
+                   finished = true;
+                   cv.notify_one();
+                 });
+  std::unique_lock lock(m);
+  cv.wait(lock, [&] { return finished; });
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::vector<grpc::Slice> slices;
+  ASSERT_TRUE(response.Dump(&slices).ok());
+  std::string bytes;
+  for (const auto& s : slices) bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  EXPECT_EQ(bytes, std::string("\x08\x01", 2));
+}
+
+}  // namespace
+}  // namespace mufric
