@@ -1,12 +1,14 @@
-# Compile options shared by every mufric target.
+# Compile options shared by every mufric target, per language.
 add_library(mufric_options INTERFACE)
 target_compile_options(mufric_options INTERFACE
-  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion -Wnon-virtual-dtor
-  -Wold-style-cast -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2)
+  $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion -Wnon-virtual-dtor
+  -Wold-style-cast -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2>
+  $<$<COMPILE_LANGUAGE:C>:-Wall -Wextra -Wpedantic>
+  $<$<COMPILE_LANGUAGE:Fortran>:-Wall>)
 if(MUFRIC_NATIVE)
   # GCC 12 reports false -Wmaybe-uninitialized inside its own AVX-512 intrinsics when Eigen
   # inlines them (GCC bug 105593); silenced for native builds only.
-  target_compile_options(mufric_options INTERFACE -march=native -Wno-maybe-uninitialized)
+  target_compile_options(mufric_options INTERFACE -march=native $<$<COMPILE_LANGUAGE:CXX>:-Wno-maybe-uninitialized>)
 endif()
 if(MUFRIC_SANITIZE)
   target_compile_options(mufric_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer

@@ -1,0 +1,70 @@
+! mufric for modern Fortran: ISO_C_BINDING interfaces to the C ABI (mufric.h). SI units throughout.
+!   use mufric
+!   type(c_ptr) :: client
+!   if (mufric_connect('grpc://127.0.0.1:50051/gp', client) /= MUFRIC_OK) print *, mufric_error()
+!   status = mufric_evaluate(client, n, p, v, t, c_null_ptr, 0.95d0, mu, c_null_ptr, lo, hi, c_null_ptr)
+module mufric
+  use, intrinsic :: iso_c_binding
+  implicit none
+  private
+  public :: mufric_connect, mufric_error, c_mufric_evaluate, c_mufric_close
+  integer(c_int), parameter, public :: MUFRIC_OK = 0, MUFRIC_INVALID_ARGUMENT = 1, MUFRIC_FAILED = 2
+  integer(c_int), parameter, public :: MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, &
+                                       MUFRIC_POINT_INVALID_INPUT = 2
+
+  interface
+    function c_mufric_open(uri, client) bind(C, name="mufric_open") result(status)
+      import :: c_char, c_ptr, c_int
+      character(kind=c_char), dimension(*), intent(in) :: uri
+      type(c_ptr), intent(out) :: client
+      integer(c_int) :: status
+    end function
+    subroutine c_mufric_close(client) bind(C, name="mufric_close")
+      import :: c_ptr
+      type(c_ptr), value :: client
+    end subroutine
+    ! Inputs and outputs not used: pass c_null_ptr; otherwise c_loc of arrays of length n.
+    function c_mufric_evaluate(client, n, contact_pressure, sliding_velocity, temperature, fibre_angle, &
+                               ci_level, mu, std, lo, hi, status) bind(C, name="mufric_evaluate") result(code)
+      import :: c_ptr, c_size_t, c_double, c_int
+      type(c_ptr), value :: client
+      integer(c_size_t), value :: n
+      type(c_ptr), value :: contact_pressure, sliding_velocity, temperature, fibre_angle
+      real(c_double), value :: ci_level
+      type(c_ptr), value :: mu, std, lo, hi, status
+      integer(c_int) :: code
+    end function
+    function c_mufric_last_error() bind(C, name="mufric_last_error") result(message)
+      import :: c_ptr
+      type(c_ptr) :: message
+    end function
+  end interface
+
+contains
+
+  ! Opens a model by URI (Fortran string, trailing blanks ignored).
+  function mufric_connect(uri, client) result(status)
+    character(len=*), intent(in) :: uri
+    type(c_ptr), intent(out) :: client
+    integer(c_int) :: status
+    status = c_mufric_open(trim(uri) // c_null_char, client)
+  end function
+
+  ! The last error message of this thread.
+  function mufric_error() result(message)
+    character(len=:), allocatable :: message
+    character(kind=c_char), pointer :: chars(:)
+    integer :: length
+    type(c_ptr) :: raw
+    raw = c_mufric_last_error()
+    call c_f_pointer(raw, chars, [4096])
+    length = 0
+    do while (length < 4096)
+      if (chars(length + 1) == c_null_char) exit
+      length = length + 1
+    end do
+    allocate(character(len=length) :: message)
+    message = transfer(chars(1:length), message)
+  end function
+
+end module mufric

@@ -1,0 +1,60 @@
+/* mufric C ABI: friction coefficients for meso-scale codes in C (and, through mufric.f90 and the
+ * F77 entry points below, Fortran). Opaque handles, integer status codes, a per-thread last-error
+ * message; no C++ exception crosses this interface. All quantities SI: Pa, m/s, K, rad.
+ *
+ *   mufric_client* c;
+ *   if (mufric_open("grpc://127.0.0.1:50051/gp", &c) != MUFRIC_OK) puts(mufric_last_error());
+ *   mufric_evaluate(c, n, p, v, T, NULL, 0.95, mu, NULL, lo, hi, status);
+ *   mufric_close(c);
+ */
+#ifndef MUFRIC_H
+#define MUFRIC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct mufric_client mufric_client;
+
+enum mufric_status_code {
+  MUFRIC_OK = 0,
+  MUFRIC_INVALID_ARGUMENT = 1, /* null handle or array, bad level, an input the model needs is NULL */
+  MUFRIC_FAILED = 2            /* model not found, server unreachable, file unreadable: see mufric_last_error */
+};
+
+enum mufric_point_status { MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, MUFRIC_POINT_INVALID_INPUT = 2 };
+
+/* uri: "grpc://host:port/model", "file:///path/model.h5" or a path. */
+int mufric_open(const char* uri, mufric_client** client);
+void mufric_close(mufric_client* client);
+
+/* n points. Inputs: NULL for inputs not sent (the model's own inputs are required). Outputs: NULL
+ * for outputs not wanted; lo/hi need ci_level in (0, 1), else pass 0. status: one
+ * mufric_point_status per point, or NULL. Invalid points get NaN outputs; the others are answered. */
+int mufric_evaluate(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
+                    const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
+                    double* lo, double* hi, int* status);
+
+/* The message of the last failure on this thread ("" if none). Valid until the next call. */
+const char* mufric_last_error(void);
+
+/* F77-style entry points (trailing underscore, every argument by reference, hidden string length
+ * last) for Fortran callers without modules, e.g. an Abaqus VFRICTION routine:
+ *   integer*8 handle; integer status
+ *   call mufric_open('file:///path/law.h5', handle, status)
+ *   call mufric_evaluate(handle, n, p, v, t, angle, mu, status)   ! all four input arrays, length n
+ *   call mufric_close(handle) */
+void mufric_open_(const char* uri, int64_t* handle, int32_t* status, size_t uri_length);
+void mufric_evaluate_(const int64_t* handle, const int32_t* n, const double* contact_pressure,
+                      const double* sliding_velocity, const double* temperature, const double* fibre_angle, double* mu,
+                      int32_t* status);
+void mufric_close_(const int64_t* handle);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MUFRIC_H */

@@ -1,0 +1,92 @@
+// The C ABI over the C++ client: every exception stops here and becomes a status code.
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <string>
+
+#include "client/friction_client.hpp"
+#include "client/mufric.h"
+
+struct mufric_client {
+  std::unique_ptr<mufric::client::FrictionClient> impl;
+};
+
+namespace {
+
+thread_local std::string last_error;
+
+int fail(int code, std::string message) {
+  last_error = std::move(message);
+  return code;
+}
+
+}  // namespace
+
+extern "C" {
+
+int mufric_open(const char* uri, mufric_client** client) {
+  if (uri == nullptr || client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_open: uri and client must not be NULL");
+  *client = nullptr;
+  try {
+    auto handle = std::make_unique<mufric_client>();
+    handle->impl = mufric::client::connect(uri);
+    handle->impl->describe();  // fail now, not at the first evaluation, if the model is not there
+    *client = handle.release();
+    last_error.clear();
+    return MUFRIC_OK;
+  } catch (const std::exception& e) {
+    return fail(MUFRIC_FAILED, std::string("mufric_open: ") + e.what());
+  }
+}
+
+void mufric_close(mufric_client* client) { delete client; }
+
+int mufric_evaluate(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
+                    const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
+                    double* lo, double* hi, int* status) {
+  if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: client is NULL");
+  if (mu == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: mu must not be NULL");
+  const bool want_interval = lo != nullptr || hi != nullptr;
+  if (want_interval && !(ci_level > 0.0 && ci_level < 1.0)) {
+    return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: lo/hi requested but ci_level is not in (0, 1)");
+  }
+  try {
+    const mufric::client::Block block{n, contact_pressure, sliding_velocity, temperature, fibre_angle};
+    const auto answer = client->impl->evaluate(
+        block, {.std = std != nullptr, .ci_level = want_interval ? ci_level : 0.0, .gradient = false});
+    for (size_t i = 0; i < n; ++i) {
+      mu[i] = answer.mu[i];
+      if (std) std[i] = answer.std[i];
+      if (lo) lo[i] = answer.lo[i];
+      if (hi) hi[i] = answer.hi[i];
+      if (status) status[i] = static_cast<int>(answer.status[i]);
+    }
+    last_error.clear();
+    return MUFRIC_OK;
+  } catch (const std::exception& e) {
+    const std::string message = e.what();
+    const bool missing_input = message.find("needs input") != std::string::npos;
+    return fail(missing_input ? MUFRIC_INVALID_ARGUMENT : MUFRIC_FAILED, "mufric_evaluate: " + message);
+  }
+}
+
+const char* mufric_last_error(void) { return last_error.c_str(); }
+
+void mufric_open_(const char* uri, int64_t* handle, int32_t* status, size_t uri_length) {
+  std::string text(uri, uri_length);
+  text.erase(text.find_last_not_of(' ') + 1);  // Fortran pads with blanks
+  mufric_client* client = nullptr;
+  *status = mufric_open(text.c_str(), &client);
+  *handle = reinterpret_cast<int64_t>(client);
+}
+
+void mufric_evaluate_(const int64_t* handle, const int32_t* n, const double* contact_pressure,
+                      const double* sliding_velocity, const double* temperature, const double* fibre_angle, double* mu,
+                      int32_t* status) {
+  *status = mufric_evaluate(reinterpret_cast<mufric_client*>(*handle), static_cast<size_t>(*n), contact_pressure,
+                            sliding_velocity, temperature, fibre_angle, 0.0, mu, nullptr, nullptr, nullptr, nullptr);
+}
+
+void mufric_close_(const int64_t* handle) { mufric_close(reinterpret_cast<mufric_client*>(*handle)); }
+
+}  // extern "C"
