@@ -135,6 +135,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
 grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
                                                     mufric::v1::EvaluateResponse* response) {
   ++counters_.requests;
+  ++counters_.in_flight;
   grpc::Status status;
   try {
     status = evaluate(*request, *response);
@@ -144,6 +145,7 @@ grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext*
   if (!status.ok()) ++counters_.errors;
   auto* reactor = context->DefaultReactor();
   reactor->Finish(status);
+  --counters_.in_flight;
   return reactor;
 }
 

@@ -34,6 +34,7 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
 
   struct Counters {
     std::atomic<long long> requests{0}, points{0}, errors{0};
+    std::atomic<int> in_flight{0};  // handlers running now; a drain waits for zero
   };
   const Counters& counters() const { return counters_; }
 

@@ -20,6 +20,9 @@
 namespace mufric::server {
 namespace {
 
+// After the last evaluation has finished, replies get this long to leave before connections close.
+constexpr int kReplyFlushMs = 200;
+
 void log_line(const std::string& level, const std::string& message) {
   std::fprintf(stderr, "%s level=%s msg=\"%s\"\n", utc_timestamp().c_str(), level.c_str(), message.c_str());
   std::fflush(stderr);
@@ -88,9 +91,14 @@ void run_server(const ServerOptions& options) {
   }
   wake.notify_all();
   poller.join();
-  server->Shutdown(std::chrono::system_clock::now() +
-                   std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                       std::chrono::duration<double>(options.drain_seconds)));
+  // Drain: wait (at most --drain) until no evaluation is running, then shut down with a short grace
+  // for the last replies to flush. Shutdown(deadline) alone would wait the whole deadline whenever
+  // a client keeps an idle channel open, which meso codes always do.
+  const auto drain_end = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.drain_seconds);
+  while (service.counters().in_flight.load() > 0 && std::chrono::steady_clock::now() < drain_end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  server->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(kReplyFlushMs));
   const auto& c = service.counters();
   log_line("info", "stopped after " + std::to_string(c.requests.load()) + " requests, " + std::to_string(c.points.load()) +
                        " points, " + std::to_string(c.errors.load()) + " errors");
