@@ -81,29 +81,14 @@ class GrpcClient final : public FrictionClient {
     const auto chunk = static_cast<size_t>(std::max<long long>(1, options_.chunk_points));
     for (size_t first = 0; first < block.points || first == 0; first += chunk) {
       const size_t count = std::min(chunk, block.points - first);
-      mufric::v1::EvaluateRequest request;
-      request.set_model(model_);
-      auto add = [&](const double* values, google::protobuf::RepeatedField<double>* field) {
-        if (values) field->Assign(values + first, values + first + count);
-      };
-      add(block.contact_pressure, request.mutable_contact_pressure());
-      add(block.sliding_velocity, request.mutable_sliding_velocity());
-      add(block.temperature, request.mutable_temperature());
-      add(block.fibre_angle, request.mutable_fibre_angle());
-      request.set_std(what.std);
-      request.set_ci_level(what.ci_level);
-      request.set_gradient(what.gradient);
+      const mufric::v1::EvaluateRequest request = make_request(block, first, count, what);
       mufric::v1::EvaluateResponse response;
-      call("Evaluate", [&](grpc::ClientContext* context) { return stub_->Evaluate(context, request, &response); });
-      answer.model = response.model();
-      answer.version = response.version();
-      answer.mu.insert(answer.mu.end(), response.mu().begin(), response.mu().end());
-      answer.std.insert(answer.std.end(), response.std().begin(), response.std().end());
-      answer.lo.insert(answer.lo.end(), response.lo().begin(), response.lo().end());
-      answer.hi.insert(answer.hi.end(), response.hi().begin(), response.hi().end());
-      answer.gradient.insert(answer.gradient.end(), response.gradient().begin(), response.gradient().end());
-      answer.gradient_inputs.assign(response.gradient_inputs().begin(), response.gradient_inputs().end());
-      for (const int s : response.status()) answer.status.push_back(static_cast<PointStatus>(s));
+      if (options_.streaming) {
+        exchange_on_stream(request, response);
+      } else {
+        call("Evaluate", [&](grpc::ClientContext* context) { return stub_->Evaluate(context, request, &response); });
+      }
+      append(response, answer);
       if (block.points == 0) break;
     }
     return answer;
@@ -153,8 +138,62 @@ class GrpcClient final : public FrictionClient {
     }
   }
 
+  mufric::v1::EvaluateRequest make_request(const Block& block, size_t first, size_t count,
+                                           const EvaluationRequest& what) const {
+    mufric::v1::EvaluateRequest request;
+    request.set_model(model_);
+    auto add = [&](const double* values, google::protobuf::RepeatedField<double>* field) {
+      if (values) field->Assign(values + first, values + first + count);
+    };
+    add(block.contact_pressure, request.mutable_contact_pressure());
+    add(block.sliding_velocity, request.mutable_sliding_velocity());
+    add(block.temperature, request.mutable_temperature());
+    add(block.fibre_angle, request.mutable_fibre_angle());
+    request.set_std(what.std);
+    request.set_ci_level(what.ci_level);
+    request.set_gradient(what.gradient);
+    return request;
+  }
+
+  static void append(const mufric::v1::EvaluateResponse& response, Answer& answer) {
+    answer.model = response.model();
+    answer.version = response.version();
+    answer.mu.insert(answer.mu.end(), response.mu().begin(), response.mu().end());
+    answer.std.insert(answer.std.end(), response.std().begin(), response.std().end());
+    answer.lo.insert(answer.lo.end(), response.lo().begin(), response.lo().end());
+    answer.hi.insert(answer.hi.end(), response.hi().begin(), response.hi().end());
+    answer.gradient.insert(answer.gradient.end(), response.gradient().begin(), response.gradient().end());
+    answer.gradient_inputs.assign(response.gradient_inputs().begin(), response.gradient_inputs().end());
+    for (const int s : response.status()) answer.status.push_back(static_cast<PointStatus>(s));
+  }
+
+  // One request, one response on the open stream; the stream is (re)opened as needed, and a stream
+  // that ends with UNAVAILABLE is retried with backoff like a unary call.
+  void exchange_on_stream(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
+    double backoff = options_.first_backoff_seconds;
+    for (int attempt = 0;; ++attempt) {
+      if (!stream_) {
+        stream_context_ = std::make_unique<grpc::ClientContext>();
+        stream_ = stub_->EvaluateStream(stream_context_.get());
+      }
+      if (stream_->Write(request) && stream_->Read(&response)) return;
+      const grpc::Status status = stream_->Finish();
+      stream_.reset();
+      stream_context_.reset();
+      if ((status.ok() || status.error_code() == grpc::StatusCode::UNAVAILABLE) && attempt < options_.retries) {
+        std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
+        backoff *= 2.0;
+        continue;
+      }
+      throw Error("EvaluateStream on model '" + model_ + "' failed (" + code_name(status.error_code()) +
+                  "): " + status.error_message());
+    }
+  }
+
   std::string model_;
   Options options_;
+  std::unique_ptr<grpc::ClientContext> stream_context_;
+  std::unique_ptr<grpc::ClientReaderWriter<mufric::v1::EvaluateRequest, mufric::v1::EvaluateResponse>> stream_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<mufric::v1::FrictionService::Stub> stub_;
 };

@@ -41,6 +41,9 @@ struct Options {
   double first_backoff_seconds = 0.05;
   long long chunk_points = 65536;   // larger blocks are split into several calls
   int max_message_mb = 64;
+  // Send blocks over one long-lived EvaluateStream (one block per increment) instead of one unary
+  // call each; a broken stream is reopened under the same retry policy. Streams carry no deadline.
+  bool streaming = false;
 };
 
 class FrictionClient {

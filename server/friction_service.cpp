@@ -132,21 +132,70 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   return grpc::Status::OK;
 }
 
-grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
-                                                    mufric::v1::EvaluateResponse* response) {
+grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
   ++counters_.requests;
-  ++counters_.in_flight;
   grpc::Status status;
   try {
-    status = evaluate(*request, *response);
+    status = evaluate(request, response);
   } catch (const std::exception& e) {
     status = grpc::Status(grpc::StatusCode::INTERNAL, std::string("evaluation failed: ") + e.what());
   }
   if (!status.ok()) ++counters_.errors;
+  return status;
+}
+
+grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
+                                                    mufric::v1::EvaluateResponse* response) {
+  ++counters_.in_flight;
+  const grpc::Status status = handle(*request, *response);
   auto* reactor = context->DefaultReactor();
   reactor->Finish(status);
   --counters_.in_flight;
   return reactor;
+}
+
+// Read a block, answer it, read the next: one response per request, in order.
+class FrictionService::StreamReactor final
+    : public grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse> {
+ public:
+  explicit StreamReactor(FrictionService& service) : service_(service) { StartRead(&request_); }
+
+  void OnReadDone(bool ok) override {
+    if (!ok) {  // the client closed its side: done
+      Finish(grpc::Status::OK);
+      return;
+    }
+    ++service_.counters_.in_flight;
+    response_.Clear();
+    const grpc::Status status = service_.handle(request_, response_);
+    if (status.ok()) {
+      StartWrite(&response_);
+    } else {
+      --service_.counters_.in_flight;
+      Finish(status);
+    }
+  }
+
+  void OnWriteDone(bool ok) override {
+    --service_.counters_.in_flight;
+    if (!ok) {
+      Finish(grpc::Status(grpc::StatusCode::CANCELLED, "the client went away"));
+      return;
+    }
+    StartRead(&request_);
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  FrictionService& service_;
+  EvaluateRequest request_;
+  mufric::v1::EvaluateResponse response_;
+};
+
+grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse>* FrictionService::EvaluateStream(
+    grpc::CallbackServerContext*) {
+  return new StreamReactor(*this);
 }
 
 grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContext* context,

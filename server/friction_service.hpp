@@ -26,6 +26,8 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
 
   grpc::ServerUnaryReactor* Evaluate(grpc::CallbackServerContext* context, const mufric::v1::EvaluateRequest* request,
                                      mufric::v1::EvaluateResponse* response) override;
+  grpc::ServerBidiReactor<mufric::v1::EvaluateRequest, mufric::v1::EvaluateResponse>* EvaluateStream(
+      grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* ListModels(grpc::CallbackServerContext* context, const mufric::v1::ListModelsRequest* request,
                                        mufric::v1::ListModelsResponse* response) override;
   grpc::ServerUnaryReactor* DescribeModel(grpc::CallbackServerContext* context,
@@ -39,6 +41,9 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   const Counters& counters() const { return counters_; }
 
  private:
+  class StreamReactor;
+  // Counts the request, evaluates it, counts an error; never throws.
+  grpc::Status handle(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
   grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
 
   const ModelRegistry& registry_;

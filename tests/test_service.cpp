@@ -107,6 +107,34 @@ TEST_F(Service, GrpcAnswersEqualInProcessAnswersAcrossChunks) {
   EXPECT_EQ(remote->describe().inputs.size(), 3u);
 }
 
+TEST_F(Service, StreamOfIncrementsAnswersLikeUnaryCallsAndSurvivesAnError) {
+  LoopbackServer server(dir_);
+  client::Options streaming;
+  streaming.streaming = true;
+  streaming.chunk_points = 100;
+  const auto stream = client::connect("grpc://" + server.address() + "/gp", streaming);
+  const auto unary = client::connect("grpc://" + server.address() + "/gp");
+  const EvaluationRequest what{.std = true, .ci_level = 0.95};
+  for (int increment = 0; increment < 5; ++increment) {  // a meso job: one block per increment
+    const Points pts = random_points(250 + static_cast<size_t>(increment));
+    const client::Answer a = stream->evaluate(pts.block(), what), b = unary->evaluate(pts.block(), what);
+    ASSERT_EQ(a.mu.size(), pts.p.size());
+    EXPECT_EQ(a.mu, b.mu);
+    EXPECT_EQ(a.hi, b.hi);
+  }
+  // A block without temperature ends that stream with INVALID_ARGUMENT; the next block reopens it.
+  Points bad = random_points(3);
+  client::Block missing = bad.block();
+  missing.temperature = nullptr;
+  try {
+    stream->evaluate(missing, {});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("INVALID_ARGUMENT"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(stream->evaluate(bad.block(), {}).mu.size(), 3u);
+}
+
 TEST_F(Service, BadPointsGetTheirStatusAndNeverPoisonTheBlock) {
   LoopbackServer server(dir_);
   const auto remote = client::connect("grpc://" + server.address() + "/gp");
