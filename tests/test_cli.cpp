@@ -135,7 +135,8 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   waitpid(pid, &status, 0);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
   std::ifstream log(path("serve.log"));
-  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  std::string text, line;
+  while (std::getline(log, line)) text += line + "\n";
   EXPECT_NE(text.find("SIGTERM: draining"), std::string::npos) << text;
 }
 
