@@ -20,7 +20,13 @@ void add_service_commands(CLI::App& app) {
       ->check(CLI::Range(1LL, 100'000'000LL));
   cmd->add_option("--drain", o->drain_seconds, "Seconds requests in flight get on SIGTERM")->capture_default_str();
   cmd->add_option("--ready-file", o->ready_file, "Write the bound address here once serving (for scripts)");
-  cmd->footer("Plaintext; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"
+  cmd->add_option("--token-file", o->token_file, "Require 'authorization: Bearer <token>' with the token in this file")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tls-cert", o->tls_cert, "PEM certificate chain: serve TLS")->check(CLI::ExistingFile);
+  cmd->add_option("--tls-key", o->tls_key, "PEM private key of --tls-cert")->check(CLI::ExistingFile);
+  cmd->add_option("--tls-client-ca", o->tls_client_ca, "PEM CA: mutual TLS, clients need a certificate it signed")
+      ->check(CLI::ExistingFile);
+  cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"
               "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
               "server reflection are on. Logs go to stderr, one line per event.");
   cmd->callback([o] { server::run_server(*o); });

@@ -3,6 +3,9 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <chrono>
 #include <thread>
 
@@ -59,10 +62,39 @@ class InProcessClient final : public FrictionClient {
   std::unique_ptr<FrictionModel> model_;
 };
 
+std::string setting(const std::string& value, const char* environment_variable) {
+  if (!value.empty()) return value;
+  const char* from_environment = std::getenv(environment_variable);
+  return from_environment ? from_environment : "";
+}
+
+std::string file_text(const std::string& path, const char* what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(std::string(what) + ": cannot read '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::shared_ptr<grpc::ChannelCredentials> channel_credentials(bool tls, const Options& options) {
+  if (!tls) return grpc::InsecureChannelCredentials();
+  grpc::SslCredentialsOptions ssl;
+  const std::string ca = setting(options.tls_ca_file, "MUFRIC_TLS_CA");
+  const std::string cert = setting(options.tls_cert_file, "MUFRIC_TLS_CERT");
+  const std::string key = setting(options.tls_key_file, "MUFRIC_TLS_KEY");
+  if (!ca.empty()) ssl.pem_root_certs = file_text(ca, "TLS CA (tls_ca_file / MUFRIC_TLS_CA)");
+  if (cert.empty() != key.empty()) throw Error("a TLS client certificate needs its key, and the key its certificate");
+  if (!cert.empty()) {
+    ssl.pem_cert_chain = file_text(cert, "TLS client certificate (tls_cert_file / MUFRIC_TLS_CERT)");
+    ssl.pem_private_key = file_text(key, "TLS client key (tls_key_file / MUFRIC_TLS_KEY)");
+  }
+  return grpc::SslCredentials(ssl);
+}
+
 class GrpcClient final : public FrictionClient {
  public:
-  GrpcClient(const std::string& target, std::string model, const Options& options)
-      : model_(std::move(model)), options_(options) {
+  GrpcClient(const std::string& target, std::string model, bool tls, const Options& options)
+      : model_(std::move(model)), options_(options), token_(setting(options.token, "MUFRIC_TOKEN")) {
     grpc::ChannelArguments arguments;
     arguments.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
     arguments.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
@@ -72,7 +104,7 @@ class GrpcClient final : public FrictionClient {
     arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, backoff_ms);
     arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, backoff_ms);
     arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, backoff_ms << options.retries);
-    channel_ = grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments);
+    channel_ = grpc::CreateCustomChannel(target, channel_credentials(tls, options), arguments);
     stub_ = mufric::v1::FrictionService::NewStub(channel_);
   }
 
@@ -111,6 +143,7 @@ class GrpcClient final : public FrictionClient {
     double backoff = options_.first_backoff_seconds;
     for (int attempt = 0;; ++attempt) {
       grpc::ClientContext context;
+      authorise(context);
       context.set_deadline(std::chrono::system_clock::now() +
                            std::chrono::duration_cast<std::chrono::system_clock::duration>(
                                std::chrono::duration<double>(options_.deadline_seconds)));
@@ -174,6 +207,7 @@ class GrpcClient final : public FrictionClient {
     for (int attempt = 0;; ++attempt) {
       if (!stream_) {
         stream_context_ = std::make_unique<grpc::ClientContext>();
+        authorise(*stream_context_);
         stream_ = stub_->EvaluateStream(stream_context_.get());
       }
       if (stream_->Write(request) && stream_->Read(&response)) return;
@@ -190,8 +224,13 @@ class GrpcClient final : public FrictionClient {
     }
   }
 
+  void authorise(grpc::ClientContext& context) const {
+    if (!token_.empty()) context.AddMetadata("authorization", "Bearer " + token_);
+  }
+
   std::string model_;
   Options options_;
+  std::string token_;
   std::unique_ptr<grpc::ClientContext> stream_context_;
   std::unique_ptr<grpc::ClientReaderWriter<mufric::v1::EvaluateRequest, mufric::v1::EvaluateResponse>> stream_;
   std::shared_ptr<grpc::Channel> channel_;
@@ -201,14 +240,14 @@ class GrpcClient final : public FrictionClient {
 }  // namespace
 
 std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options) {
-  const std::string grpc_scheme = "grpc://";
-  if (uri.rfind(grpc_scheme, 0) == 0) {
-    const std::string rest = uri.substr(grpc_scheme.size());
+  for (const std::string scheme : {"grpc://", "grpcs://"}) {
+    if (uri.rfind(scheme, 0) != 0) continue;
+    const std::string rest = uri.substr(scheme.size());
     const auto slash = rest.find('/');
     if (slash == std::string::npos || slash + 1 == rest.size()) {
-      throw Error("model URI '" + uri + "': expected grpc://host:port/model");
+      throw Error("model URI '" + uri + "': expected " + scheme + "host:port/model");
     }
-    return std::make_unique<GrpcClient>(rest.substr(0, slash), rest.substr(slash + 1), options);
+    return std::make_unique<GrpcClient>(rest.substr(0, slash), rest.substr(slash + 1), scheme == "grpcs://", options);
   }
   return std::make_unique<InProcessClient>(model_path_from_uri(uri));
 }

@@ -2,6 +2,7 @@
 // The meso-code side: one interface, two transports chosen by URI.
 //   grpc://host:port/model   a mufric server (channel reuse, deadlines, retry with backoff on
 //                            UNAVAILABLE, automatic chunking under the message limit)
+//   grpcs://host:port/model  the same over TLS (mutual TLS with a client certificate)
 //   file:///path/model.h5    the same model evaluated in-process, no server (or a plain path)
 #include <memory>
 #include <string>
@@ -44,6 +45,12 @@ struct Options {
   // Send blocks over one long-lived EvaluateStream (one block per increment) instead of one unary
   // call each; a broken stream is reopened under the same retry policy. Streams carry no deadline.
   bool streaming = false;
+  // Security; each empty field falls back to an environment variable, so C and Fortran callers
+  // configure it without code: MUFRIC_TOKEN, MUFRIC_TLS_CA, MUFRIC_TLS_CERT, MUFRIC_TLS_KEY.
+  std::string token;          // sent as "authorization: Bearer <token>"
+  std::string tls_ca_file;    // PEM roots to verify the server (grpcs://); empty: the system's
+  std::string tls_cert_file;  // PEM client certificate chain and key, for mutual TLS
+  std::string tls_key_file;
 };
 
 class FrictionClient {

@@ -11,7 +11,7 @@ packages=(
   # numerical core
   libeigen3-dev libsuitesparse-dev libnlopt-dev libnlopt-cxx-dev libboost-dev
   # files and command line
-  libhdf5-dev hdf5-tools nlohmann-json3-dev libcli11-dev libssl-dev
+  libhdf5-dev hdf5-tools nlohmann-json3-dev libcli11-dev libssl-dev openssl
   # the service: gRPC + Protobuf (C++ and Python), Fortran for the Fortran client
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc python3-grpcio python3-grpc-tools gfortran
   # LAPACK (Cholesky, inverse) from OpenBLAS

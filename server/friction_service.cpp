@@ -132,6 +132,16 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   return grpc::Status::OK;
 }
 
+grpc::Status FrictionService::authorise(const grpc::CallbackServerContext& context) const {
+  if (limits_.bearer_token.empty()) return grpc::Status::OK;
+  const auto& metadata = context.client_metadata();
+  const auto it = metadata.find("authorization");
+  if (it != metadata.end() && std::string(it->second.data(), it->second.size()) == "Bearer " + limits_.bearer_token) {
+    return grpc::Status::OK;
+  }
+  return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token (metadata 'authorization: Bearer ...')"};
+}
+
 grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
   ++counters_.requests;
   grpc::Status status;
@@ -147,7 +157,12 @@ grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1:
 grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
                                                     mufric::v1::EvaluateResponse* response) {
   ++counters_.in_flight;
-  const grpc::Status status = handle(*request, *response);
+  grpc::Status status = authorise(*context);
+  if (status.ok()) {
+    status = handle(*request, *response);
+  } else {
+    ++counters_.errors;
+  }
   auto* reactor = context->DefaultReactor();
   reactor->Finish(status);
   --counters_.in_flight;
@@ -158,7 +173,14 @@ grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext*
 class FrictionService::StreamReactor final
     : public grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse> {
  public:
-  explicit StreamReactor(FrictionService& service) : service_(service) { StartRead(&request_); }
+  StreamReactor(FrictionService& service, const grpc::Status& authorised) : service_(service) {
+    if (authorised.ok()) {
+      StartRead(&request_);
+    } else {
+      ++service_.counters_.errors;
+      Finish(authorised);
+    }
+  }
 
   void OnReadDone(bool ok) override {
     if (!ok) {  // the client closed its side: done
@@ -194,21 +216,26 @@ class FrictionService::StreamReactor final
 };
 
 grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse>* FrictionService::EvaluateStream(
-    grpc::CallbackServerContext*) {
-  return new StreamReactor(*this);
+    grpc::CallbackServerContext* context) {
+  return new StreamReactor(*this, authorise(*context));
 }
 
 grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContext* context,
                                                       const mufric::v1::ListModelsRequest*,
                                                       mufric::v1::ListModelsResponse* response) {
   ++counters_.requests;
+  auto* reactor = context->DefaultReactor();
+  if (grpc::Status status = authorise(*context); !status.ok()) {
+    ++counters_.errors;
+    reactor->Finish(status);
+    return reactor;
+  }
   for (const auto& served : registry_.all()) {
     auto* m = response->add_models();
     m->set_name(served->name);
     m->set_version(served->version);
     m->set_kind(std::string(served->model->kind()));
   }
-  auto* reactor = context->DefaultReactor();
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }
@@ -218,6 +245,11 @@ grpc::ServerUnaryReactor* FrictionService::DescribeModel(grpc::CallbackServerCon
                                                          mufric::v1::ModelDescription* response) {
   ++counters_.requests;
   auto* reactor = context->DefaultReactor();
+  if (grpc::Status status = authorise(*context); !status.ok()) {
+    ++counters_.errors;
+    reactor->Finish(status);
+    return reactor;
+  }
   const auto served = registry_.find(request->model());
   if (!served) {
     ++counters_.errors;

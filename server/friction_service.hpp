@@ -11,6 +11,9 @@ namespace mufric::server {
 
 struct ServiceLimits {
   long long max_points_per_request = 1'000'000;
+  // When set, every FrictionService call must carry "authorization: Bearer <token>" or gets
+  // UNAUTHENTICATED. Health and reflection stay open for probes.
+  std::string bearer_token;
 };
 
 // Copies the request's packed arrays into a batch in the model's input order. Unequal lengths or a
@@ -42,6 +45,7 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
 
  private:
   class StreamReactor;
+  grpc::Status authorise(const grpc::CallbackServerContext& context) const;
   // Counts the request, evaluates it, counts an error; never throws.
   grpc::Status handle(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
   grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "common/error.hpp"
@@ -30,6 +31,30 @@ void log_line(const std::string& level, const std::string& message) {
 
 }  // namespace
 
+std::string read_text_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(what + ": cannot read '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::shared_ptr<grpc::ServerCredentials> server_credentials(const ServerOptions& options) {
+  if (options.tls_cert.empty() != options.tls_key.empty()) throw Error("--tls-cert and --tls-key go together");
+  if (options.tls_cert.empty()) {
+    if (!options.tls_client_ca.empty()) throw Error("--tls-client-ca needs --tls-cert and --tls-key");
+    return grpc::InsecureServerCredentials();
+  }
+  grpc::SslServerCredentialsOptions ssl;
+  ssl.pem_key_cert_pairs.push_back(
+      {read_text_file(options.tls_key, "--tls-key"), read_text_file(options.tls_cert, "--tls-cert")});
+  if (!options.tls_client_ca.empty()) {
+    ssl.pem_root_certs = read_text_file(options.tls_client_ca, "--tls-client-ca");
+    ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  return grpc::SslServerCredentials(ssl);
+}
+
 void run_server(const ServerOptions& options) {
   if (!std::filesystem::is_directory(options.models_directory)) {
     throw Error("--models: '" + options.models_directory + "' is not a directory");
@@ -44,13 +69,19 @@ void run_server(const ServerOptions& options) {
 
   ModelRegistry registry(options.models_directory, log_line);
   registry.refresh();
-  FrictionService service(registry, {.max_points_per_request = options.max_points});
+  std::string token;
+  if (!options.token_file.empty()) {
+    token = read_text_file(options.token_file, "--token-file");
+    token.erase(token.find_last_not_of(" \t\r\n") + 1);
+    if (token.empty()) throw Error("--token-file: '" + options.token_file + "' is empty");
+  }
+  FrictionService service(registry, {.max_points_per_request = options.max_points, .bearer_token = token});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int bound_port = 0;
-  builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &bound_port);
+  builder.AddListeningPort(options.listen, server_credentials(options), &bound_port);
   builder.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
   builder.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
   builder.RegisterService(&service);
@@ -58,7 +89,11 @@ void run_server(const ServerOptions& options) {
   if (!server || bound_port == 0) throw Error("--listen: cannot listen on '" + options.listen + "'");
   const std::string host = options.listen.substr(0, options.listen.rfind(':'));
   const std::string address = host + ":" + std::to_string(bound_port);
-  log_line("info", "mufric " + code_version() + " serving " + registry.names() + " on " + address + " (plaintext)");
+  const std::string security = options.tls_cert.empty()           ? "plaintext"
+                               : options.tls_client_ca.empty()     ? "TLS"
+                                                                   : "mutual TLS";
+  log_line("info", "mufric " + code_version() + " serving " + registry.names() + " on " + address + " (" + security +
+                       (token.empty() ? "" : ", bearer token required") + ")");
   if (!options.ready_file.empty()) std::ofstream(options.ready_file) << address << "\n";
 
   std::mutex mutex;

@@ -1,7 +1,10 @@
 #pragma once
 // `mufric serve`: runs the FrictionService until SIGTERM/SIGINT (graceful drain), reloading models
 // on SIGHUP and whenever a file in the directory appears, changes or disappears.
+#include <memory>
 #include <string>
+
+#include <grpcpp/security/server_credentials.h>
 
 namespace mufric::server {
 
@@ -13,7 +16,15 @@ struct ServerOptions {
   long long max_points = 1'000'000;   // per request
   double drain_seconds = 5.0;         // requests in flight get this long on shutdown
   std::string ready_file;             // written with the bound address once serving (for scripts)
+  std::string token_file;             // bearer token required of every client (file, not argv)
+  std::string tls_cert, tls_key;      // PEM server certificate chain and key: TLS instead of plaintext
+  std::string tls_client_ca;          // PEM CA: mutual TLS, clients must present a certificate it signed
 };
+
+// Plaintext, TLS or mutual TLS from the options; throws Error naming an unreadable file.
+std::shared_ptr<grpc::ServerCredentials> server_credentials(const ServerOptions& options);
+// The whole content of a file; throws Error naming it (`what` says which option it came from).
+std::string read_text_file(const std::string& path, const std::string& what);
 
 // Blocks until a termination signal. Throws mufric::Error if the directory or address is unusable.
 void run_server(const ServerOptions& options);

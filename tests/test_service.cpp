@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <condition_variable>
 #include <fstream>
 #include <mutex>
@@ -19,6 +20,7 @@
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
 #include "server/friction_service.hpp"
+#include "server/server.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
@@ -31,12 +33,13 @@ namespace fs = std::filesystem;
 // A FrictionService on 127.0.0.1 with its own model directory.
 class LoopbackServer {
  public:
-  explicit LoopbackServer(const fs::path& directory, int port = 0, long long max_points = 1'000'000)
-      : registry_(directory, [](const std::string&, const std::string&) {}), service_(registry_, {max_points}) {
+  explicit LoopbackServer(const fs::path& directory, int port = 0, server::ServiceLimits limits = {},
+                          std::shared_ptr<grpc::ServerCredentials> credentials = grpc::InsecureServerCredentials())
+      : registry_(directory, [](const std::string&, const std::string&) {}), service_(registry_, std::move(limits)) {
     registry_.refresh();
     grpc::EnableDefaultHealthCheckService(true);
     grpc::ServerBuilder builder;
-    builder.AddListeningPort("127.0.0.1:" + std::to_string(port), grpc::InsecureServerCredentials(), &port_);
+    builder.AddListeningPort("127.0.0.1:" + std::to_string(port), credentials, &port_);
     builder.RegisterService(&service_);
     server_ = builder.BuildAndStart();
   }
@@ -157,7 +160,7 @@ grpc::Status raw_evaluate(const std::string& address, const mufric::v1::Evaluate
 }
 
 TEST_F(Service, MalformedRequestsAreRefusedNamingTheProblem) {
-  LoopbackServer server(dir_, 0, 1000);
+  LoopbackServer server(dir_, 0, {.max_points_per_request = 1000, .bearer_token = {}});
   mufric::v1::EvaluateRequest request;
   request.set_model("gp");
   for (int i = 0; i < 3; ++i) request.add_contact_pressure(500e6);
@@ -254,6 +257,61 @@ TEST_F(Service, ClientReconnectsAfterTheServerRestarts) {
   restart.join();
   EXPECT_EQ(error, "");
   EXPECT_DOUBLE_EQ(mu, 0.3);
+}
+
+TEST_F(Service, BearerTokenIsRequiredWhenConfigured) {
+  LoopbackServer server(dir_, 0, {.max_points_per_request = 1000000, .bearer_token = "s3cret"});
+  const Points pts = random_points(2);
+  client::Options without;
+  without.retries = 0;
+  try {
+    client::connect("grpc://" + server.address() + "/coulomb", without)->evaluate(pts.block(), {});
+    FAIL() << "expected UNAUTHENTICATED";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("UNAUTHENTICATED"), std::string::npos) << e.what();
+  }
+  client::Options with = without;
+  with.token = "s3cret";
+  EXPECT_DOUBLE_EQ(client::connect("grpc://" + server.address() + "/coulomb", with)->evaluate(pts.block(), {}).mu[0], 0.3);
+  with.streaming = true;
+  EXPECT_DOUBLE_EQ(client::connect("grpc://" + server.address() + "/coulomb", with)->evaluate(pts.block(), {}).mu[0], 0.3);
+}
+
+// A test CA, a server certificate for 127.0.0.1 and a client certificate, made with openssl.
+void make_certificates(const fs::path& d) {
+  const std::string dir = d.string();
+  const std::string key = " -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes ";
+  const std::string script =
+      "cd " + dir + " && openssl req -x509" + key + "-keyout ca.key -out ca.pem -days 1 -subj /CN=mufric-test-ca" +
+      " && openssl req" + key + "-keyout server.key -out server.csr -subj /CN=localhost" +
+      " && printf 'subjectAltName=IP:127.0.0.1,DNS:localhost' > san.ext" +
+      " && openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -out server.pem -days 1 -extfile san.ext" +
+      " && openssl req" + key + "-keyout client.key -out client.csr -subj /CN=meso-client" +
+      " && openssl x509 -req -in client.csr -CA ca.pem -CAkey ca.key -CAcreateserial -out client.pem -days 1";
+  ASSERT_EQ(std::system(("(" + script + ") >/dev/null 2>&1").c_str()), 0) << "openssl failed";
+}
+
+TEST_F(Service, TlsAndMutualTls) {
+  make_certificates(dir_);
+  const Points pts = random_points(2);
+  server::ServerOptions tls;
+  tls.tls_cert = (dir_ / "server.pem").string();
+  tls.tls_key = (dir_ / "server.key").string();
+  client::Options options;
+  options.retries = 0;
+  options.deadline_seconds = 5;
+  options.tls_ca_file = (dir_ / "ca.pem").string();
+  {
+    LoopbackServer server(dir_, 0, {}, server::server_credentials(tls));
+    EXPECT_DOUBLE_EQ(client::connect("grpcs://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}).mu[0], 0.3);
+    EXPECT_THROW(client::connect("grpc://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}), Error);
+  }
+  tls.tls_client_ca = (dir_ / "ca.pem").string();
+  LoopbackServer server(dir_, 0, {}, server::server_credentials(tls));
+  EXPECT_THROW(client::connect("grpcs://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}), Error);
+  options.tls_cert_file = (dir_ / "client.pem").string();
+  options.tls_key_file = (dir_ / "client.key").string();
+  EXPECT_DOUBLE_EQ(client::connect("grpcs://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}).mu[0], 0.3);
 }
 
 TEST_F(Service, StandardHealthServiceAnswersServing) {
