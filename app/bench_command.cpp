@@ -1,27 +1,88 @@
-// `mufric bench`: evaluation throughput and latency of a model, in-process.
+// `mufric bench`: throughput and latency of a model through the client interface, so the same
+// command measures a server (grpc://, grpcs://) and the in-process evaluator (file://).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "app/commands.hpp"
+#include "client/friction_client.hpp"
 #include "common/error.hpp"
-#include "surrogate/model_file.hpp"
 
 namespace mufric::app {
 namespace {
 
-QueryBatch random_points(const InputSpace& inputs, Eigen::Index count, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  QueryBatch x(count, static_cast<Eigen::Index>(inputs.size()));
-  for (Eigen::Index j = 0; j < x.cols(); ++j) {
-    const auto& input = inputs[static_cast<size_t>(j)];
-    for (Eigen::Index i = 0; i < count; ++i) x(i, j) = input.lo + unit(rng) * (input.hi - input.lo);
+// Points drawn uniformly in the model's box, one array per input, as a meso code holds them.
+struct RandomBlock {
+  std::vector<std::vector<double>> columns;
+  client::Block block;
+
+  RandomBlock(const InputSpace& inputs, size_t count, std::uint64_t seed) : columns(inputs.size()) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    block.points = count;
+    for (size_t j = 0; j < inputs.size(); ++j) {
+      for (size_t i = 0; i < count; ++i) columns[j].push_back(inputs[j].lo + unit(rng) * (inputs[j].hi - inputs[j].lo));
+      const double* data = columns[j].data();
+      const std::string& name = inputs[j].name;
+      if (name == "contact_pressure") block.contact_pressure = data;
+      if (name == "sliding_velocity") block.sliding_velocity = data;
+      if (name == "temperature") block.temperature = data;
+      if (name == "fibre_angle") block.fibre_angle = data;
+    }
   }
-  return x;
+};
+
+struct Measurement {
+  std::vector<double> latencies;  // seconds per call, all clients
+  long long errors = 0;
+  std::string first_error;
+  double wall_seconds = 0.0;
+};
+
+Measurement measure(const std::string& uri, const client::Options& options, long long batch, int clients,
+                    double seconds, const EvaluationRequest& what) {
+  Measurement m;
+  std::mutex mutex;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::thread> threads;
+  for (int c = 0; c < clients; ++c) {
+    threads.emplace_back([&, c] {
+      std::vector<double> local;
+      long long errors = 0;
+      std::string first_error;
+      try {
+        const auto client = client::connect(uri, options);
+        const RandomBlock points(client->describe().inputs, static_cast<size_t>(batch), 7 + static_cast<unsigned>(c));
+        client->evaluate(points.block, what);  // warm-up: connection, caches
+        while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < seconds ||
+               local.size() < 5) {
+          const auto t0 = std::chrono::steady_clock::now();
+          try {
+            client->evaluate(points.block, what);
+          } catch (const Error& e) {
+            if (errors++ == 0) first_error = e.what();
+          }
+          local.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        }
+      } catch (const Error& e) {
+        if (errors++ == 0) first_error = e.what();
+      }
+      std::lock_guard lock(mutex);
+      m.latencies.insert(m.latencies.end(), local.begin(), local.end());
+      m.errors += errors;
+      if (m.first_error.empty()) m.first_error = first_error;
+    });
+  }
+  for (auto& t : threads) t.join();
+  m.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::sort(m.latencies.begin(), m.latencies.end());
+  return m;
 }
 
 }  // namespace
@@ -30,53 +91,49 @@ void add_bench_command(CLI::App& app) {
   struct Options {
     std::string model;
     std::vector<long long> batches{1, 64, 1024, 16384};
+    int clients = 1;
     double seconds = 1.0;
     bool with_std = false;
+    bool streaming = false;
     bool json = false;
   };
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("bench", "Evaluation throughput and latency of a model (in-process)");
-  cmd->add_option("--model", o->model, "Model file or file:// URI")->required();
+  auto* cmd = app.add_subcommand("bench", "Throughput and latency of a model: in-process (file://) or a server (grpc://)");
+  cmd->add_option("--model", o->model, "file:///path/model.h5 (or a path), grpc://host:port/model")->required();
   cmd->add_option("--batch", o->batches, "Batch sizes (points per call)")->capture_default_str()->expected(1, 16);
-  cmd->add_option("--seconds", o->seconds, "Minimum measuring time per batch size")->capture_default_str()
-      ->check(CLI::Range(0.01, 600.0));
-  cmd->add_flag("--std", o->with_std, "Also compute the standard deviation (and a 95 % interval)");
+  cmd->add_option("--clients", o->clients, "Concurrent clients, each with its own connection")
+      ->capture_default_str()->check(CLI::Range(1, 1024));
+  cmd->add_option("--seconds", o->seconds, "Measuring time per batch size")->capture_default_str()
+      ->check(CLI::Range(0.01, 3600.0));
+  cmd->add_flag("--std", o->with_std, "Also the standard deviation and a 95 % interval");
+  cmd->add_flag("--stream", o->streaming, "grpc://: send blocks over one EvaluateStream per client");
   cmd->add_flag("--json", o->json, "One JSON object per batch size instead of a table");
   cmd->callback([o] {
-    const auto model = load_model(model_path_from_uri(o->model));
     const EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
-    if (!o->json) std::printf("%10s %12s %14s %12s %12s   (%s, %s)\n", "batch", "calls", "points/s", "p50 [us]", "p99 [us]",
-                              o->model.c_str(), o->with_std ? "mean+std" : "mean only");
+    client::Options options;
+    options.streaming = o->streaming;
+    if (!o->json) {
+      std::printf("%10s %10s %14s %12s %12s %8s   (%s, %s, %d client%s)\n", "batch", "calls", "points/s", "p50 [us]",
+                  "p99 [us]", "errors", o->model.c_str(), o->with_std ? "mean+std" : "mean only", o->clients,
+                  o->clients == 1 ? "" : "s");
+    }
     for (const long long batch : o->batches) {
       if (batch <= 0) throw Error("--batch: sizes must be positive");
-      const QueryBatch x = random_points(model->inputs(), batch, 7);
-      model->evaluate(x, what);  // warm-up: page in caches and the thread pool
-      std::vector<double> latencies;
-      const auto start = std::chrono::steady_clock::now();
-      double elapsed = 0.0;
-      double sink = 0.0;
-      while (elapsed < o->seconds || latencies.size() < 5) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const Evaluation e = model->evaluate(x, what);
-        const auto t1 = std::chrono::steady_clock::now();
-        sink += e.mu(0);
-        latencies.push_back(std::chrono::duration<double>(t1 - t0).count());
-        elapsed = std::chrono::duration<double>(t1 - start).count();
-      }
-      std::sort(latencies.begin(), latencies.end());
-      double total = 0.0;
-      for (double l : latencies) total += l;
-      const double p50 = latencies[latencies.size() / 2];
-      const double p99 = latencies[std::min(latencies.size() - 1, latencies.size() * 99 / 100)];
-      const double points_per_second = static_cast<double>(batch) * static_cast<double>(latencies.size()) / total;
+      const Measurement m = measure(o->model, options, batch, o->clients, o->seconds, what);
+      if (m.latencies.empty()) throw Error("bench: no call succeeded: " + m.first_error);
+      const double p50 = m.latencies[m.latencies.size() / 2];
+      const double p99 = m.latencies[std::min(m.latencies.size() - 1, m.latencies.size() * 99 / 100)];
+      const double points_per_second = static_cast<double>(batch) * static_cast<double>(m.latencies.size()) / m.wall_seconds;
       if (o->json) {
-        std::printf("{\"batch\": %lld, \"calls\": %zu, \"points_per_second\": %.6g, \"p50_us\": %.4g, \"p99_us\": %.4g, "
-                    "\"std\": %s}\n",
-                    batch, latencies.size(), points_per_second, 1e6 * p50, 1e6 * p99, o->with_std ? "true" : "false");
+        std::printf("{\"batch\": %lld, \"clients\": %d, \"calls\": %zu, \"points_per_second\": %.6g, \"p50_us\": %.4g, "
+                    "\"p99_us\": %.4g, \"errors\": %lld, \"std\": %s}\n",
+                    batch, o->clients, m.latencies.size(), points_per_second, 1e6 * p50, 1e6 * p99, m.errors,
+                    o->with_std ? "true" : "false");
       } else {
-        std::printf("%10lld %12zu %14.4g %12.4g %12.4g\n", batch, latencies.size(), points_per_second, 1e6 * p50, 1e6 * p99);
+        std::printf("%10lld %10zu %14.4g %12.4g %12.4g %8lld\n", batch, m.latencies.size(), points_per_second, 1e6 * p50,
+                    1e6 * p99, m.errors);
       }
-      if (sink == 12345.678) std::printf(" ");  // keeps the evaluations observable to the optimiser
+      if (m.errors > 0) std::fprintf(stderr, "bench: %lld failed calls, first: %s\n", m.errors, m.first_error.c_str());
     }
   });
 }
