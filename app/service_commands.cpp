@@ -1,12 +1,36 @@
 // serve: the gRPC friction service.
+#include <cstdio>
 #include <memory>
 
 #include "app/commands.hpp"
+#include "client/friction_client.hpp"
 #include "server/server.hpp"
 
 namespace mufric::app {
 
+void add_status_command(CLI::App& app) {
+  auto uri = std::make_shared<std::string>();
+  auto* cmd = app.add_subcommand("status", "Counters and latency histogram of a running server");
+  cmd->add_option("server", *uri, "grpc://host:port (or grpcs://; token and certificates from MUFRIC_* variables)")
+      ->required();
+  cmd->callback([uri] {
+    const client::ServerStatus s = client::server_status(*uri);
+    std::printf("mufric %s, up %.1f s: %lld requests, %lld points, %lld errors, %lld in flight\n", s.code_version.c_str(),
+                s.uptime_seconds, s.requests, s.points, s.errors, s.in_flight);
+    std::printf("server-side evaluation time:\n");
+    for (size_t i = 0; i < s.latency_counts.size(); ++i) {
+      if (i < s.latency_bounds_us.size()) {
+        std::printf("  <= %8.0f us  %lld\n", s.latency_bounds_us[i], s.latency_counts[i]);
+      } else {
+        std::printf("  >  %8.0f us  %lld\n", s.latency_bounds_us.back(), s.latency_counts[i]);
+      }
+    }
+    for (const auto& m : s.models) std::printf("model %s\n", m.c_str());
+  });
+}
+
 void add_service_commands(CLI::App& app) {
+  add_status_command(app);
   auto o = std::make_shared<server::ServerOptions>();
   auto* cmd = app.add_subcommand("serve", "Serve every model file (*.h5) of a directory over gRPC");
   cmd->add_option("--models", o->models_directory, "Directory of model files; the name of a model is its file stem")

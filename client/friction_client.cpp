@@ -239,6 +239,27 @@ class GrpcClient final : public FrictionClient {
 
 }  // namespace
 
+ServerStatus server_status(const std::string& uri, const Options& options) {
+  const bool tls = uri.rfind("grpcs://", 0) == 0;
+  if (!tls && uri.rfind("grpc://", 0) != 0) throw Error("server URI '" + uri + "': expected grpc://host:port");
+  std::string target = uri.substr(tls ? 8 : 7);
+  target = target.substr(0, target.find('/'));
+  auto stub = mufric::v1::FrictionService::NewStub(grpc::CreateChannel(target, channel_credentials(tls, options)));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  const std::string token = setting(options.token, "MUFRIC_TOKEN");
+  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+  mufric::v1::ServerStatus s;
+  const grpc::Status status = stub->GetServerStatus(&context, mufric::v1::ServerStatusRequest(), &s);
+  if (!status.ok()) throw Error("GetServerStatus on " + target + " failed: " + status.error_message());
+  ServerStatus out{s.code_version(), s.uptime_seconds(), static_cast<long long>(s.requests()),
+                   static_cast<long long>(s.points()), static_cast<long long>(s.errors()),
+                   static_cast<long long>(s.in_flight()), {s.latency_bounds_us().begin(), s.latency_bounds_us().end()},
+                   {s.latency_counts().begin(), s.latency_counts().end()}, {}};
+  for (const auto& m : s.models()) out.models.push_back(m.name() + " " + m.version() + " " + m.kind());
+  return out;
+}
+
 std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options) {
   for (const std::string scheme : {"grpc://", "grpcs://"}) {
     if (uri.rfind(scheme, 0) != 0) continue;

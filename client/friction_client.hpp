@@ -63,4 +63,16 @@ class FrictionClient {
 
 std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options = {});
 
+struct ServerStatus {
+  std::string code_version;
+  double uptime_seconds = 0.0;
+  long long requests = 0, points = 0, errors = 0, in_flight = 0;
+  std::vector<double> latency_bounds_us;  // histogram of server-side evaluation time
+  std::vector<long long> latency_counts;  // one more than bounds: the last is unbounded
+  std::vector<std::string> models;        // "name version kind"
+};
+
+// Counters of a server: "grpc://host:port" or "grpcs://host:port" (a model path is ignored).
+ServerStatus server_status(const std::string& uri, const Options& options = {});
+
 }  // namespace mufric::client

@@ -1,8 +1,10 @@
 #include "server/friction_service.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
+#include "common/version.hpp"
 #include "surrogate/gaussian_process.hpp"
 
 namespace mufric::server {
@@ -144,6 +146,7 @@ grpc::Status FrictionService::authorise(const grpc::CallbackServerContext& conte
 
 grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
   ++counters_.requests;
+  const auto start = std::chrono::steady_clock::now();
   grpc::Status status;
   try {
     status = evaluate(request, response);
@@ -151,6 +154,9 @@ grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1:
     status = grpc::Status(grpc::StatusCode::INTERNAL, std::string("evaluation failed: ") + e.what());
   }
   if (!status.ok()) ++counters_.errors;
+  const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  const auto bucket = std::lower_bound(kLatencyBoundsUs.begin(), kLatencyBoundsUs.end(), us) - kLatencyBoundsUs.begin();
+  ++counters_.latency[static_cast<size_t>(bucket)];
   return status;
 }
 
@@ -230,6 +236,32 @@ grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContex
     reactor->Finish(status);
     return reactor;
   }
+  for (const auto& served : registry_.all()) {
+    auto* m = response->add_models();
+    m->set_name(served->name);
+    m->set_version(served->version);
+    m->set_kind(std::string(served->model->kind()));
+  }
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerContext* context,
+                                                           const mufric::v1::ServerStatusRequest*,
+                                                           mufric::v1::ServerStatus* response) {
+  auto* reactor = context->DefaultReactor();
+  if (grpc::Status status = authorise(*context); !status.ok()) {
+    reactor->Finish(status);
+    return reactor;
+  }
+  response->set_code_version(code_version());
+  response->set_uptime_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count());
+  response->set_requests(static_cast<uint64_t>(counters_.requests.load()));
+  response->set_points(static_cast<uint64_t>(counters_.points.load()));
+  response->set_errors(static_cast<uint64_t>(counters_.errors.load()));
+  response->set_in_flight(static_cast<uint64_t>(counters_.in_flight.load()));
+  for (const double bound : kLatencyBoundsUs) response->add_latency_bounds_us(bound);
+  for (const auto& count : counters_.latency) response->add_latency_counts(static_cast<uint64_t>(count.load()));
   for (const auto& served : registry_.all()) {
     auto* m = response->add_models();
     m->set_name(served->name);

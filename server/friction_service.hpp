@@ -1,6 +1,8 @@
 #pragma once
 // The gRPC FrictionService (callback API) over a ModelRegistry.
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -33,13 +35,19 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
       grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* ListModels(grpc::CallbackServerContext* context, const mufric::v1::ListModelsRequest* request,
                                        mufric::v1::ListModelsResponse* response) override;
+  grpc::ServerUnaryReactor* GetServerStatus(grpc::CallbackServerContext* context,
+                                            const mufric::v1::ServerStatusRequest* request,
+                                            mufric::v1::ServerStatus* response) override;
   grpc::ServerUnaryReactor* DescribeModel(grpc::CallbackServerContext* context,
                                           const mufric::v1::DescribeModelRequest* request,
                                           mufric::v1::ModelDescription* response) override;
 
+  // Upper bounds (µs) of the latency histogram's buckets; one more bucket holds the rest.
+  static constexpr std::array<double, 12> kLatencyBoundsUs{10, 20, 50, 100, 200, 500, 1e3, 2e3, 5e3, 1e4, 1e5, 1e6};
   struct Counters {
     std::atomic<long long> requests{0}, points{0}, errors{0};
     std::atomic<int> in_flight{0};  // handlers running now; a drain waits for zero
+    std::array<std::atomic<long long>, kLatencyBoundsUs.size() + 1> latency{};
   };
   const Counters& counters() const { return counters_; }
 
@@ -53,6 +61,7 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   const ModelRegistry& registry_;
   ServiceLimits limits_;
   Counters counters_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace mufric::server

@@ -314,6 +314,25 @@ TEST_F(Service, TlsAndMutualTls) {
   EXPECT_DOUBLE_EQ(client::connect("grpcs://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}).mu[0], 0.3);
 }
 
+TEST_F(Service, StatusCountsRequestsPointsErrorsAndLatencies) {
+  LoopbackServer server(dir_);
+  const auto remote = client::connect("grpc://" + server.address() + "/coulomb");
+  const Points pts = random_points(10);
+  for (int i = 0; i < 3; ++i) remote->evaluate(pts.block(), {});
+  client::Options quick;
+  quick.retries = 0;
+  EXPECT_THROW(client::connect("grpc://" + server.address() + "/nope", quick)->evaluate(pts.block(), {}), Error);
+  const client::ServerStatus s = client::server_status("grpc://" + server.address());
+  // Three Evaluate calls of 10 points answered, one for an unknown model refused (NOT_FOUND).
+  EXPECT_EQ(s.points, 30);
+  EXPECT_GE(s.errors, 1);
+  long long evaluations = 0;
+  for (const long long c : s.latency_counts) evaluations += c;
+  EXPECT_EQ(evaluations, 4);  // three answered, one NOT_FOUND
+  EXPECT_EQ(s.latency_counts.size(), s.latency_bounds_us.size() + 1);
+  EXPECT_EQ(s.models.size(), 2u);
+}
+
 TEST_F(Service, StandardHealthServiceAnswersServing) {
   LoopbackServer server(dir_);
   auto channel = grpc::CreateChannel(server.address(), grpc::InsecureChannelCredentials());
