@@ -85,6 +85,40 @@ Measurement measure(const std::string& uri, const client::Options& options, long
   return m;
 }
 
+// Meso-trace replay: `points` contact points whose states drift by a random walk of 0.5 % of the
+// box width per increment (reflected at the box walls), one evaluate() per increment.
+Measurement replay(const std::string& uri, const client::Options& options, long long points, long long increments,
+                   const EvaluationRequest& what) {
+  constexpr double kDriftPerIncrement = 0.005;
+  Measurement m;
+  const auto client = client::connect(uri, options);
+  const InputSpace inputs = client->describe().inputs;
+  RandomBlock state(inputs, static_cast<size_t>(points), 11);
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> step(0.0, kDriftPerIncrement);
+  const auto start = std::chrono::steady_clock::now();
+  for (long long k = 0; k < increments; ++k) {
+    for (size_t j = 0; j < inputs.size(); ++j) {
+      const double width = inputs[j].hi - inputs[j].lo;
+      for (double& x : state.columns[j]) {
+        x += width * step(rng);
+        if (x < inputs[j].lo) x = 2 * inputs[j].lo - x;
+        if (x > inputs[j].hi) x = 2 * inputs[j].hi - x;
+      }
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      client->evaluate(state.block, what);
+    } catch (const Error& e) {
+      if (m.errors++ == 0) m.first_error = e.what();
+    }
+    m.latencies.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  m.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::sort(m.latencies.begin(), m.latencies.end());
+  return m;
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -96,6 +130,7 @@ void add_bench_command(CLI::App& app) {
     bool with_std = false;
     bool streaming = false;
     bool json = false;
+    std::vector<long long> replay;  // points, increments
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "Throughput and latency of a model: in-process (file://) or a server (grpc://)");
@@ -108,10 +143,31 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--std", o->with_std, "Also the standard deviation and a 95 % interval");
   cmd->add_flag("--stream", o->streaming, "grpc://: send blocks over one EvaluateStream per client");
   cmd->add_flag("--json", o->json, "One JSON object per batch size instead of a table");
+  cmd->add_option("--replay", o->replay,
+                  "Meso-trace replay instead of fixed batches: POINTS,INCREMENTS contact points drifting over "
+                  "increments, one call per increment")
+      ->delimiter(',')->expected(2);
   cmd->callback([o] {
     const EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
     client::Options options;
     options.streaming = o->streaming;
+    if (!o->replay.empty()) {
+      if (o->replay[0] <= 0 || o->replay[1] <= 0) throw Error("--replay: POINTS and INCREMENTS must be positive");
+      const Measurement m = replay(o->model, options, o->replay[0], o->replay[1], what);
+      const double p50 = m.latencies[m.latencies.size() / 2];
+      const double p99 = m.latencies[std::min(m.latencies.size() - 1, m.latencies.size() * 99 / 100)];
+      const double rate = static_cast<double>(o->replay[0] * o->replay[1]) / m.wall_seconds;
+      if (o->json) {
+        std::printf("{\"replay_points\": %lld, \"increments\": %lld, \"seconds\": %.4g, \"points_per_second\": %.6g, "
+                    "\"p50_us\": %.4g, \"p99_us\": %.4g, \"errors\": %lld}\n",
+                    o->replay[0], o->replay[1], m.wall_seconds, rate, 1e6 * p50, 1e6 * p99, m.errors);
+      } else {
+        std::printf("replay %lld points x %lld increments on %s: %.3g s, %.4g points/s, per increment p50 %.4g us, "
+                    "p99 %.4g us, %lld errors\n",
+                    o->replay[0], o->replay[1], o->model.c_str(), m.wall_seconds, rate, 1e6 * p50, 1e6 * p99, m.errors);
+      }
+      return;
+    }
     if (!o->json) {
       std::printf("%10s %10s %14s %12s %12s %8s   (%s, %s, %d client%s)\n", "batch", "calls", "points/s", "p50 [us]",
                   "p99 [us]", "errors", o->model.c_str(), o->with_std ? "mean+std" : "mean only", o->clients,

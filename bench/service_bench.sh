@@ -2,7 +2,8 @@
 # The friction service against the in-process evaluator, same model, same run (issue 3):
 #   1. batch sizes 1, 64, 1024, 4096, 16384, mean only and with a 95 % interval: in-process (file://),
 #      unary gRPC and EvaluateStream over loopback, one client;
-#   2. soak: 32 concurrent clients for 60 s (batch 64, with interval), errors counted, server
+#   2. a meso-trace replay (2000 points drifting over 300 increments) on the three transports;
+#   3. soak: 32 concurrent clients for 60 s (batch 64, with interval), errors counted, server
 #      resident memory sampled every 10 s.
 # Usage: bash bench/service_bench.sh [build-dir] [model.h5]   (default: a GP fitted to 900 points)
 set -euo pipefail
@@ -47,6 +48,12 @@ for l, u, s in zip(*rows):
           f"{s['points_per_second']:.4g} | {s['points_per_second'] / l['points_per_second']:.0%} | {s['p50_us']:.4g} |")
 PY
 done
+echo; echo "== meso-trace replay: 2000 contact points x 300 increments, drifting states, mean + 95 % interval"
+for uri in "$work/models/gp.h5" "grpc://$address/gp"; do
+  "$mufric" bench --model "$uri" --replay 2000,300 --std
+done
+"$mufric" bench --model "grpc://$address/gp" --replay 2000,300 --std --stream | sed 's/$/ (stream)/'
+
 echo; echo "== soak: 32 clients x 60 s, batch 64, mean + 95 % interval"
 rss() { awk '/VmRSS/ {print $2 " kB"}' /proc/$server/status; }
 echo "server RSS before: $(rss)"
