@@ -22,6 +22,16 @@ const google::protobuf::RepeatedField<double>* input_array(const EvaluateRequest
 
 constexpr const char* kWireInputs[] = {"contact_pressure", "sliding_velocity", "temperature", "fibre_angle"};
 
+void add_model_summaries(const ModelRegistry& registry,
+                         google::protobuf::RepeatedPtrField<mufric::v1::ModelSummary>& summaries) {
+  for (const auto& served : registry.all()) {
+    auto* m = summaries.Add();
+    m->set_name(served->name);
+    m->set_version(served->version);
+    m->set_kind(std::string(served->model->kind()));
+  }
+}
+
 }  // namespace
 
 grpc::Status batch_from_request(const EvaluateRequest& request, const InputSpace& inputs, long long max_points,
@@ -144,6 +154,15 @@ grpc::Status FrictionService::authorise(const grpc::CallbackServerContext& conte
   return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token (metadata 'authorization: Bearer ...')"};
 }
 
+grpc::ServerUnaryReactor* FrictionService::refuse_unless_authorised(grpc::CallbackServerContext* context) {
+  grpc::Status status = authorise(*context);
+  if (status.ok()) return nullptr;
+  ++counters_.errors;
+  auto* reactor = context->DefaultReactor();
+  reactor->Finish(status);
+  return reactor;
+}
+
 grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
   ++counters_.requests;
   const auto start = std::chrono::steady_clock::now();
@@ -230,18 +249,9 @@ grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContex
                                                       const mufric::v1::ListModelsRequest*,
                                                       mufric::v1::ListModelsResponse* response) {
   ++counters_.requests;
+  if (auto* refusal = refuse_unless_authorised(context)) return refusal;
   auto* reactor = context->DefaultReactor();
-  if (grpc::Status status = authorise(*context); !status.ok()) {
-    ++counters_.errors;
-    reactor->Finish(status);
-    return reactor;
-  }
-  for (const auto& served : registry_.all()) {
-    auto* m = response->add_models();
-    m->set_name(served->name);
-    m->set_version(served->version);
-    m->set_kind(std::string(served->model->kind()));
-  }
+  add_model_summaries(registry_, *response->mutable_models());
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }
@@ -249,11 +259,8 @@ grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContex
 grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerContext* context,
                                                            const mufric::v1::ServerStatusRequest*,
                                                            mufric::v1::ServerStatus* response) {
+  if (auto* refusal = refuse_unless_authorised(context)) return refusal;
   auto* reactor = context->DefaultReactor();
-  if (grpc::Status status = authorise(*context); !status.ok()) {
-    reactor->Finish(status);
-    return reactor;
-  }
   response->set_code_version(code_version());
   response->set_uptime_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count());
   response->set_requests(static_cast<uint64_t>(counters_.requests.load()));
@@ -262,12 +269,7 @@ grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerC
   response->set_in_flight(static_cast<uint64_t>(counters_.in_flight.load()));
   for (const double bound : kLatencyBoundsUs) response->add_latency_bounds_us(bound);
   for (const auto& count : counters_.latency) response->add_latency_counts(static_cast<uint64_t>(count.load()));
-  for (const auto& served : registry_.all()) {
-    auto* m = response->add_models();
-    m->set_name(served->name);
-    m->set_version(served->version);
-    m->set_kind(std::string(served->model->kind()));
-  }
+  add_model_summaries(registry_, *response->mutable_models());
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }
@@ -276,12 +278,8 @@ grpc::ServerUnaryReactor* FrictionService::DescribeModel(grpc::CallbackServerCon
                                                          const mufric::v1::DescribeModelRequest* request,
                                                          mufric::v1::ModelDescription* response) {
   ++counters_.requests;
+  if (auto* refusal = refuse_unless_authorised(context)) return refusal;
   auto* reactor = context->DefaultReactor();
-  if (grpc::Status status = authorise(*context); !status.ok()) {
-    ++counters_.errors;
-    reactor->Finish(status);
-    return reactor;
-  }
   const auto served = registry_.find(request->model());
   if (!served) {
     ++counters_.errors;

@@ -54,6 +54,8 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
  private:
   class StreamReactor;
   grpc::Status authorise(const grpc::CallbackServerContext& context) const;
+  // A reactor already finished with UNAUTHENTICATED, or nullptr when the call may proceed.
+  grpc::ServerUnaryReactor* refuse_unless_authorised(grpc::CallbackServerContext* context);
   // Counts the request, evaluates it, counts an error; never throws.
   grpc::Status handle(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
   grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
