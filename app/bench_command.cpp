@@ -28,12 +28,7 @@ struct RandomBlock {
     block.points = count;
     for (size_t j = 0; j < inputs.size(); ++j) {
       for (size_t i = 0; i < count; ++i) columns[j].push_back(inputs[j].lo + unit(rng) * (inputs[j].hi - inputs[j].lo));
-      const double* data = columns[j].data();
-      const std::string& name = inputs[j].name;
-      if (name == "contact_pressure") block.contact_pressure = data;
-      if (name == "sliding_velocity") block.sliding_velocity = data;
-      if (name == "temperature") block.temperature = data;
-      if (name == "fibre_angle") block.fibre_angle = data;
+      if (const auto field = client::Block::field_for(inputs[j].name)) block.*field = columns[j].data();
     }
   }
 };

@@ -163,12 +163,7 @@ void add_predict(CLI::App& app) {
       if (text.empty()) throw Error(flag_it->second + " is required: the model's input " + inputs[j].name + " (e.g. " +
                                     flag_it->second + " " + std::string(example_quantity(inputs[j].kind())) + ")");
       values[j] = parse_quantity(text, inputs[j].kind(), flag_it->second);
-      const std::string& name = inputs[j].name;
-      const double* value = &values[j];
-      if (name == "contact_pressure") block.contact_pressure = value;
-      if (name == "sliding_velocity") block.sliding_velocity = value;
-      if (name == "temperature") block.temperature = value;
-      if (name == "fibre_angle") block.fibre_angle = value;
+      if (const auto field = client::Block::field_for(inputs[j].name)) block.*field = &values[j];
     }
     for (const auto& [input, flag] : kInputFlags) {
       const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
+#include <optional>
 #include <chrono>
 #include <thread>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "mufric/v1/friction.grpc.pb.h"
 #include "surrogate/gaussian_process.hpp"
 #include "surrogate/model_file.hpp"
@@ -18,11 +18,8 @@ namespace mufric::client {
 namespace {
 
 const double* input_pointer(const Block& block, const std::string& name) {
-  if (name == "contact_pressure") return block.contact_pressure;
-  if (name == "sliding_velocity") return block.sliding_velocity;
-  if (name == "temperature") return block.temperature;
-  if (name == "fibre_angle") return block.fibre_angle;
-  return nullptr;
+  const auto field = Block::field_for(name);
+  return field ? block.*field : nullptr;
 }
 
 class InProcessClient final : public FrictionClient {
@@ -62,6 +59,24 @@ class InProcessClient final : public FrictionClient {
   std::unique_ptr<FrictionModel> model_;
 };
 
+struct ServerUri {
+  std::string target;  // host:port
+  std::string model;   // empty when the URI names no model
+  bool tls;
+};
+
+// "grpc://host:port[/model]" or "grpcs://…"; nothing for other schemes.
+std::optional<ServerUri> parse_server_uri(const std::string& uri) {
+  for (const std::string scheme : {"grpc://", "grpcs://"}) {
+    if (uri.rfind(scheme, 0) != 0) continue;
+    const std::string rest = uri.substr(scheme.size());
+    const auto slash = rest.find('/');
+    return ServerUri{rest.substr(0, slash), slash == std::string::npos ? "" : rest.substr(slash + 1),
+                     scheme == "grpcs://"};
+  }
+  return std::nullopt;
+}
+
 std::string setting(const std::string& value, const char* environment_variable) {
   if (!value.empty()) return value;
   const char* from_environment = std::getenv(environment_variable);
@@ -69,11 +84,9 @@ std::string setting(const std::string& value, const char* environment_variable) 
 }
 
 std::string file_text(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(std::string(what) + ": cannot read '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  auto text = read_whole_file(path);
+  if (!text) throw Error(std::string(what) + ": cannot read '" + path + "'");
+  return std::move(*text);
 }
 
 std::shared_ptr<grpc::ChannelCredentials> channel_credentials(bool tls, const Options& options) {
@@ -240,11 +253,11 @@ class GrpcClient final : public FrictionClient {
 }  // namespace
 
 ServerStatus server_status(const std::string& uri, const Options& options) {
-  const bool tls = uri.rfind("grpcs://", 0) == 0;
-  if (!tls && uri.rfind("grpc://", 0) != 0) throw Error("server URI '" + uri + "': expected grpc://host:port");
-  std::string target = uri.substr(tls ? 8 : 7);
-  target = target.substr(0, target.find('/'));
-  auto stub = mufric::v1::FrictionService::NewStub(grpc::CreateChannel(target, channel_credentials(tls, options)));
+  const auto server = parse_server_uri(uri);
+  if (!server) throw Error("server URI '" + uri + "': expected grpc://host:port");
+  const std::string& target = server->target;
+  auto stub =
+      mufric::v1::FrictionService::NewStub(grpc::CreateChannel(target, channel_credentials(server->tls, options)));
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
   const std::string token = setting(options.token, "MUFRIC_TOKEN");
@@ -261,14 +274,11 @@ ServerStatus server_status(const std::string& uri, const Options& options) {
 }
 
 std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options) {
-  for (const std::string scheme : {"grpc://", "grpcs://"}) {
-    if (uri.rfind(scheme, 0) != 0) continue;
-    const std::string rest = uri.substr(scheme.size());
-    const auto slash = rest.find('/');
-    if (slash == std::string::npos || slash + 1 == rest.size()) {
-      throw Error("model URI '" + uri + "': expected " + scheme + "host:port/model");
+  if (const auto server = parse_server_uri(uri)) {
+    if (server->model.empty()) {
+      throw Error("model URI '" + uri + "': expected " + (server->tls ? "grpcs" : "grpc") + "://host:port/model");
     }
-    return std::make_unique<GrpcClient>(rest.substr(0, slash), rest.substr(slash + 1), scheme == "grpcs://", options);
+    return std::make_unique<GrpcClient>(server->target, server->model, server->tls, options);
   }
   return std::make_unique<InProcessClient>(model_path_from_uri(uri));
 }

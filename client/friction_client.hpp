@@ -6,6 +6,7 @@
 //   file:///path/model.h5    the same model evaluated in-process, no server (or a plain path)
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "surrogate/friction_model.hpp"
@@ -19,6 +20,16 @@ struct Block {
   const double* sliding_velocity = nullptr;  // m/s
   const double* temperature = nullptr;       // K
   const double* fibre_angle = nullptr;       // rad
+
+  // The field that carries a named model input, or nullptr for a name the wire does not carry:
+  //   if (auto field = Block::field_for(name)) block.*field = values;
+  static const double* Block::*field_for(std::string_view name) {
+    if (name == "contact_pressure") return &Block::contact_pressure;
+    if (name == "sliding_velocity") return &Block::sliding_velocity;
+    if (name == "temperature") return &Block::temperature;
+    if (name == "fibre_angle") return &Block::fibre_angle;
+    return nullptr;
+  }
 };
 
 struct Answer {

@@ -3,13 +3,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <openssl/sha.h>
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/version.hpp"
 
 namespace mufric {
@@ -161,11 +160,9 @@ std::string sha256_hex(const std::string& bytes) {
 }
 
 std::string sha256_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open for hashing");
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return sha256_hex(bytes.str());
+  const auto bytes = read_whole_file(path);
+  if (!bytes) throw Error(path + ": cannot open for hashing");
+  return sha256_hex(*bytes);
 }
 
 }  // namespace mufric

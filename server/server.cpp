@@ -11,10 +11,10 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
-#include <sstream>
 #include <thread>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/version.hpp"
 #include "server/friction_service.hpp"
 
@@ -32,11 +32,9 @@ void log_line(const std::string& level, const std::string& message) {
 }  // namespace
 
 std::string read_text_file(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(what + ": cannot read '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  auto text = read_whole_file(path);
+  if (!text) throw Error(what + ": cannot read '" + path + "'");
+  return std::move(*text);
 }
 
 std::shared_ptr<grpc::ServerCredentials> server_credentials(const ServerOptions& options) {
