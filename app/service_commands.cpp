@@ -15,8 +15,10 @@ void add_status_command(CLI::App& app) {
       ->required();
   cmd->callback([uri] {
     const client::ServerStatus s = client::server_status(*uri);
-    std::printf("mufric %s, up %.1f s: %lld requests, %lld points, %lld errors, %lld in flight\n", s.code_version.c_str(),
-                s.uptime_seconds, s.requests, s.points, s.errors, s.in_flight);
+    std::printf("mufric %s, up %.1f s, %d evaluation threads: %lld requests, %lld points, %lld errors "
+                "(%lld abandoned at their deadline), %lld in flight\n",
+                s.code_version.c_str(), s.uptime_seconds, s.evaluation_threads, s.requests, s.points, s.errors,
+                s.abandoned, s.in_flight);
     std::printf("server-side evaluation time:\n");
     for (size_t i = 0; i < s.latency_counts.size(); ++i) {
       if (i < s.latency_bounds_us.size()) {
@@ -42,6 +44,10 @@ void add_service_commands(CLI::App& app) {
       ->check(CLI::Range(1, 2000));
   cmd->add_option("--max-points", o->max_points, "Most points in one request")->capture_default_str()
       ->check(CLI::Range(1LL, 100'000'000LL));
+  cmd->add_option("--threads", o->threads,
+                  "Cores evaluation may use (0: all). A batch running alone uses them all; k concurrent batches "
+                  "share them, max(1, threads/k) each")
+      ->capture_default_str()->check(CLI::Range(0, 4096));
   cmd->add_option("--drain", o->drain_seconds, "Seconds requests in flight get on SIGTERM")->capture_default_str();
   cmd->add_option("--ready-file", o->ready_file, "Write the bound address here once serving (for scripts)");
   cmd->add_option("--token-file", o->token_file, "Require 'authorization: Bearer <token>' with the token in this file")
@@ -52,7 +58,8 @@ void add_service_commands(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"
               "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
-              "server reflection are on. Logs go to stderr, one line per event.");
+              "server reflection are on. Logs go to stderr, one line per event. A call whose deadline passes (or that\n"
+              "the client cancels) stops within a few thousand points and answers DEADLINE_EXCEEDED (CANCELLED).");
   cmd->callback([o] { server::run_server(*o); });
 }
 

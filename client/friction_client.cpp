@@ -267,7 +267,9 @@ ServerStatus server_status(const std::string& uri, const Options& options) {
   if (!status.ok()) throw Error("GetServerStatus on " + target + " failed: " + status.error_message());
   ServerStatus out{s.code_version(), s.uptime_seconds(), static_cast<long long>(s.requests()),
                    static_cast<long long>(s.points()), static_cast<long long>(s.errors()),
-                   static_cast<long long>(s.in_flight()), {s.latency_bounds_us().begin(), s.latency_bounds_us().end()},
+                   static_cast<long long>(s.in_flight()), static_cast<long long>(s.abandoned()),
+                   static_cast<int>(s.evaluation_threads()),
+                   {s.latency_bounds_us().begin(), s.latency_bounds_us().end()},
                    {s.latency_counts().begin(), s.latency_counts().end()}, {}};
   for (const auto& m : s.models()) out.models.push_back(m.name() + " " + m.version() + " " + m.kind());
   return out;

@@ -78,6 +78,8 @@ struct ServerStatus {
   std::string code_version;
   double uptime_seconds = 0.0;
   long long requests = 0, points = 0, errors = 0, in_flight = 0;
+  long long abandoned = 0;          // evaluations stopped because the caller's deadline passed
+  int evaluation_threads = 0;       // cores one batch may use when it runs alone
   std::vector<double> latency_bounds_us;  // histogram of server-side evaluation time
   std::vector<long long> latency_counts;  // one more than bounds: the last is unbounded
   std::vector<std::string> models;        // "name version kind"

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <exception>
 
+#include <omp.h>
+
 #include "common/version.hpp"
 #include "surrogate/gaussian_process.hpp"
 
@@ -30,6 +32,16 @@ void add_model_summaries(const ModelRegistry& registry,
     m->set_version(served->version);
     m->set_kind(std::string(served->model->kind()));
   }
+}
+
+// OK while the caller still waits for the answer; otherwise why not, with how far evaluation got.
+grpc::Status caller_gone(const grpc::CallbackServerContext& context, int done, int total) {
+  const std::string progress = " after " + std::to_string(done) + " of " + std::to_string(total) + " points";
+  if (context.IsCancelled()) return {grpc::StatusCode::CANCELLED, "the caller cancelled the call" + progress};
+  if (std::chrono::system_clock::now() > context.deadline()) {
+    return {grpc::StatusCode::DEADLINE_EXCEEDED, "the call's deadline passed" + progress};
+  }
+  return grpc::Status::OK;
 }
 
 }  // namespace
@@ -95,7 +107,12 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
   out.set_summary(model.summary());
 }
 
-grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
+int threads_per_evaluation(int evaluation_threads, int in_flight) {
+  return std::max(1, evaluation_threads / std::max(1, in_flight));
+}
+
+grpc::Status FrictionService::evaluate(const grpc::CallbackServerContext& context, const EvaluateRequest& request,
+                                       mufric::v1::EvaluateResponse& response) {
   const auto served = registry_.find(request.model());
   if (!served) {
     return {grpc::StatusCode::NOT_FOUND, "model '" + request.model() + "' is not served; serving: " + registry_.names()};
@@ -113,29 +130,48 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   std::vector<std::string> ignored;
   grpc::Status status = batch_from_request(request, model.inputs(), limits_.max_points_per_request, batch, ignored);
   if (!status.ok()) return status;
-  const Evaluation e =
-      model.evaluate(batch, {.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()});
   const auto n = static_cast<int>(batch.rows());
   response.set_model(served->name);
   response.set_version(served->version);
-  response.mutable_mu()->Assign(e.mu.data(), e.mu.data() + n);
-  if (request.std()) response.mutable_std()->Assign(e.std.data(), e.std.data() + n);
-  if (request.ci_level() > 0.0) {
-    response.mutable_lo()->Assign(e.lo.data(), e.lo.data() + n);
-    response.mutable_hi()->Assign(e.hi.data(), e.hi.data() + n);
+  const EvaluationRequest what{.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()};
+  response.mutable_mu()->Reserve(n);
+  if (what.std) response.mutable_std()->Reserve(n);
+  if (what.ci_level > 0.0) {
+    response.mutable_lo()->Reserve(n);
+    response.mutable_hi()->Reserve(n);
   }
-  if (request.gradient()) {
-    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
-    response.mutable_gradient()->Assign(rows.data(), rows.data() + rows.size());
+  if (what.gradient) {
+    response.mutable_gradient()->Reserve(n * static_cast<int>(batch.cols()));
     for (const auto& input : model.inputs()) response.add_gradient_inputs(input.name);
   }
   auto* statuses = response.mutable_status();
   statuses->Reserve(n);
   uint64_t extrapolated = 0, invalid = 0;
-  for (const PointStatus s : e.status) {
-    statuses->Add(static_cast<int>(s));
-    extrapolated += s == PointStatus::extrapolated;
-    invalid += s == PointStatus::invalid_input;
+  // Chunks, so that a call whose caller has given up (deadline passed, cancelled) stops within a
+  // few milliseconds instead of computing an answer nobody reads.
+  for (int first = 0; first < n; first += static_cast<int>(kPointsBetweenDeadlineChecks)) {
+    if (grpc::Status gone = caller_gone(context, first, n); !gone.ok()) {
+      ++counters_.abandoned;
+      return gone;
+    }
+    const int count = std::min(n - first, static_cast<int>(kPointsBetweenDeadlineChecks));
+    const Evaluation e = count == n ? model.evaluate(batch, what)
+                                    : model.evaluate(QueryBatch(batch.middleRows(first, count)), what);
+    response.mutable_mu()->Add(e.mu.data(), e.mu.data() + count);
+    if (what.std) response.mutable_std()->Add(e.std.data(), e.std.data() + count);
+    if (what.ci_level > 0.0) {
+      response.mutable_lo()->Add(e.lo.data(), e.lo.data() + count);
+      response.mutable_hi()->Add(e.hi.data(), e.hi.data() + count);
+    }
+    if (what.gradient) {
+      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
+      response.mutable_gradient()->Add(rows.data(), rows.data() + rows.size());
+    }
+    for (const PointStatus s : e.status) {
+      statuses->Add(static_cast<int>(s));
+      extrapolated += s == PointStatus::extrapolated;
+      invalid += s == PointStatus::invalid_input;
+    }
   }
   response.set_extrapolated_points(extrapolated);
   response.set_invalid_points(invalid);
@@ -163,12 +199,15 @@ grpc::ServerUnaryReactor* FrictionService::refuse_unless_authorised(grpc::Callba
   return reactor;
 }
 
-grpc::Status FrictionService::handle(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
+grpc::Status FrictionService::handle(const grpc::CallbackServerContext& context, const EvaluateRequest& request,
+                                     mufric::v1::EvaluateResponse& response) {
   ++counters_.requests;
   const auto start = std::chrono::steady_clock::now();
+  // The OpenMP thread count is per calling thread, and gRPC runs handlers on its own threads.
+  omp_set_num_threads(threads_per_evaluation(limits_.evaluation_threads, counters_.in_flight.load()));
   grpc::Status status;
   try {
-    status = evaluate(request, response);
+    status = evaluate(context, request, response);
   } catch (const std::exception& e) {
     status = grpc::Status(grpc::StatusCode::INTERNAL, std::string("evaluation failed: ") + e.what());
   }
@@ -184,7 +223,7 @@ grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext*
   ++counters_.in_flight;
   grpc::Status status = authorise(*context);
   if (status.ok()) {
-    status = handle(*request, *response);
+    status = handle(*context, *request, *response);
   } else {
     ++counters_.errors;
   }
@@ -198,7 +237,8 @@ grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext*
 class FrictionService::StreamReactor final
     : public grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse> {
  public:
-  StreamReactor(FrictionService& service, const grpc::Status& authorised) : service_(service) {
+  StreamReactor(FrictionService& service, const grpc::CallbackServerContext& context, const grpc::Status& authorised)
+      : service_(service), context_(context) {
     if (authorised.ok()) {
       StartRead(&request_);
     } else {
@@ -214,7 +254,7 @@ class FrictionService::StreamReactor final
     }
     ++service_.counters_.in_flight;
     response_.Clear();
-    const grpc::Status status = service_.handle(request_, response_);
+    const grpc::Status status = service_.handle(context_, request_, response_);
     if (status.ok()) {
       StartWrite(&response_);
     } else {
@@ -236,13 +276,14 @@ class FrictionService::StreamReactor final
 
  private:
   FrictionService& service_;
+  const grpc::CallbackServerContext& context_;
   EvaluateRequest request_;
   mufric::v1::EvaluateResponse response_;
 };
 
 grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse>* FrictionService::EvaluateStream(
     grpc::CallbackServerContext* context) {
-  return new StreamReactor(*this, authorise(*context));
+  return new StreamReactor(*this, *context, authorise(*context));
 }
 
 grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContext* context,
@@ -267,6 +308,8 @@ grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerC
   response->set_points(static_cast<uint64_t>(counters_.points.load()));
   response->set_errors(static_cast<uint64_t>(counters_.errors.load()));
   response->set_in_flight(static_cast<uint64_t>(counters_.in_flight.load()));
+  response->set_abandoned(static_cast<uint64_t>(counters_.abandoned.load()));
+  response->set_evaluation_threads(static_cast<uint32_t>(limits_.evaluation_threads));
   for (const double bound : kLatencyBoundsUs) response->add_latency_bounds_us(bound);
   for (const auto& count : counters_.latency) response->add_latency_counts(static_cast<uint64_t>(count.load()));
   add_model_summaries(registry_, *response->mutable_models());

@@ -16,7 +16,17 @@ struct ServiceLimits {
   // When set, every FrictionService call must carry "authorization: Bearer <token>" or gets
   // UNAUTHENTICATED. Health and reflection stay open for probes.
   std::string bearer_token;
+  // Cores one batch may use when it is the only evaluation running (`--threads`). With k
+  // evaluations in flight each gets max(1, threads / k), so concurrent clients do not oversubscribe
+  // the machine with nested thread teams.
+  int evaluation_threads = 1;
 };
+
+// Points evaluated between two looks at the caller's deadline and cancellation: a few ms of work.
+inline constexpr long long kPointsBetweenDeadlineChecks = 8192;
+
+// Threads for one evaluation when `in_flight` evaluations (this one included) are running.
+int threads_per_evaluation(int evaluation_threads, int in_flight);
 
 // Copies the request's packed arrays into a batch in the model's input order. Unequal lengths or a
 // missing input give INVALID_ARGUMENT naming the field; inputs the model does not use are listed.
@@ -47,6 +57,7 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   struct Counters {
     std::atomic<long long> requests{0}, points{0}, errors{0};
     std::atomic<int> in_flight{0};  // handlers running now; a drain waits for zero
+    std::atomic<long long> abandoned{0};  // stopped part-way: deadline passed or call cancelled
     std::array<std::atomic<long long>, kLatencyBoundsUs.size() + 1> latency{};
   };
   const Counters& counters() const { return counters_; }
@@ -57,8 +68,11 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   // A reactor already finished with UNAUTHENTICATED, or nullptr when the call may proceed.
   grpc::ServerUnaryReactor* refuse_unless_authorised(grpc::CallbackServerContext* context);
   // Counts the request, evaluates it, counts an error; never throws.
-  grpc::Status handle(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
-  grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response);
+  // `context` gives the call's deadline and cancellation, checked between chunks of points.
+  grpc::Status handle(const grpc::CallbackServerContext& context, const mufric::v1::EvaluateRequest& request,
+                      mufric::v1::EvaluateResponse& response);
+  grpc::Status evaluate(const grpc::CallbackServerContext& context, const mufric::v1::EvaluateRequest& request,
+                        mufric::v1::EvaluateResponse& response);
 
   const ModelRegistry& registry_;
   ServiceLimits limits_;

@@ -5,6 +5,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -73,7 +74,9 @@ void run_server(const ServerOptions& options) {
     token.erase(token.find_last_not_of(" \t\r\n") + 1);
     if (token.empty()) throw Error("--token-file: '" + options.token_file + "' is empty");
   }
-  FrictionService service(registry, {.max_points_per_request = options.max_points, .bearer_token = token});
+  const int threads = options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  FrictionService service(registry,
+                          {.max_points_per_request = options.max_points, .bearer_token = token, .evaluation_threads = threads});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -91,7 +94,8 @@ void run_server(const ServerOptions& options) {
                                : options.tls_client_ca.empty()     ? "TLS"
                                                                    : "mutual TLS";
   log_line("info", "mufric " + code_version() + " serving " + registry.names() + " on " + address + " (" + security +
-                       (token.empty() ? "" : ", bearer token required") + ")");
+                       (token.empty() ? "" : ", bearer token required") + ", " + std::to_string(threads) +
+                       " evaluation threads)");
   if (!options.ready_file.empty()) std::ofstream(options.ready_file) << address << "\n";
 
   std::mutex mutex;

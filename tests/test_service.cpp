@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <condition_variable>
 #include <fstream>
@@ -47,6 +48,7 @@ class LoopbackServer {
   std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
   int port() const { return port_; }
   server::ModelRegistry& registry() { return registry_; }
+  const server::FrictionService& service() const { return service_; }
 
  private:
   server::ModelRegistry registry_;
@@ -331,6 +333,45 @@ TEST_F(Service, StatusCountsRequestsPointsErrorsAndLatencies) {
   EXPECT_EQ(evaluations, 4);  // three answered, one NOT_FOUND
   EXPECT_EQ(s.latency_counts.size(), s.latency_bounds_us.size() + 1);
   EXPECT_EQ(s.models.size(), 2u);
+}
+
+TEST_F(Service, AnEvaluationWhoseDeadlinePassedStopsEarly) {
+  // A GP heavy enough that 100 000 points with std take about a second (L⁻¹ of 1500² per point).
+  GpTrainingOptions options;
+  options.optimise = false;
+  options.initial.length_scales = Eigen::Vector3d(0.3, 0.3, 0.3);
+  options.initial.noise_variance = 1e-4;
+  save_model((dir_ / "heavy.h5").string(), train_gaussian_process(test::smooth_training_set(1500, 5), options));
+  const Points pts = random_points(100'000);
+  const EvaluationRequest what{.std = true};
+  const auto start_local = std::chrono::steady_clock::now();
+  client::connect("file://" + (dir_ / "heavy.h5").string())->evaluate(pts.block(), what);
+  const double full_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_local).count();
+
+  LoopbackServer server(dir_);
+  client::Options impatient;
+  impatient.deadline_seconds = full_seconds / 8;
+  impatient.retries = 0;
+  impatient.chunk_points = 200'000;  // one call
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    client::connect("grpc://" + server.address() + "/heavy", impatient)->evaluate(pts.block(), what);
+    ADD_FAILURE() << "the call should have missed its deadline of " << impatient.deadline_seconds << " s";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("eadline"), std::string::npos) << e.what();
+  }
+  // The server must stop within a chunk or two of the deadline, not finish the whole batch.
+  while (server.service().counters().in_flight.load() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  const double busy_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(server.service().counters().abandoned.load(), 1);
+  EXPECT_LT(busy_seconds, full_seconds / 2) << "in-process evaluation of the whole batch takes " << full_seconds << " s";
+}
+
+TEST(ServiceThreads, ConcurrentEvaluationsShareTheCores) {
+  EXPECT_EQ(server::threads_per_evaluation(8, 1), 8);
+  EXPECT_EQ(server::threads_per_evaluation(8, 3), 2);
+  EXPECT_EQ(server::threads_per_evaluation(2, 32), 1);
+  EXPECT_EQ(server::threads_per_evaluation(2, 0), 2);
 }
 
 TEST_F(Service, StandardHealthServiceAnswersServing) {
