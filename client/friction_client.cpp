@@ -31,7 +31,9 @@ class InProcessClient final : public FrictionClient {
     QueryBatch x(static_cast<Eigen::Index>(block.points), static_cast<Eigen::Index>(inputs.size()));
     for (size_t j = 0; j < inputs.size(); ++j) {
       const double* values = input_pointer(block, inputs[j].name);
-      if (values == nullptr) throw Error("model '" + path_ + "' needs input " + inputs[j].name + ", which was not given");
+      if (values == nullptr) {
+        throw InvalidArgument("model '" + path_ + "' needs input " + inputs[j].name + ", which was not given");
+      }
       x.col(static_cast<Eigen::Index>(j)) = Eigen::Map<const Eigen::VectorXd>(values, x.rows());
     }
     const Evaluation e = model_->evaluate(x, what);
@@ -167,9 +169,16 @@ class GrpcClient final : public FrictionClient {
         backoff *= 2.0;
         continue;
       }
-      throw Error(std::string(method) + " on model '" + model_ + "' failed (" + code_name(status.error_code()) +
-                  "): " + status.error_message());
+      throw_failure(std::string(method), status);
     }
+  }
+
+  // The caller's own mistake (INVALID_ARGUMENT) is told apart from a failure of the service.
+  [[noreturn]] void throw_failure(const std::string& method, const grpc::Status& status) const {
+    const std::string message =
+        method + " on model '" + model_ + "' failed (" + code_name(status.error_code()) + "): " + status.error_message();
+    if (status.error_code() == grpc::StatusCode::INVALID_ARGUMENT) throw InvalidArgument(message);
+    throw Error(message);
   }
 
   static std::string code_name(grpc::StatusCode code) {
@@ -232,8 +241,7 @@ class GrpcClient final : public FrictionClient {
         backoff *= 2.0;
         continue;
       }
-      throw Error("EvaluateStream on model '" + model_ + "' failed (" + code_name(status.error_code()) +
-                  "): " + status.error_message());
+      throw_failure("EvaluateStream", status);
     }
   }
 

@@ -9,9 +9,17 @@
 #include <string_view>
 #include <vector>
 
+#include "common/error.hpp"
 #include "surrogate/friction_model.hpp"
 
 namespace mufric::client {
+
+// The block itself is malformed (an input the model needs is missing, arrays of unequal length):
+// retrying cannot help, the caller must fix the call. Every other failure is a plain Error.
+class InvalidArgument : public Error {
+ public:
+  using Error::Error;
+};
 
 // One block of contact points, structure-of-arrays, SI; null for inputs not sent.
 struct Block {
@@ -67,7 +75,8 @@ struct Options {
 class FrictionClient {
  public:
   virtual ~FrictionClient() = default;
-  // Throws mufric::Error naming the problem (unknown model, missing input, server error).
+  // Throws InvalidArgument for a malformed block, mufric::Error for anything else (unknown model,
+  // server unreachable); the message names the problem.
   virtual Answer evaluate(const Block& block, const EvaluationRequest& what) = 0;
   virtual ModelInfo describe() = 0;
 };

@@ -63,10 +63,10 @@ int mufric_evaluate(mufric_client* client, size_t n, const double* contact_press
     }
     last_error.clear();
     return MUFRIC_OK;
+  } catch (const mufric::client::InvalidArgument& e) {
+    return fail(MUFRIC_INVALID_ARGUMENT, std::string("mufric_evaluate: ") + e.what());
   } catch (const std::exception& e) {
-    const std::string message = e.what();
-    const bool missing_input = message.find("needs input") != std::string::npos;
-    return fail(missing_input ? MUFRIC_INVALID_ARGUMENT : MUFRIC_FAILED, "mufric_evaluate: " + message);
+    return fail(MUFRIC_FAILED, std::string("mufric_evaluate: ") + e.what());
   }
 }
 

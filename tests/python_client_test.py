@@ -1,8 +1,17 @@
 #!/usr/bin/python3
-"""The Python client end to end: starts `mufric serve` on a free loopback port with a seed-001 law,
-runs examples/python/evaluate_block.py against it and checks mu against the closed-form Table 4
-law, then checks that an unknown model is NOT_FOUND and unequal arrays are INVALID_ARGUMENT.
-Usage: python_client_test.py MUFRIC_EXE PYTHON_STUB_DIR EXAMPLES_DIR"""
+"""Every client language end to end on loopback against a running `mufric serve`:
+
+1. Python (generated stubs, examples/python/evaluate_block.py): mu of a seed-001 law against the
+   closed-form Table 4 law; NOT_FOUND for an unknown model, INVALID_ARGUMENT for unequal arrays.
+2. A Gaussian process trained by `mufric train`: mu, std and the 95 % interval from Python over gRPC,
+   from C (the C ABI over grpc:// and file://) and from Fortran (the ISO_C_BINDING module over
+   grpc://), each against an independent posterior computed here with numpy from the model file's
+   hyper-parameters and training data (Rasmussen & Williams 2006, Algorithm 2.1).
+3. The C example program over grpc:// against the law.
+4. The VFRICTION-style Fortran example (F77 entry points) over grpc:// against the law.
+Usage: python_client_test.py --mufric EXE --stubs DIR --examples DIR --c-example EXE --c-driver EXE
+                             [--fortran-driver EXE] [--vfriction EXE]"""
+import argparse
 import os
 import signal
 import subprocess
@@ -11,19 +20,96 @@ import tempfile
 import time
 from pathlib import Path
 
-mufric, stubs, examples = sys.argv[1], sys.argv[2], sys.argv[3]
-sys.path[:0] = [stubs, examples]
+parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+for name in ("mufric", "stubs", "examples", "c-example", "c-driver"):
+    parser.add_argument("--" + name, required=True)
+parser.add_argument("--fortran-driver")
+parser.add_argument("--vfriction")
+args = parser.parse_args()
+mufric, c_example, c_driver, fortran_driver = args.mufric, args.c_example, args.c_driver, args.fortran_driver
+sys.path[:0] = [args.stubs, args.examples]
+from statistics import NormalDist  # noqa: E402
+
 import grpc  # noqa: E402
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
 from mufric.v1 import friction_pb2, friction_pb2_grpc  # noqa: E402
 import evaluate_block  # noqa: E402
 
 failures = []
 
 
+checks = 0
+# The server's and numpy's posteriors differ only by rounding in different operation orders.
+POSTERIOR_RTOL = 1e-9
+
+
 def check(ok, what):
+    global checks
+    checks += 1
     print(("ok   " if ok else "FAIL ") + what)
     if not ok:
         failures.append(what)
+
+
+def reference_posterior(model_path, x):
+    """mu, std of the GP in model_path at SI points x (m x 3), computed independently with numpy."""
+    with h5py.File(model_path, "r") as f:
+        g = f["gp"]
+        lo, hi = f["inputs/box_lo"][()], f["inputs/box_hi"][()]
+        scale = lambda a: (a - lo) / (hi - lo)  # noqa: E731
+        xs, y = scale(g["x_train"][()]), g["y_train"][()]
+        s2, noise, jitter = g.attrs["signal_variance"], g.attrs["noise_variance"], g.attrs["jitter"]
+        lengths, y_mean, y_scale = g["length_scales"][()], g.attrs["y_mean"], g.attrs["y_scale"]
+        if not g.attrs["noise_term"]:
+            noise = 0.0
+
+    def rbf(a, b):
+        d = (a[:, None, :] - b[None, :, :]) / lengths
+        return s2 * np.exp(-0.5 * np.sum(d * d, axis=2))
+
+    k = rbf(xs, xs) + (noise + jitter) * np.eye(len(xs))
+    ks = rbf(scale(x), xs)
+    mean = ks @ np.linalg.solve(k, (y - y_mean) / y_scale)
+    var = s2 + noise - np.einsum("ij,ji->i", ks, np.linalg.solve(k, ks.T))
+    return y_mean + y_scale * mean, y_scale * np.sqrt(var)
+
+
+def close(a, b):
+    return np.allclose(a, b, rtol=POSTERIOR_RTOL, atol=POSTERIOR_RTOL * np.max(np.abs(b)))
+
+
+def check_gp_answer(who, mu, std, lo, hi, ref_mu, ref_std):
+    z = NormalDist().inv_cdf(0.975)
+    check(close(mu, ref_mu), f"{who}: mu equals the numpy posterior mean (max diff {np.max(np.abs(mu - ref_mu)):.1e})")
+    check(close(std, ref_std), f"{who}: std equals the numpy posterior std (max diff {np.max(np.abs(std - ref_std)):.1e})")
+    check(close(lo, ref_mu - z * ref_std) and close(hi, ref_mu + z * ref_std), f"{who}: 95 % interval = mu -+ 1.96 std")
+
+
+def run_driver(driver, uri, x, count_first):
+    text = (f"{len(x)}\n" if count_first else "") + "".join(f"{p!r} {v!r} {t!r}\n" for p, v, t in x)
+    out = subprocess.run([driver, uri], input=text, capture_output=True, text=True, timeout=60)
+    if out.returncode != 0:
+        return None, out.stderr
+    rows = np.array([[float(w) for w in line.split()] for line in out.stdout.splitlines() if line.strip()])
+    return rows, ""
+
+
+def make_gp(tmp):
+    """A GP trained by mufric on 80 noisy samples of a smooth field over the seed-000 box."""
+    rng = np.random.default_rng(7)
+    raw = np.column_stack([rng.uniform(300, 1300, 80), rng.uniform(22.5, 200, 80), rng.uniform(25, 900, 80)])
+    mu = 0.3 - 0.08 * (raw[:, 0] - 300) / 1000 + 0.05 * np.sin(3 * (raw[:, 1] - 22.5) / 177.5) \
+        + 0.1 * np.exp(-2 * (raw[:, 2] - 25) / 875) + rng.normal(0, 2e-3, 80)
+    with open(tmp / "train.csv", "w") as out:
+        out.write("contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n")
+        for row, m in zip(raw, mu):
+            out.write(f"{row[0]!r},{row[1]!r},{row[2]!r},{m!r}\n")
+    subprocess.run([mufric, "train", "--data", str(tmp / "train.csv"), "--out", str(tmp / "models/gp.h5"),
+                    "--restarts", "1"], check=True, capture_output=True)
+    # SI query points inside the box.
+    q = np.column_stack([rng.uniform(500e6, 1100e6, 12), rng.uniform(0.8, 2.8, 12), rng.uniform(400, 1000, 12)])
+    return q
 
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -31,6 +117,8 @@ with tempfile.TemporaryDirectory() as tmp:
     (tmp / "models").mkdir()
     subprocess.run([mufric, "law", "seward", "--table", "4", "--out", str(tmp / "models/law.h5")], check=True,
                    capture_output=True)
+    queries = make_gp(tmp)
+    ref_mu, ref_std = reference_posterior(tmp / "models/gp.h5", queries)
     server = subprocess.Popen([mufric, "serve", "--models", str(tmp / "models"), "--listen", "127.0.0.1:0",
                                "--ready-file", str(tmp / "address")], stderr=subprocess.DEVNULL)
     try:
@@ -57,9 +145,34 @@ with tempfile.TemporaryDirectory() as tmp:
         except grpc.RpcError as e:
             check(e.code() == grpc.StatusCode.INVALID_ARGUMENT and "sliding_velocity" in e.details(),
                   "unequal arrays: INVALID_ARGUMENT naming sliding_velocity")
+
+        # The GP's mu, std and interval from every language.
+        answer = stub.Evaluate(friction_pb2.EvaluateRequest(
+            model="gp", contact_pressure=queries[:, 0], sliding_velocity=queries[:, 1], temperature=queries[:, 2],
+            std=True, ci_level=0.95), timeout=10)
+        check_gp_answer("Python over gRPC", np.array(answer.mu), np.array(answer.std), np.array(answer.lo),
+                        np.array(answer.hi), ref_mu, ref_std)
+        drivers = [("C over gRPC", c_driver, f"grpc://{address}/gp", False),
+                   ("C in-process", c_driver, f"file://{tmp}/models/gp.h5", False)]
+        if fortran_driver:
+            drivers.append(("Fortran module over gRPC", fortran_driver, f"grpc://{address}/gp", True))
+        for who, driver, uri, count_first in drivers:
+            rows, error = run_driver(driver, uri, queries, count_first)
+            check(rows is not None and rows.shape == (len(queries), 5), f"{who}: one answer per point {error}")
+            if rows is not None and rows.shape == (len(queries), 5):
+                check_gp_answer(who, rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3], ref_mu, ref_std)
+                check(np.all(rows[:, 4] == 0), f"{who}: every point OK (statuses {rows[:, 4].astype(int).tolist()})")
+        example = subprocess.run([c_example, f"grpc://{address}/law"], capture_output=True, text=True, timeout=60)
+        check(example.returncode == 0, "C example over gRPC: mu of the law and a NaN point refused alone"
+              + ("" if example.returncode == 0 else "\n" + example.stdout + example.stderr))
+        if args.vfriction:
+            example = subprocess.run([args.vfriction, f"grpc://{address}/law"], capture_output=True, text=True,
+                                     timeout=60)
+            check(example.returncode == 0, "VFRICTION-style Fortran example (F77 entry points) over gRPC"
+                  + ("" if example.returncode == 0 else "\n" + example.stdout + example.stderr))
     finally:
         server.send_signal(signal.SIGTERM)
         check(server.wait(timeout=20) == 0, "server drained and exited 0 on SIGTERM")
 
-print(f"{6 - len(failures)} passed, {len(failures)} failed")
+print(f"{checks - len(failures)} passed, {len(failures)} failed")
 sys.exit(1 if failures else 0)
