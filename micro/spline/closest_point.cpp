@@ -1,0 +1,187 @@
+#include "micro/spline/closest_point.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace mufric::spline {
+namespace {
+
+struct Sample {
+  double u;
+  double distance_squared;
+};
+
+struct LocalResult {
+  double u;
+  double distance_squared;
+  int iterations;
+  bool converged;
+};
+
+// f(u) = C'·(C − x) and f'(u) = C''·(C − x) + |C'|²: the derivative of ½|C − x|² and its slope.
+struct Stationarity {
+  double f, slope, distance_squared, speed;
+};
+
+Stationarity stationarity(const SplineCurve& curve, const Eigen::Vector2d& x, double u) {
+  const Points2 d = curve.derivatives(u, 2);
+  const Eigen::Vector2d r = d.row(0).transpose() - x;
+  const Eigen::Vector2d c1 = d.row(1).transpose(), c2 = d.row(2).transpose();
+  return {c1.dot(r), c2.dot(r) + c1.squaredNorm(), r.squaredNorm(), c1.norm()};
+}
+
+// Golden-section search for the minimum of |C(u) − x|² on [a, b] (Numerical Recipes §10.2): the
+// last resort when the derivative-based iteration lands on a stationary point that is no minimum.
+LocalResult golden_section(const SplineCurve& curve, const Eigen::Vector2d& x, double a, double b) {
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  const double tolerance = kProjectionRelativeTolerance * (b - a);
+  auto distance2 = [&](double u) { return (curve.point(u) - x).squaredNorm(); };
+  double c = b - ratio * (b - a), d = a + ratio * (b - a);
+  double fc = distance2(c), fd = distance2(d);
+  int it = 0;
+  while (b - a > tolerance && it < 200) {
+    ++it;
+    if (fc < fd) {
+      b = d, d = c, fd = fc;
+      c = b - ratio * (b - a), fc = distance2(c);
+    } else {
+      a = c, c = d, fc = fd;
+      d = a + ratio * (b - a), fd = distance2(d);
+    }
+  }
+  const double u = fc < fd ? c : d;
+  return {u, std::min(fc, fd), it, true};
+}
+
+// Minimises ½|C(u) − x|² on [a, b], where a sampled local minimum `seed` lies between a and b.
+LocalResult refine(const SplineCurve& curve, const Eigen::Vector2d& x, double a, double b, double seed,
+                   double length_scale) {
+  const double a0 = a, b0 = b;
+  const double width_tolerance = kProjectionRelativeTolerance * (b - a);
+  const Stationarity fa = stationarity(curve, x, a), fb = stationarity(curve, x, b);
+  // With f(a) ≤ 0 ≤ f(b) the bracket holds a minimum and shrinks around it (rtsafe); otherwise the
+  // minimum may sit at an end of the bracket and only descending steps are taken.
+  const bool bracketed = fa.f <= 0.0 && fb.f >= 0.0;
+  double u = seed;
+  Stationarity s = stationarity(curve, x, u);
+  const double seed_distance_squared = s.distance_squared;
+  double lambda = 0.0;  // Levenberg–Marquardt damping, raised when a step fails to descend
+  LocalResult result{u, s.distance_squared, 0, false};
+  for (int it = 1; it <= kProjectionMaxIterations && !result.converged; ++it) {
+    result.iterations = it;
+    const double tolerance = kProjectionRelativeTolerance * s.speed * (std::sqrt(s.distance_squared) + length_scale);
+    const bool at_end = (u - a <= width_tolerance && s.f > 0.0) || (b - u <= width_tolerance && s.f < 0.0);
+    if (std::abs(s.f) <= tolerance || b - a <= width_tolerance || at_end) {
+      result.converged = true;
+      break;
+    }
+    if (bracketed) (s.f < 0.0 ? a : b) = u;
+    double step;
+    if (s.slope > 0.0) {
+      step = -s.f / (s.slope + lambda);  // Newton (λ = 0) or damped Newton
+    } else {
+      // Not convex here: Gauss–Newton with Marquardt damping, a descent direction whatever C'' is.
+      lambda = std::max(lambda, std::abs(s.slope));
+      step = -s.f / (s.speed * s.speed + lambda);
+    }
+    double next = u + step;
+    if (!(next > a && next < b)) next = bracketed ? 0.5 * (a + b) : std::clamp(next, a, b);
+    const Stationarity t = stationarity(curve, x, next);
+    if (bracketed || t.distance_squared <= s.distance_squared) {
+      u = next;
+      s = t;
+      lambda *= 0.1;
+    } else {
+      lambda = std::max(4.0 * lambda, s.speed * s.speed);  // reject, damp harder
+    }
+  }
+  result.u = u;
+  result.distance_squared = s.distance_squared;
+  if (!result.converged || s.distance_squared > seed_distance_squared) {
+    const LocalResult g = golden_section(curve, x, a0, b0);
+    if (g.distance_squared <= s.distance_squared) return {g.u, g.distance_squared, result.iterations + g.iterations, true};
+  }
+  return result;
+}
+
+}  // namespace
+
+Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const ProjectionOptions& options) {
+  const SplineBasis& basis = curve.basis();
+  const int per_span = options.samples_per_span > 0 ? options.samples_per_span : 2 * basis.degree() + 4;
+  // Parameter range: open curves their domain; periodic curves with a shift a few periods around
+  // the period the point's position along the shift falls into.
+  double lo = basis.lo(), hi = basis.hi();
+  std::vector<double> breaks = basis.breakpoints();
+  if (basis.is_periodic() && !curve.shift().isZero() && options.periods > 1) {
+    const Eigen::Vector2d s = curve.shift();
+    const double along = (x - curve.point(lo)).dot(s) / s.squaredNorm();
+    const int centre = static_cast<int>(std::floor(along));
+    const int first = centre - (options.periods - 1) / 2;
+    std::vector<double> extended;
+    for (int q = first; q < first + options.periods; ++q) {
+      for (size_t e = 0; e + 1 < breaks.size(); ++e) extended.push_back(breaks[e] + q * basis.period());
+    }
+    extended.push_back(breaks.back() + (first + options.periods - 1) * basis.period());
+    breaks = std::move(extended);
+    lo = breaks.front();
+    hi = breaks.back();
+  }
+  std::vector<Sample> samples;
+  for (size_t e = 0; e + 1 < breaks.size(); ++e) {
+    for (int q = 0; q < per_span; ++q) {
+      const double u = breaks[e] + (breaks[e + 1] - breaks[e]) * q / per_span;
+      samples.push_back({u, (curve.point(u) - x).squaredNorm()});
+    }
+  }
+  samples.push_back({hi, (curve.point(hi) - x).squaredNorm()});
+  const bool closed = basis.is_periodic() && curve.shift().isZero();
+  const size_t count = samples.size();
+  double length_scale = 0.0;
+  for (size_t i = 1; i < count; ++i) {
+    length_scale = std::max(length_scale, (curve.point(samples[i].u) - curve.point(samples[i - 1].u)).norm());
+  }
+  Projection out;
+  out.distance = std::numeric_limits<double>::infinity();
+  size_t best_sample = 0;
+  for (size_t i = 0; i < count; ++i) {
+    if (samples[i].distance_squared < samples[best_sample].distance_squared) best_sample = i;
+  }
+  // Every local minimum of the sampled distance is a candidate basin.
+  for (size_t i = 0; i < count; ++i) {
+    const bool has_left = i > 0 || closed, has_right = i + 1 < count || closed;
+    const Sample& left = samples[i > 0 ? i - 1 : count - 2];
+    const Sample& right = samples[i + 1 < count ? i + 1 : 1];
+    if ((has_left && left.distance_squared < samples[i].distance_squared) ||
+        (has_right && right.distance_squared < samples[i].distance_squared)) {
+      continue;
+    }
+    const double a = has_left ? (i > 0 ? left.u : samples[count - 2].u - (hi - lo)) : samples[i].u;
+    const double b = has_right ? (i + 1 < count ? right.u : samples[1].u + (hi - lo)) : samples[i].u;
+    ++out.candidates;
+    LocalResult r = a < b ? refine(curve, x, a, b, samples[i].u, length_scale)
+                          : LocalResult{samples[i].u, samples[i].distance_squared, 0, true};
+    if (r.distance_squared < out.distance * out.distance ||
+        (r.distance_squared == out.distance * out.distance && r.u < out.u)) {
+      out.u = r.u;
+      out.distance = std::sqrt(r.distance_squared);
+      out.iterations = r.iterations;
+      out.converged = r.converged;
+    }
+  }
+  if (out.candidates == 0 || !std::isfinite(out.distance)) {
+    out.u = samples[best_sample].u;
+    out.distance = std::sqrt(samples[best_sample].distance_squared);
+    out.converged = false;
+    out.reason = "no local minimum found among the samples; the best sample is returned";
+  } else if (!out.converged) {
+    out.reason = "the local iteration did not meet its tolerance in " + std::to_string(kProjectionMaxIterations) +
+                 " iterations; the best iterate is returned";
+  }
+  out.foot = curve.point(out.u);
+  return out;
+}
+
+}  // namespace mufric::spline

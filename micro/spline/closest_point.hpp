@@ -1,0 +1,39 @@
+#pragma once
+// Closest-point projection of a point onto a planar spline curve, robust on rough profiles of any
+// degree: global seeding over every span, then per candidate a safeguarded Newton iteration on
+// f(u) = C'(u)·(C(u) − x) inside a sign-change bracket (Press et al., Numerical Recipes 3rd ed.,
+// §9.4 "rtsafe"), with a Levenberg–Marquardt step (Marquardt 1963) where the Newton model is not
+// convex and bisection where both would leave the bracket.
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "micro/spline/spline_curve.hpp"
+
+namespace mufric::spline {
+
+// Stop when |f| ≤ this × |C'| × (|C − x| + curve scale) or the bracket is this narrow (× span).
+inline constexpr double kProjectionRelativeTolerance = 1e-13;
+inline constexpr int kProjectionMaxIterations = 100;
+
+struct ProjectionOptions {
+  // Samples per span for the global seeding; more catches narrower features between samples.
+  int samples_per_span = 0;  // 0: 2p + 4
+  // Periodic curves with a shift (profiles): the parameter range searched, in periods, centred on
+  // the period of the point's own x (for closed curves one period is everything).
+  int periods = 3;
+};
+
+struct Projection {
+  double u = 0.0;                  // parameter of the foot (periodic: may lie outside [lo, hi))
+  Eigen::Vector2d foot = Eigen::Vector2d::Zero();
+  double distance = 0.0;
+  int iterations = 0;              // local iterations of the winning candidate
+  int candidates = 0;              // local minima of the seeding that were refined
+  bool converged = false;          // false: the best sample is returned and `reason` says why
+  std::string reason;
+};
+
+Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const ProjectionOptions& options = {});
+
+}  // namespace mufric::spline

@@ -1,0 +1,175 @@
+#include "micro/spline/spline_surface.hpp"
+
+#include <string>
+
+#include "common/error.hpp"
+
+namespace mufric::spline {
+
+SplineSurface::SplineSurface(SplineBasis u_basis, SplineBasis v_basis, Points2 points, Eigen::VectorXd weights,
+                             Eigen::Vector2d shift)
+    : u_(std::move(u_basis)), v_(std::move(v_basis)), points_(std::move(points)), weights_(std::move(weights)),
+      shift_(shift) {
+  if (points_.rows() != u_.count() * v_.count()) {
+    throw Error("spline surface: " + std::to_string(points_.rows()) + " control points for " +
+                std::to_string(u_.count()) + " × " + std::to_string(v_.count()) + " functions");
+  }
+  if (v_.is_periodic()) throw Error("spline surface: only the u direction may be periodic");
+  if (weights_.size() != 0 && weights_.size() != points_.rows()) {
+    throw Error("spline surface: one weight per control point is needed");
+  }
+  if (weights_.size() != 0 && !(weights_.array() > 0.0).all()) throw Error("spline surface: weights must be positive");
+  if (!u_.is_periodic() && !shift_.isZero()) throw Error("spline surface: a shift needs a periodic u basis");
+}
+
+Eigen::Matrix2d SplineSurface::jacobian(double u, double v) const {
+  const auto au = u_.locate(u), av = v_.locate(v);
+  const Eigen::MatrixXd nu = u_.derivatives(au.span, au.u, 1), nv = v_.derivatives(av.span, av.u, 1);
+  // Homogeneous sums A (point·w) and W with their first derivatives (A4.4 to first order).
+  Eigen::Vector2d a = Eigen::Vector2d::Zero(), a_u = a, a_v = a;
+  double w = 0.0, w_u = 0.0, w_v = 0.0;
+  for (int jv = 0; jv <= v_.degree(); ++jv) {
+    const int j = v_.function_index(av.span, jv);
+    for (int iu = 0; iu <= u_.degree(); ++iu) {
+      const int i = u_.function_index(au.span, iu);
+      const int k = index(i, j);
+      const double weight = is_rational() ? weights_(k) : 1.0;
+      const Eigen::Vector2d p =
+          points_.row(k).transpose() + (u_.function_period(au.span, iu) + au.periods) * shift_;
+      const double n00 = nu(0, iu) * nv(0, jv), n10 = nu(1, iu) * nv(0, jv), n01 = nu(0, iu) * nv(1, jv);
+      a += n00 * weight * p, a_u += n10 * weight * p, a_v += n01 * weight * p;
+      w += n00 * weight, w_u += n10 * weight, w_v += n01 * weight;
+    }
+  }
+  const Eigen::Vector2d s = a / w;
+  Eigen::Matrix2d j;
+  j.col(0) = (a_u - w_u * s) / w;
+  j.col(1) = (a_v - w_v * s) / w;
+  return j;
+}
+
+Eigen::Vector2d SplineSurface::point(double u, double v) const {
+  // Evaluate as the column curve at u: exact and reuses the curve algorithm.
+  const auto au = u_.locate(u);
+  const Eigen::VectorXd nu = u_.values(au.span, au.u);
+  const auto av = v_.locate(v);
+  const Eigen::VectorXd nv = v_.values(av.span, av.u);
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();
+  double w = 0.0;
+  for (int jv = 0; jv <= v_.degree(); ++jv) {
+    for (int iu = 0; iu <= u_.degree(); ++iu) {
+      const int k = index(u_.function_index(au.span, iu), v_.function_index(av.span, jv));
+      const double weight = is_rational() ? weights_(k) : 1.0;
+      const Eigen::Vector2d p =
+          points_.row(k).transpose() + (u_.function_period(au.span, iu) + au.periods) * shift_;
+      a += nu(iu) * nv(jv) * weight * p;
+      w += nu(iu) * nv(jv) * weight;
+    }
+  }
+  return a / w;
+}
+
+SplineCurve SplineSurface::row(int j) const {
+  Points2 p(u_.count(), 2);
+  Eigen::VectorXd w(is_rational() ? u_.count() : 0);
+  for (int i = 0; i < u_.count(); ++i) {
+    p.row(i) = points_.row(index(i, j));
+    if (is_rational()) w(i) = weights_(index(i, j));
+  }
+  return SplineCurve(u_, std::move(p), std::move(w), shift_);
+}
+
+SplineCurve SplineSurface::column(int i) const {
+  Points2 p(v_.count(), 2);
+  Eigen::VectorXd w(is_rational() ? v_.count() : 0);
+  for (int j = 0; j < v_.count(); ++j) {
+    p.row(j) = points_.row(index(i, j));
+    if (is_rational()) w(j) = weights_(index(i, j));
+  }
+  return SplineCurve(v_, std::move(p), std::move(w));
+}
+
+SplineSurface SplineSurface::from_rows(const std::vector<SplineCurve>& rows, const SplineBasis& v_basis) {
+  const SplineBasis& u = rows.front().basis();
+  const bool rational = rows.front().is_rational();
+  Points2 p(u.count() * v_basis.count(), 2);
+  Eigen::VectorXd w(rational ? p.rows() : 0);
+  for (int j = 0; j < v_basis.count(); ++j) {
+    for (int i = 0; i < u.count(); ++i) {
+      p.row(i + u.count() * j) = rows[static_cast<size_t>(j)].points().row(i);
+      if (rational) w(i + u.count() * j) = rows[static_cast<size_t>(j)].weights()(i);
+    }
+  }
+  return SplineSurface(u, v_basis, std::move(p), std::move(w), rows.front().shift());
+}
+
+SplineSurface SplineSurface::from_columns(const std::vector<SplineCurve>& columns, const SplineBasis& u_basis,
+                                          const Eigen::Vector2d& shift) {
+  const SplineBasis& v = columns.front().basis();
+  const bool rational = columns.front().is_rational();
+  Points2 p(u_basis.count() * v.count(), 2);
+  Eigen::VectorXd w(rational ? p.rows() : 0);
+  for (int i = 0; i < u_basis.count(); ++i) {
+    for (int j = 0; j < v.count(); ++j) {
+      p.row(i + u_basis.count() * j) = columns[static_cast<size_t>(i)].points().row(j);
+      if (rational) w(i + u_basis.count() * j) = columns[static_cast<size_t>(i)].weights()(j);
+    }
+  }
+  return SplineSurface(u_basis, v, std::move(p), std::move(w), shift);
+}
+
+SplineSurface SplineSurface::refined_u(const std::vector<double>& us) const {
+  std::vector<SplineCurve> rows;
+  for (int j = 0; j < v_.count(); ++j) rows.push_back(row(j).refined(us));
+  return from_rows(rows, v_);
+}
+
+SplineSurface SplineSurface::refined_v(const std::vector<double>& vs) const {
+  std::vector<SplineCurve> columns;
+  for (int i = 0; i < u_.count(); ++i) columns.push_back(column(i).refined(vs));
+  return from_columns(columns, u_, shift_);
+}
+
+SplineSurface SplineSurface::elevated_u() const {
+  std::vector<SplineCurve> rows;
+  for (int j = 0; j < v_.count(); ++j) rows.push_back(row(j).elevated());
+  return from_rows(rows, v_);
+}
+
+SplineSurface SplineSurface::elevated_v() const {
+  std::vector<SplineCurve> columns;
+  for (int i = 0; i < u_.count(); ++i) columns.push_back(column(i).elevated());
+  return from_columns(columns, u_, shift_);
+}
+
+namespace {
+std::vector<double> interior_splits(const SplineBasis& basis, int parts) {
+  std::vector<double> out;
+  const auto breaks = basis.breakpoints();
+  for (size_t e = 0; e + 1 < breaks.size(); ++e) {
+    for (int q = 1; q < parts; ++q) out.push_back(breaks[e] + (breaks[e + 1] - breaks[e]) * q / parts);
+  }
+  return out;
+}
+}  // namespace
+
+SplineSurface SplineSurface::subdivided(int parts_u, int parts_v) const {
+  return refined_u(interior_splits(u_, parts_u)).refined_v(interior_splits(v_, parts_v));
+}
+
+SplineSurface SplineSurface::extruded(const SplineCurve& top, double y_bottom, int v_degree, int v_spans) {
+  const SplineBasis linear = SplineBasis::open_uniform(1, 1, 0.0, 1.0);
+  const int nu = top.basis().count();
+  Points2 p(2 * nu, 2);
+  Eigen::VectorXd w(top.is_rational() ? 2 * nu : 0);
+  for (int i = 0; i < nu; ++i) {
+    p.row(i) = Eigen::RowVector2d(top.points()(i, 0), y_bottom);
+    p.row(i + nu) = top.points().row(i);
+    if (top.is_rational()) w(i) = w(i + nu) = top.weights()(i);
+  }
+  SplineSurface s(top.basis(), linear, std::move(p), std::move(w), top.shift());
+  for (int d = 1; d < v_degree; ++d) s = s.elevated_v();
+  return s.subdivided(1, v_spans);
+}
+
+}  // namespace mufric::spline
