@@ -1,0 +1,178 @@
+#include "micro/solid/iga_space.hpp"
+
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace mufric::solid {
+namespace {
+
+// Rational basis functions of the patch at (u, v) with their parametric derivatives, and the
+// geometry there (periodic control points moved by their period's shift).
+struct Basis2 {
+  std::vector<int> nodes;
+  Eigen::VectorXd r, r_u, r_v;
+  Eigen::Vector2d x;
+  Eigen::Matrix2d jacobian;  // columns ∂X/∂u, ∂X/∂v
+};
+
+Basis2 evaluate_basis(const spline::SplineSurface& s, double u, double v) {
+  const auto& bu = s.u_basis();
+  const auto& bv = s.v_basis();
+  const auto au = bu.locate(u), av = bv.locate(v);
+  const Eigen::MatrixXd nu = bu.derivatives(au.span, au.u, 1), nv = bv.derivatives(av.span, av.u, 1);
+  const int p = bu.degree(), q = bv.degree(), count = (p + 1) * (q + 1);
+  Basis2 b;
+  b.nodes.resize(static_cast<size_t>(count));
+  b.r.resize(count), b.r_u.resize(count), b.r_v.resize(count);
+  double w = 0.0, w_u = 0.0, w_v = 0.0;
+  std::vector<Eigen::Vector2d> positions(static_cast<size_t>(count));
+  for (int j = 0; j <= q; ++j) {
+    for (int i = 0; i <= p; ++i) {
+      const int a = i + (p + 1) * j;
+      const int node = s.index(bu.function_index(au.span, i), bv.function_index(av.span, j));
+      const double weight = s.is_rational() ? s.weights()(node) : 1.0;
+      b.nodes[static_cast<size_t>(a)] = node;
+      b.r(a) = nu(0, i) * nv(0, j) * weight;
+      b.r_u(a) = nu(1, i) * nv(0, j) * weight;
+      b.r_v(a) = nu(0, i) * nv(1, j) * weight;
+      w += b.r(a), w_u += b.r_u(a), w_v += b.r_v(a);
+      positions[static_cast<size_t>(a)] =
+          s.points().row(node).transpose() + (bu.function_period(au.span, i) + au.periods) * s.shift();
+    }
+  }
+  // Quotient rule: R = N w / W, R_u = (N_u w − R W_u) / W.
+  b.r /= w;
+  b.r_u = (b.r_u - b.r * w_u) / w;
+  b.r_v = (b.r_v - b.r * w_v) / w;
+  b.x.setZero();
+  b.jacobian.setZero();
+  for (int a = 0; a < count; ++a) {
+    b.x += b.r(a) * positions[static_cast<size_t>(a)];
+    b.jacobian.col(0) += b.r_u(a) * positions[static_cast<size_t>(a)];
+    b.jacobian.col(1) += b.r_v(a) * positions[static_cast<size_t>(a)];
+  }
+  return b;
+}
+
+}  // namespace
+
+void gauss_legendre(int count, std::vector<double>& nodes, std::vector<double>& weights) {
+  Eigen::MatrixXd jacobi = Eigen::MatrixXd::Zero(count, count);
+  for (int k = 1; k < count; ++k) {
+    jacobi(k, k - 1) = jacobi(k - 1, k) = k / std::sqrt(4.0 * k * k - 1.0);
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jacobi);
+  nodes.resize(static_cast<size_t>(count));
+  weights.resize(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    nodes[static_cast<size_t>(k)] = eigen.eigenvalues()(k);
+    weights[static_cast<size_t>(k)] = 2.0 * eigen.eigenvectors()(0, k) * eigen.eigenvectors()(0, k);
+  }
+}
+
+IgaSpace::IgaSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
+  const auto bu = patch_.u_basis().breakpoints(), bv = patch_.v_basis().breakpoints();
+  elements_u_ = static_cast<int>(bu.size()) - 1;
+  elements_v_ = static_cast<int>(bv.size()) - 1;
+  std::vector<double> gu, wu, gv, wv;
+  gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
+  gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
+  for (int ev = 0; ev < elements_v_; ++ev) {
+    for (int eu = 0; eu < elements_u_; ++eu) {
+      const double u0 = bu[static_cast<size_t>(eu)], u1 = bu[static_cast<size_t>(eu) + 1];
+      const double v0 = bv[static_cast<size_t>(ev)], v1 = bv[static_cast<size_t>(ev) + 1];
+      for (size_t b = 0; b < gv.size(); ++b) {
+        for (size_t a = 0; a < gu.size(); ++a) {
+          const double u = 0.5 * (u0 + u1) + 0.5 * (u1 - u0) * gu[a];
+          const double v = 0.5 * (v0 + v1) + 0.5 * (v1 - v0) * gv[b];
+          const Basis2 basis = evaluate_basis(patch_, u, v);
+          const double det = basis.jacobian.determinant();
+          if (!(det > 0.0)) {
+            throw Error("IGA patch: the parameterisation is not orientation-preserving (det J = " +
+                        std::to_string(det) + " at u = " + std::to_string(u) + ", v = " + std::to_string(v) + ")");
+          }
+          QuadraturePoint qp;
+          qp.nodes = basis.nodes;
+          qp.values = basis.r;
+          Eigen::Matrix2Xd parametric(2, basis.r.size());
+          parametric.row(0) = basis.r_u.transpose();
+          parametric.row(1) = basis.r_v.transpose();
+          qp.gradients = basis.jacobian.transpose().inverse() * parametric;
+          qp.weight = wu[a] * wv[b] * 0.25 * (u1 - u0) * (v1 - v0) * det;
+          qp.position = basis.x;
+          qp.element = eu + elements_u_ * ev;
+          points_.push_back(std::move(qp));
+        }
+      }
+    }
+  }
+}
+
+std::vector<BoundaryPoint> IgaSpace::boundary(Side side) const {
+  const bool along_u = side == Side::bottom || side == Side::top;
+  if (!along_u && patch_.u_basis().is_periodic()) {
+    throw Error("IGA patch: a periodic patch has no left or right side");
+  }
+  const auto& along = along_u ? patch_.u_basis() : patch_.v_basis();
+  const auto& across = along_u ? patch_.v_basis() : patch_.u_basis();
+  const double fixed = (side == Side::bottom || side == Side::left) ? across.lo() : across.hi();
+  const double outward = (side == Side::bottom || side == Side::left) ? -1.0 : 1.0;
+  std::vector<double> g, w;
+  gauss_legendre(along.degree() + 1, g, w);
+  const auto breaks = along.breakpoints();
+  std::vector<BoundaryPoint> out;
+  for (size_t e = 0; e + 1 < breaks.size(); ++e) {
+    for (size_t k = 0; k < g.size(); ++k) {
+      const double t = 0.5 * (breaks[e] + breaks[e + 1]) + 0.5 * (breaks[e + 1] - breaks[e]) * g[k];
+      const Basis2 b = along_u ? evaluate_basis(patch_, t, fixed) : evaluate_basis(patch_, fixed, t);
+      const Eigen::Vector2d tangent = b.jacobian.col(along_u ? 0 : 1);
+      const Eigen::Vector2d inward_direction = b.jacobian.col(along_u ? 1 : 0);
+      Eigen::Vector2d normal(tangent.y(), -tangent.x());
+      normal.normalize();
+      if (normal.dot(inward_direction) * outward < 0.0) normal = -normal;
+      BoundaryPoint bp;
+      bp.nodes = b.nodes;
+      bp.values = b.r;
+      bp.weight = w[k] * 0.5 * (breaks[e + 1] - breaks[e]) * tangent.norm();
+      bp.position = b.x;
+      bp.normal = normal;
+      bp.parameter = t;
+      out.push_back(std::move(bp));
+    }
+  }
+  return out;
+}
+
+std::vector<int> IgaSpace::side_nodes(Side side) const {
+  const int nu = patch_.u_basis().count(), nv = patch_.v_basis().count();
+  std::vector<int> out;
+  switch (side) {
+    case Side::bottom: for (int i = 0; i < nu; ++i) out.push_back(patch_.index(i, 0)); break;
+    case Side::top: for (int i = 0; i < nu; ++i) out.push_back(patch_.index(i, nv - 1)); break;
+    case Side::left:
+    case Side::right:
+      if (patch_.u_basis().is_periodic()) throw Error("IGA patch: a periodic patch has no left or right side");
+      for (int j = 0; j < nv; ++j) out.push_back(patch_.index(side == Side::left ? 0 : nu - 1, j));
+      break;
+  }
+  return out;
+}
+
+Eigen::Matrix2d IgaSpace::gradient(const QuadraturePoint& q, const Eigen::VectorXd& u) {
+  Eigen::Matrix2d h = Eigen::Matrix2d::Zero();
+  for (size_t a = 0; a < q.nodes.size(); ++a) {
+    const Eigen::Vector2d ua = u.segment<2>(2 * q.nodes[a]);
+    h += ua * q.gradients.col(static_cast<Eigen::Index>(a)).transpose();
+  }
+  return h;
+}
+
+Eigen::Vector2d IgaSpace::displacement(const Eigen::VectorXd& u, double pu, double pv) const {
+  const Basis2 b = evaluate_basis(patch_, pu, pv);
+  Eigen::Vector2d out = Eigen::Vector2d::Zero();
+  for (size_t a = 0; a < b.nodes.size(); ++a) out += b.r(static_cast<Eigen::Index>(a)) * u.segment<2>(2 * b.nodes[a]);
+  return out;
+}
+
+}  // namespace mufric::solid

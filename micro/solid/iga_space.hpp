@@ -1,0 +1,68 @@
+#pragma once
+// The isogeometric discretisation of one patch (Hughes, Cottrell & Bazilevs, CMAME 194, 2005):
+// the patch's own NURBS basis carries the displacement, elements are the non-empty knot spans,
+// (p+1)×(q+1) Gauss points per element. A periodic u basis identifies the wrapped functions, so
+// periodicity is built into the control-point (dof) numbering. Everything here is in the reference
+// configuration and computed once.
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "micro/spline/spline_surface.hpp"
+
+namespace mufric::solid {
+
+// One quadrature point of the domain: the functions that are non-zero there, their values and
+// reference gradients ∂R/∂X, and the weight × |det J|.
+struct QuadraturePoint {
+  std::vector<int> nodes;   // control-point indices (0..nodes-1)
+  Eigen::VectorXd values;   // R_a
+  Eigen::Matrix2Xd gradients;  // column a: ∂R_a/∂X
+  double weight = 0.0;
+  Eigen::Vector2d position;  // X
+  int element = 0;
+};
+
+enum class Side { bottom, top, left, right };  // v = lo, v = hi, u = lo, u = hi
+
+// A quadrature point on a boundary side: values, the weight × line Jacobian, and the outward unit
+// normal (reference configuration); `parameter` is the curve parameter along the side.
+struct BoundaryPoint {
+  std::vector<int> nodes;
+  Eigen::VectorXd values;
+  double weight = 0.0;
+  Eigen::Vector2d position, normal;
+  double parameter = 0.0;
+};
+
+class IgaSpace {
+ public:
+  explicit IgaSpace(spline::SplineSurface patch);
+
+  const spline::SplineSurface& patch() const { return patch_; }
+  int node_count() const { return patch_.u_basis().count() * patch_.v_basis().count(); }
+  int dof_count() const { return 2 * node_count(); }
+  int element_count() const { return elements_u_ * elements_v_; }
+  const std::vector<QuadraturePoint>& quadrature() const { return points_; }
+  // Gauss points along a side (throws Error for left/right of a periodic patch: it has none).
+  std::vector<BoundaryPoint> boundary(Side side) const;
+  // Control points on a side (for Dirichlet conditions).
+  std::vector<int> side_nodes(Side side) const;
+  // The nodes' reference control-point positions (for linear fields: affine covariance).
+  Eigen::Vector2d node_position(int node) const { return patch_.points().row(node).transpose(); }
+
+  // Displacement gradient and value at a quadrature point for the nodal displacements u (2 per node).
+  static Eigen::Matrix2d gradient(const QuadraturePoint& q, const Eigen::VectorXd& u);
+  // Displacement anywhere in the patch, at parameters (u, v).
+  Eigen::Vector2d displacement(const Eigen::VectorXd& u, double pu, double pv) const;
+
+ private:
+  spline::SplineSurface patch_;
+  int elements_u_ = 0, elements_v_ = 0;
+  std::vector<QuadraturePoint> points_;
+};
+
+// Gauss–Legendre nodes and weights on [−1, 1] (Golub & Welsch 1969, via the symmetric Jacobi matrix).
+void gauss_legendre(int count, std::vector<double>& nodes, std::vector<double>& weights);
+
+}  // namespace mufric::solid

@@ -1,0 +1,53 @@
+#include "micro/solid/linear_solver.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/UmfPackSupport>
+#include <vector>
+
+namespace mufric::solid {
+
+struct LinearSolver::Impl {
+  Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>> lu;
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>> cholesky;
+  std::vector<int> outer, inner;  // pattern of the last analysis
+};
+
+LinearSolver::LinearSolver(LinearSolverKind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {}
+LinearSolver::~LinearSolver() = default;
+LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
+LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
+
+bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a) {
+  const bool same_pattern =
+      analyses_ > 0 && static_cast<Eigen::Index>(impl_->outer.size()) == a.outerSize() + 1 &&
+      static_cast<Eigen::Index>(impl_->inner.size()) == a.nonZeros() &&
+      std::equal(impl_->outer.begin(), impl_->outer.end(), a.outerIndexPtr()) &&
+      std::equal(impl_->inner.begin(), impl_->inner.end(), a.innerIndexPtr());
+  if (!same_pattern) {
+    if (kind_ == LinearSolverKind::lu) impl_->lu.analyzePattern(a); else impl_->cholesky.analyzePattern(a);
+    impl_->outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1);
+    impl_->inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
+    ++analyses_;
+  }
+  if (kind_ == LinearSolverKind::lu) {
+    impl_->lu.factorize(a);
+    if (impl_->lu.info() != Eigen::Success) {
+      reason_ = "UMFPACK: the tangent is singular";
+      return false;
+    }
+  } else {
+    impl_->cholesky.factorize(a);
+    if (impl_->cholesky.info() != Eigen::Success) {
+      reason_ = "CHOLMOD: the tangent is not positive definite";
+      return false;
+    }
+  }
+  reason_.clear();
+  return true;
+}
+
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {
+  return kind_ == LinearSolverKind::lu ? Eigen::VectorXd(impl_->lu.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
+}
+
+}  // namespace mufric::solid

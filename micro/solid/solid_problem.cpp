@@ -1,0 +1,178 @@
+#include "micro/solid/solid_problem.hpp"
+
+#include <algorithm>
+
+#include "common/error.hpp"
+
+namespace mufric::solid {
+
+SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> material, MaterialState initial_state)
+    : space_(std::move(space)), material_(std::move(material)),
+      states_(space_.quadrature().size(), initial_state),
+      constrained_(static_cast<size_t>(space_.dof_count()), false) {
+  build_pattern();
+}
+
+void SolidProblem::build_pattern() {
+  const auto& qps = space_.quadrature();
+  // Quadrature points are stored element by element.
+  for (size_t k = 0; k < qps.size(); ++k) {
+    if (k == 0 || qps[k].element != qps[k - 1].element) element_first_point_.push_back(static_cast<int>(k));
+  }
+  element_first_point_.push_back(static_cast<int>(qps.size()));
+  std::vector<Eigen::Triplet<double>> triplets;
+  const size_t elements = element_first_point_.size() - 1;
+  element_dofs_.resize(elements);
+  for (size_t e = 0; e < elements; ++e) {
+    const auto& nodes = qps[static_cast<size_t>(element_first_point_[e])].nodes;
+    auto& dofs = element_dofs_[e];
+    for (const int n : nodes) dofs.insert(dofs.end(), {2 * n, 2 * n + 1});
+    for (const int r : dofs) {
+      for (const int c : dofs) triplets.emplace_back(r, c, 0.0);
+    }
+  }
+  pattern_.resize(space_.dof_count(), space_.dof_count());
+  pattern_.setFromTriplets(triplets.begin(), triplets.end());
+  pattern_.makeCompressed();
+  // Slot of each local (row, col) in the compressed value array: found once, used every assembly.
+  element_slots_.resize(elements);
+  for (size_t e = 0; e < elements; ++e) {
+    const auto& dofs = element_dofs_[e];
+    auto& slots = element_slots_[e];
+    slots.resize(dofs.size() * dofs.size());
+    for (size_t c = 0; c < dofs.size(); ++c) {
+      const int col = dofs[c];
+      const int* rows_begin = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col];
+      const int* rows_end = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col + 1];
+      for (size_t r = 0; r < dofs.size(); ++r) {
+        slots[r + dofs.size() * c] = static_cast<int>(std::lower_bound(rows_begin, rows_end, dofs[r]) -
+                                                      pattern_.innerIndexPtr());
+      }
+    }
+  }
+}
+
+void SolidProblem::add_dirichlet(DirichletCondition condition) {
+  if (condition.node < 0 || condition.node >= space_.node_count() || condition.component < 0 ||
+      condition.component > 1) {
+    throw Error("Dirichlet condition on node " + std::to_string(condition.node) + " component " +
+                std::to_string(condition.component) + ": no such dof");
+  }
+  const int dof = 2 * condition.node + condition.component;
+  if (constrained_[static_cast<size_t>(dof)]) {
+    // A later condition on the same dof replaces the earlier one.
+    std::erase_if(dirichlet_, [&](const DirichletCondition& d) { return 2 * d.node + d.component == dof; });
+  }
+  constrained_[static_cast<size_t>(dof)] = true;
+  dirichlet_.push_back(std::move(condition));
+}
+
+void SolidProblem::fix_side(Side side, int component, double value, TimeFunction scale) {
+  for (const int node : space_.side_nodes(side)) add_dirichlet({node, component, value, scale});
+}
+
+void SolidProblem::add_load(SideLoad load) {
+  space_.boundary(load.side);  // throws for a side the patch does not have
+  loads_.push_back(std::move(load));
+}
+
+void SolidProblem::apply_dirichlet(double t, Eigen::VectorXd& u) const {
+  for (const auto& d : dirichlet_) u(2 * d.node + d.component) = d.value * (d.scale ? d.scale(t) : 1.0);
+}
+
+SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double dt, bool with_tangent) const {
+  Assembly out;
+  out.internal = Eigen::VectorXd::Zero(dof_count());
+  out.states.resize(states_.size());
+  out.stresses.resize(states_.size());
+  if (with_tangent) out.tangent = pattern_;
+  double* values = with_tangent ? out.tangent.valuePtr() : nullptr;
+  const auto& qps = space_.quadrature();
+  const size_t elements = element_first_point_.size() - 1;
+  Eigen::MatrixXd local;
+  for (size_t e = 0; e < elements && out.ok; ++e) {
+    const auto& dofs = element_dofs_[e];
+    const auto n = static_cast<Eigen::Index>(dofs.size());
+    if (with_tangent) local.setZero(n, n);
+    for (int k = element_first_point_[e]; k < element_first_point_[e + 1]; ++k) {
+      const QuadraturePoint& q = qps[static_cast<size_t>(k)];
+      const StressResponse r = material_->update(IgaSpace::gradient(q, u), states_[static_cast<size_t>(k)], dt);
+      if (!r.ok) {
+        out.ok = false;
+        out.reason = r.reason + " at X = (" + std::to_string(q.position.x()) + ", " + std::to_string(q.position.y()) + ")";
+        break;
+      }
+      out.states[static_cast<size_t>(k)] = r.state;
+      out.stresses[static_cast<size_t>(k)] = r.stress;
+      const Eigen::Index nen = q.gradients.cols();
+      // f_int[a, i] += S_ij ∂R_a/∂X_j w
+      const Eigen::Matrix2Xd sg = r.stress * q.gradients * q.weight;
+      for (Eigen::Index a = 0; a < nen; ++a) out.internal.segment<2>(2 * q.nodes[static_cast<size_t>(a)]) += sg.col(a);
+      if (!with_tangent) continue;
+      // K[(a,i),(b,k)] += ∂R_a/∂X_j A_(ij)(kl) ∂R_b/∂X_l w: per node pair, G_aᵀ A G_b with G_a the
+      // 4×2 map from δu_a to δH.
+      Eigen::Matrix<double, 4, Eigen::Dynamic> ag(4, 2 * nen);  // A · (∂H/∂u) column block per dof
+      for (Eigen::Index b = 0; b < nen; ++b) {
+        for (int kk = 0; kk < 2; ++kk) {
+          // δH_kl = δu_k ∂R_b/∂X_l
+          ag.col(2 * b + kk) = r.tangent.col(2 * kk) * q.gradients(0, b) + r.tangent.col(2 * kk + 1) * q.gradients(1, b);
+        }
+      }
+      for (Eigen::Index a = 0; a < nen; ++a) {
+        for (int i = 0; i < 2; ++i) {
+          local.row(2 * a + i) += q.weight * (ag.row(2 * i) * q.gradients(0, a) + ag.row(2 * i + 1) * q.gradients(1, a));
+        }
+      }
+    }
+    if (with_tangent && out.ok) {
+      const auto& slots = element_slots_[e];
+      for (Eigen::Index c = 0; c < n; ++c) {
+        for (Eigen::Index r = 0; r < n; ++r) values[slots[static_cast<size_t>(r + n * c)]] += local(r, c);
+      }
+    }
+  }
+  return out;
+}
+
+Eigen::VectorXd SolidProblem::external(double t) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(dof_count());
+  for (const auto& load : loads_) {
+    const double s = load.scale ? load.scale(t) : 1.0;
+    for (const auto& bp : space_.boundary(load.side)) {
+      const Eigen::Vector2d traction = s * (load.traction - load.pressure * bp.normal);
+      for (size_t a = 0; a < bp.nodes.size(); ++a) {
+        f.segment<2>(2 * bp.nodes[a]) += bp.values(static_cast<Eigen::Index>(a)) * bp.weight * traction;
+      }
+    }
+  }
+  return f;
+}
+
+const SparseMatrix& SolidProblem::mass() const {
+  if (mass_.nonZeros() > 0) return mass_;
+  mass_ = pattern_;
+  double* values = mass_.valuePtr();
+  const auto& qps = space_.quadrature();
+  const double rho = material_->density();
+  for (size_t e = 0; e + 1 < element_first_point_.size(); ++e) {
+    const auto& slots = element_slots_[e];
+    const auto n = static_cast<Eigen::Index>(element_dofs_[e].size());
+    for (int k = element_first_point_[e]; k < element_first_point_[e + 1]; ++k) {
+      const QuadraturePoint& q = qps[static_cast<size_t>(k)];
+      const Eigen::Index nen = q.values.size();
+      for (Eigen::Index b = 0; b < nen; ++b) {
+        for (Eigen::Index a = 0; a < nen; ++a) {
+          const double m = rho * q.values(a) * q.values(b) * q.weight;
+          for (int i = 0; i < 2; ++i) values[slots[static_cast<size_t>((2 * a + i) + n * (2 * b + i))]] += m;
+        }
+      }
+    }
+  }
+  return mass_;
+}
+
+double SolidProblem::elastic_energy(const Eigen::VectorXd& u) const {
+  return 0.5 * u.dot(assemble(u, 1.0, false).internal);
+}
+
+}  // namespace mufric::solid

@@ -1,0 +1,86 @@
+#pragma once
+// The chip as a boundary-value problem: one IGA patch, one material, Dirichlet conditions on
+// control-point displacement components and dead tractions on sides, each scaled by a function of
+// time. Assembles internal forces, the tangent (a fixed sparsity pattern, filled element by
+// element), external forces and the consistent mass matrix.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Sparse>
+
+#include "micro/solid/iga_space.hpp"
+#include "micro/solid/materials.hpp"
+
+namespace mufric::solid {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using TimeFunction = std::function<double(double)>;  // scale of a boundary condition at time t
+
+struct DirichletCondition {
+  int node = 0, component = 0;  // component 0: x, 1: y
+  double value = 0.0;           // m, multiplied by scale(t)
+  TimeFunction scale;           // empty: 1
+};
+
+struct SideLoad {
+  Side side = Side::top;
+  Eigen::Vector2d traction = Eigen::Vector2d::Zero();  // N/m² (force per reference length and unit depth)
+  double pressure = 0.0;  // Pa, acting against the reference outward normal (dead load)
+  TimeFunction scale;     // empty: 1
+};
+
+class SolidProblem {
+ public:
+  SolidProblem(IgaSpace space, std::shared_ptr<const Material> material,
+               MaterialState initial_state = MaterialState());
+
+  const IgaSpace& space() const { return space_; }
+  const Material& material() const { return *material_; }
+  int dof_count() const { return space_.dof_count(); }
+
+  void add_dirichlet(DirichletCondition condition);
+  // Every control point of a side, one component.
+  void fix_side(Side side, int component, double value = 0.0, TimeFunction scale = {});
+  void add_load(SideLoad load);
+  const std::vector<DirichletCondition>& dirichlet() const { return dirichlet_; }
+  // true for each dof that carries a Dirichlet condition
+  const std::vector<bool>& constrained() const { return constrained_; }
+  // Prescribed values at time t written into u (other entries untouched).
+  void apply_dirichlet(double t, Eigen::VectorXd& u) const;
+
+  struct Assembly {
+    Eigen::VectorXd internal;           // f_int(u)
+    SparseMatrix tangent;               // ∂f_int/∂u (when requested)
+    std::vector<MaterialState> states;  // trial states at u
+    std::vector<Eigen::Matrix2d> stresses;  // S at each quadrature point
+    bool ok = true;
+    std::string reason;
+  };
+  // Internal forces at u from the committed states (step length dt for rates); never commits.
+  Assembly assemble(const Eigen::VectorXd& u, double dt, bool with_tangent) const;
+  Eigen::VectorXd external(double t) const;
+  const SparseMatrix& mass() const;  // consistent, ∫ρ R_a R_b dX, built on first use
+
+  const std::vector<MaterialState>& states() const { return states_; }
+  void commit(std::vector<MaterialState> states) { states_ = std::move(states); }
+  // Strain energy ½ uᵀ f_int for linear elastic problems (energy checks).
+  double elastic_energy(const Eigen::VectorXd& u) const;
+
+ private:
+  void build_pattern();
+  IgaSpace space_;
+  std::shared_ptr<const Material> material_;
+  std::vector<MaterialState> states_;  // one per quadrature point, committed
+  std::vector<DirichletCondition> dirichlet_;
+  std::vector<bool> constrained_;
+  std::vector<SideLoad> loads_;
+  SparseMatrix pattern_;                       // structure of the tangent, values zero
+  std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col)
+  std::vector<std::vector<int>> element_dofs_;
+  std::vector<int> element_first_point_;       // quadrature points of element e: [first[e], first[e+1])
+  mutable SparseMatrix mass_;
+};
+
+}  // namespace mufric::solid

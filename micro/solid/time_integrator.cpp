@@ -1,0 +1,230 @@
+#include "micro/solid/time_integrator.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace mufric::solid {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Rows and columns of constrained dofs become identity rows/columns (symmetry kept).
+void constrain(SparseMatrix& k, const std::vector<bool>& constrained) {
+  for (int col = 0; col < k.outerSize(); ++col) {
+    for (SparseMatrix::InnerIterator it(k, col); it; ++it) {
+      if (constrained[static_cast<size_t>(it.row())] || constrained[static_cast<size_t>(col)]) {
+        it.valueRef() = it.row() == col ? 1.0 : 0.0;
+      }
+    }
+  }
+}
+
+double free_norm(const Eigen::VectorXd& g, const std::vector<bool>& constrained) {
+  double s = 0.0;
+  for (Eigen::Index i = 0; i < g.size(); ++i) {
+    if (!constrained[static_cast<size_t>(i)]) s += g(i) * g(i);
+  }
+  return std::sqrt(s);
+}
+
+}  // namespace
+
+TimeIntegrator::TimeIntegrator(SolidProblem& problem, TimeIntegrationOptions options)
+    : problem_(problem), options_(options), solver_(options.linear_solver) {
+  if (!(options_.dt > 0.0) || !(options_.end_time > 0.0)) throw Error("time integration: dt and end_time must be positive");
+  if (!(options_.spectral_radius >= 0.0 && options_.spectral_radius <= 1.0)) {
+    throw Error("time integration: the spectral radius must lie in [0, 1]");
+  }
+  const auto n = problem_.dof_count();
+  u_ = v_ = a_ = reactions_ = Eigen::VectorXd::Zero(n);
+  f_int_ = problem_.assemble(u_, options_.dt, false).internal;
+}
+
+double TimeIntegrator::alpha_m() const {
+  const double r = options_.spectral_radius;
+  return (2.0 * r - 1.0) / (r + 1.0);
+}
+double TimeIntegrator::alpha_f() const { return options_.spectral_radius / (options_.spectral_radius + 1.0); }
+double TimeIntegrator::gamma() const { return 0.5 - alpha_m() + alpha_f(); }
+double TimeIntegrator::beta() const {
+  const double s = 1.0 - alpha_m() + alpha_f();
+  return 0.25 * s * s;
+}
+
+void TimeIntegrator::set_initial(const Eigen::VectorXd& u, const Eigen::VectorXd& v) {
+  u_ = u;
+  v_ = v;
+  const auto assembly = problem_.assemble(u_, options_.dt, false);
+  if (!assembly.ok) throw Error("time integration: initial state: " + assembly.reason);
+  f_int_ = assembly.internal;
+  a_.setZero(u_.size());
+  if (options_.scheme == TimeScheme::generalized_alpha) {
+    SparseMatrix m = problem_.mass();
+    constrain(m, problem_.constrained());
+    Eigen::VectorXd rhs = problem_.external(0.0) - f_int_;
+    for (Eigen::Index i = 0; i < rhs.size(); ++i) {
+      if (problem_.constrained()[static_cast<size_t>(i)]) rhs(i) = 0.0;
+    }
+    LinearSolver mass_solver(LinearSolverKind::cholesky);
+    if (!mass_solver.factorize(m)) throw Error("time integration: the mass matrix is singular");
+    a_ = mass_solver.solve(rhs);
+  }
+}
+
+TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
+  Attempt at;
+  const bool dynamic = options_.scheme == TimeScheme::generalized_alpha;
+  const double am = alpha_m(), af = alpha_f(), b = beta(), g = gamma();
+  const double t1 = t0 + dt;
+  const auto& constrained = problem_.constrained();
+  Eigen::VectorXd u1 = dynamic ? Eigen::VectorXd(u_ + dt * v_ + 0.5 * dt * dt * a_) : u_;
+  problem_.apply_dirichlet(t1, u1);
+  const Eigen::VectorXd f_ext1 = problem_.external(t1), f_ext0 = problem_.external(t0);
+  const SparseMatrix* mass = dynamic ? &problem_.mass() : nullptr;
+  const double mass_factor = dynamic ? (1.0 - am) / (b * dt * dt) : 0.0;
+  const double stiffness_factor = dynamic ? 1.0 - af : 1.0;
+
+  // The residual G(u1) and the quantities that come with it.
+  struct Evaluation {
+    SolidProblem::Assembly assembly;
+    Eigen::VectorXd residual, a1;
+    double norm = 0.0, scale = 0.0;
+  };
+  auto evaluate = [&](const Eigen::VectorXd& u, bool with_tangent) {
+    Evaluation e;
+    const auto start = std::chrono::steady_clock::now();
+    e.assembly = problem_.assemble(u, dt, with_tangent);
+    report_.seconds_assembly += seconds_since(start);
+    if (!e.assembly.ok) return e;
+    if (dynamic) {
+      e.a1 = (u - u_ - dt * v_ - dt * dt * (0.5 - b) * a_) / (b * dt * dt);
+      const Eigen::VectorXd inertia = *mass * ((1.0 - am) * e.a1 + am * a_);
+      e.residual = inertia + (1.0 - af) * e.assembly.internal + af * f_int_ - (1.0 - af) * f_ext1 - af * f_ext0;
+      e.scale = std::max({e.assembly.internal.norm(), f_ext1.norm(), inertia.norm()});
+    } else {
+      e.residual = e.assembly.internal - f_ext1;
+      e.scale = std::max(e.assembly.internal.norm(), f_ext1.norm());
+    }
+    e.norm = free_norm(e.residual, constrained);
+    return e;
+  };
+
+  Evaluation current = evaluate(u1, true);
+  double force_scale = 0.0;
+  for (int it = 0;; ++it) {
+    if (!current.assembly.ok) {
+      at.reason = current.assembly.reason;
+      return at;
+    }
+    if (!std::isfinite(current.norm)) {
+      at.reason = "the residual is not finite";
+      return at;
+    }
+    force_scale = std::max(force_scale, current.scale);
+    const double tolerance = options_.relative_tolerance * force_scale + 1e-300;
+    at.record.residual = current.norm;
+    at.record.newton_iterations = it;
+    if (current.norm <= tolerance) break;
+    if (it >= options_.max_newton_iterations) {
+      at.reason = "Newton did not converge in " + std::to_string(it) + " iterations (residual " +
+                  std::to_string(current.norm) + " N, tolerance " + std::to_string(tolerance) + " N)";
+      return at;
+    }
+    SparseMatrix k = std::move(current.assembly.tangent);
+    if (stiffness_factor != 1.0) k *= stiffness_factor;
+    if (dynamic) {
+      // Same pattern as the tangent: add value arrays.
+      Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
+          mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
+    }
+    constrain(k, constrained);
+    Eigen::VectorXd rhs = -current.residual;
+    for (Eigen::Index i = 0; i < rhs.size(); ++i) {
+      if (constrained[static_cast<size_t>(i)]) rhs(i) = 0.0;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    if (!solver_.factorize(k)) {
+      at.reason = solver_.reason();
+      return at;
+    }
+    const Eigen::VectorXd delta = solver_.solve(rhs);
+    report_.seconds_solve += seconds_since(start);
+    // Line search on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction.
+    const double phi0 = current.norm * current.norm;
+    double s = 1.0;
+    Evaluation trial = evaluate(u1 + delta, false);
+    if (options_.line_search) {
+      for (int r = 0; r < kLineSearchMaxReductions; ++r) {
+        const double phi1 = trial.assembly.ok ? trial.norm * trial.norm : std::numeric_limits<double>::infinity();
+        if (phi1 <= (1.0 - 2.0 * kLineSearchSufficientDecrease * s) * phi0) break;
+        const double minimiser = std::isfinite(phi1) ? phi0 * s * s / (phi1 - phi0 + 2.0 * phi0 * s) : 0.1 * s;
+        s = std::clamp(minimiser, 0.1 * s, 0.5 * s);
+        trial = evaluate(u1 + s * delta, false);
+        ++at.record.line_search_reductions;
+      }
+    }
+    u1 += s * delta;
+    const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
+                           trial.norm <= 1e3 * tolerance;
+    current = evaluate(u1, !stagnated);
+    if (stagnated && current.assembly.ok) {
+      at.record.newton_iterations = it + 1;
+      at.record.residual = current.norm;
+      break;
+    }
+  }
+  // Accept.
+  problem_.commit(std::move(current.assembly.states));
+  stresses_ = std::move(current.assembly.stresses);
+  if (dynamic) {
+    v_ += dt * ((1.0 - g) * a_ + g * current.a1);
+    a_ = current.a1;
+  }
+  u_ = u1;
+  f_int_ = current.assembly.internal;
+  reactions_.setZero(u_.size());
+  for (Eigen::Index i = 0; i < u_.size(); ++i) {
+    if (constrained[static_cast<size_t>(i)]) reactions_(i) = current.residual(i);
+  }
+  at.ok = true;
+  at.record.time = t1;
+  at.record.dt = dt;
+  return at;
+}
+
+IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>& on_step) {
+  report_ = IntegrationReport();
+  double t = 0.0, dt = options_.dt;
+  int consecutive_cuts = 0;
+  const double end_tolerance = 1e-12 * options_.end_time;
+  while (t < options_.end_time - end_tolerance) {
+    const double this_dt = std::min(dt, options_.end_time - t);
+    const std::vector<MaterialState> saved_states = problem_.states();
+    const Attempt at = step(t, this_dt);
+    if (!at.ok) {
+      problem_.commit(saved_states);
+      report_.cutbacks.push_back({t, this_dt, at.reason});
+      if (++consecutive_cuts > options_.max_cutbacks) {
+        report_.reason = "step at t = " + std::to_string(t) + " s failed after " + std::to_string(options_.max_cutbacks) +
+                         " cut-backs: " + at.reason;
+        return report_;
+      }
+      dt = 0.5 * this_dt;
+      continue;
+    }
+    consecutive_cuts = 0;
+    t += this_dt;
+    report_.steps.push_back(at.record);
+    report_.newton_iterations += at.record.newton_iterations;
+    if (on_step) on_step(StepView{t, u_, v_, a_, reactions_, stresses_, problem_});
+    dt = std::min(options_.dt, 2.0 * dt);  // grow back after a cut-back
+  }
+  report_.completed = true;
+  return report_;
+}
+
+}  // namespace mufric::solid
