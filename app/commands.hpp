@@ -6,4 +6,5 @@ namespace mufric::app {
 void add_surrogate_commands(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_service_commands(CLI::App& app);
+void add_micro_commands(CLI::App& app);
 }  // namespace mufric::app

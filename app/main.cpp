@@ -13,12 +13,14 @@ int main(int argc, char** argv) {
   CLI::App app{
       "mufric — a friction service for machining simulation.\n"
       "Answers mu(contact pressure, sliding velocity, temperature) with a confidence interval from a\n"
-      "Gaussian-process surrogate or an empirical law. Quantities carry units: 800MPa, 100m/min, 500C."};
+      "Gaussian-process surrogate or an empirical law, learned from a high-fidelity micro-model of the\n"
+      "contact zone (`mufric micro`). Quantities carry units: 800MPa, 100m/min, 500C."};
   app.set_version_flag("--version", mufric::code_version());
   app.require_subcommand(1);
   mufric::app::add_surrogate_commands(app);
   mufric::app::add_bench_command(app);
   mufric::app::add_service_commands(app);
+  mufric::app::add_micro_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -140,6 +140,33 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   EXPECT_NE(text.find("SIGTERM: draining"), std::string::npos) << text;
 }
 
+TEST_F(Cli, MicroProfileReportsRoughnessAndFitError) {
+  CommandResult r = run("micro profile --ra 0.25um --correlation 1um --length 20um --seed 3 --out " + path("fit.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Ra 0.25um"), std::string::npos) << r.output;  // scaled to the request exactly
+  EXPECT_NE(r.output.find("max error"), std::string::npos) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(path("fit.csv")));
+  // The written data, read back as a measured profile (microns in the header), fits the same way.
+  std::ofstream(path("measured.csv")) << "x[um],height[um]\n";
+  {
+    std::ifstream in(path("fit.csv"));
+    std::ofstream out(path("measured.csv"), std::ios::app);
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) out << line.substr(0, line.find(',', line.find(',') + 1)) << "\n";
+  }
+  r = run("micro profile --csv " + path("measured.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Ra 0.25um"), std::string::npos) << r.output;
+  r = run("micro profile --ra 0.2 --length 10um");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--ra"), std::string::npos) << r.output;
+  std::ofstream(path("bad.csv")) << "x[um],height[um]\n0,0\n1,0\n2,0\n2,1\n4,0\n5,0\n6,0\n7,0\n8,0\n9,0\n10,0\n";
+  r = run("micro profile --csv " + path("bad.csv"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("bad.csv:5"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, CorruptModelIsRefused) {
   std::ofstream(path("bad.h5")) << "not a model";
   const CommandResult r = run("predict --model " + path("bad.h5") + " --p 800MPa --v 100m/min --T 500C");
