@@ -175,4 +175,31 @@ Eigen::Vector2d IgaSpace::displacement(const Eigen::VectorXd& u, double pu, doub
   return out;
 }
 
+spline::SplineSurface chip_patch(const spline::SplineCurve& surface, const ChipMeshOptions& options) {
+  if (!surface.basis().is_periodic()) throw Error("chip patch: the surface curve must be periodic (one interval)");
+  if (options.degree < surface.basis().degree()) {
+    throw Error("chip patch: degree " + std::to_string(options.degree) + " is below the surface fit's degree " +
+                std::to_string(surface.basis().degree()));
+  }
+  const int existing = static_cast<int>(surface.basis().breakpoints().size()) - 1;
+  if (options.spans_x < existing || options.spans_y < 1) {
+    throw Error("chip patch: spans_x must be at least the surface fit's " + std::to_string(existing) +
+                " spans and spans_y at least 1");
+  }
+  const double top_min = surface.points().col(1).minCoeff();
+  if (!(options.y_bottom < top_min)) throw Error("chip patch: y_bottom must lie below the surface");
+  spline::SplineCurve top = surface;
+  while (top.basis().degree() < options.degree) top = top.elevated();
+  // Split the longest spans until there are spans_x of them (keeps the fit's own knots).
+  while (static_cast<int>(top.basis().breakpoints().size()) - 1 < options.spans_x) {
+    const auto b = top.basis().breakpoints();
+    size_t longest = 0;
+    for (size_t e = 1; e + 1 < b.size(); ++e) {
+      if (b[e + 1] - b[e] > b[longest + 1] - b[longest]) longest = e;
+    }
+    top = top.with_knot(0.5 * (b[longest] + b[longest + 1]));
+  }
+  return spline::SplineSurface::extruded(top, options.y_bottom, options.degree, options.spans_y);
+}
+
 }  // namespace mufric::solid

@@ -62,6 +62,17 @@ class IgaSpace {
   std::vector<QuadraturePoint> points_;
 };
 
+// The chip patch of one periodic interval from its configuration: the surface curve (periodic,
+// shift (L, 0)) raised to `degree` along x and refined to `spans_x` spans, extruded down to
+// y_bottom with `degree` and `spans_y` spans across the thickness.
+struct ChipMeshOptions {
+  int degree = 2;
+  int spans_x = 32;   // spans along the interval (at least the surface fit's own spans)
+  int spans_y = 8;    // spans across the thickness
+  double y_bottom = -5e-6;  // m, the loaded bottom Γ_B
+};
+spline::SplineSurface chip_patch(const spline::SplineCurve& surface, const ChipMeshOptions& options);
+
 // Gauss–Legendre nodes and weights on [−1, 1] (Golub & Welsch 1969, via the symmetric Jacobi matrix).
 void gauss_legendre(int count, std::vector<double>& nodes, std::vector<double>& weights);
 

@@ -209,6 +209,7 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
       problem_.commit(saved_states);
       report_.cutbacks.push_back({t, this_dt, at.reason});
       if (++consecutive_cuts > options_.max_cutbacks) {
+        report_.symbolic_analyses = solver_.analyses();
         report_.reason = "step at t = " + std::to_string(t) + " s failed after " + std::to_string(options_.max_cutbacks) +
                          " cut-backs: " + at.reason;
         return report_;
@@ -224,6 +225,7 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     dt = std::min(options_.dt, 2.0 * dt);  // grow back after a cut-back
   }
   report_.completed = true;
+  report_.symbolic_analyses = solver_.analyses();
   return report_;
 }
 

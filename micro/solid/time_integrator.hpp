@@ -52,6 +52,7 @@ struct IntegrationReport {
   std::vector<StepRecord> steps;
   std::vector<CutBack> cutbacks;
   int newton_iterations = 0;
+  int symbolic_analyses = 0;  // sparse symbolic factorisations (1 per run: the pattern is fixed)
   double seconds_assembly = 0.0, seconds_solve = 0.0;
 };
 
