@@ -69,77 +69,70 @@ Eigen::Vector2d SplineSurface::point(double u, double v) const {
   return a / w;
 }
 
-SplineCurve SplineSurface::row(int j) const {
-  Points2 p(u_.count(), 2);
-  Eigen::VectorXd w(is_rational() ? u_.count() : 0);
-  for (int i = 0; i < u_.count(); ++i) {
-    p.row(i) = points_.row(index(i, j));
-    if (is_rational()) w(i) = weights_(index(i, j));
+SplineCurve SplineSurface::curve_through(const SplineBasis& basis, const std::vector<int>& indices,
+                                         const Eigen::Vector2d& shift) const {
+  const auto n = static_cast<Eigen::Index>(indices.size());
+  Points2 p(n, 2);
+  Eigen::VectorXd w(is_rational() ? n : 0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    p.row(k) = points_.row(indices[static_cast<size_t>(k)]);
+    if (is_rational()) w(k) = weights_(indices[static_cast<size_t>(k)]);
   }
-  return SplineCurve(u_, std::move(p), std::move(w), shift_);
+  return SplineCurve(basis, std::move(p), std::move(w), shift);
+}
+
+SplineCurve SplineSurface::row(int j) const {
+  std::vector<int> indices;
+  for (int i = 0; i < u_.count(); ++i) indices.push_back(index(i, j));
+  return curve_through(u_, indices, shift_);
 }
 
 SplineCurve SplineSurface::column(int i) const {
-  Points2 p(v_.count(), 2);
-  Eigen::VectorXd w(is_rational() ? v_.count() : 0);
-  for (int j = 0; j < v_.count(); ++j) {
-    p.row(j) = points_.row(index(i, j));
-    if (is_rational()) w(j) = weights_(index(i, j));
-  }
-  return SplineCurve(v_, std::move(p), std::move(w));
+  std::vector<int> indices;
+  for (int j = 0; j < v_.count(); ++j) indices.push_back(index(i, j));
+  return curve_through(v_, indices, Eigen::Vector2d::Zero());
 }
 
-SplineSurface SplineSurface::from_rows(const std::vector<SplineCurve>& rows, const SplineBasis& v_basis) {
-  const SplineBasis& u = rows.front().basis();
-  const bool rational = rows.front().is_rational();
-  Points2 p(u.count() * v_basis.count(), 2);
+SplineSurface SplineSurface::from_curves(const std::vector<SplineCurve>& curves, const SplineBasis& across,
+                                         bool curves_along_u, const Eigen::Vector2d& shift) {
+  const SplineBasis& along = curves.front().basis();
+  const SplineBasis& u = curves_along_u ? along : across;
+  const SplineBasis& v = curves_along_u ? across : along;
+  const bool rational = curves.front().is_rational();
+  Points2 p(u.count() * v.count(), 2);
   Eigen::VectorXd w(rational ? p.rows() : 0);
-  for (int j = 0; j < v_basis.count(); ++j) {
-    for (int i = 0; i < u.count(); ++i) {
-      p.row(i + u.count() * j) = rows[static_cast<size_t>(j)].points().row(i);
-      if (rational) w(i + u.count() * j) = rows[static_cast<size_t>(j)].weights()(i);
+  for (int c = 0; c < across.count(); ++c) {
+    for (int k = 0; k < along.count(); ++k) {
+      const int i = curves_along_u ? k : c, j = curves_along_u ? c : k;
+      p.row(i + u.count() * j) = curves[static_cast<size_t>(c)].points().row(k);
+      if (rational) w(i + u.count() * j) = curves[static_cast<size_t>(c)].weights()(k);
     }
   }
-  return SplineSurface(u, v_basis, std::move(p), std::move(w), rows.front().shift());
-}
-
-SplineSurface SplineSurface::from_columns(const std::vector<SplineCurve>& columns, const SplineBasis& u_basis,
-                                          const Eigen::Vector2d& shift) {
-  const SplineBasis& v = columns.front().basis();
-  const bool rational = columns.front().is_rational();
-  Points2 p(u_basis.count() * v.count(), 2);
-  Eigen::VectorXd w(rational ? p.rows() : 0);
-  for (int i = 0; i < u_basis.count(); ++i) {
-    for (int j = 0; j < v.count(); ++j) {
-      p.row(i + u_basis.count() * j) = columns[static_cast<size_t>(i)].points().row(j);
-      if (rational) w(i + u_basis.count() * j) = columns[static_cast<size_t>(i)].weights()(j);
-    }
-  }
-  return SplineSurface(u_basis, v, std::move(p), std::move(w), shift);
+  return SplineSurface(u, v, std::move(p), std::move(w), shift);
 }
 
 SplineSurface SplineSurface::refined_u(const std::vector<double>& us) const {
   std::vector<SplineCurve> rows;
   for (int j = 0; j < v_.count(); ++j) rows.push_back(row(j).refined(us));
-  return from_rows(rows, v_);
+  return from_curves(rows, v_, true, rows.front().shift());
 }
 
 SplineSurface SplineSurface::refined_v(const std::vector<double>& vs) const {
   std::vector<SplineCurve> columns;
   for (int i = 0; i < u_.count(); ++i) columns.push_back(column(i).refined(vs));
-  return from_columns(columns, u_, shift_);
+  return from_curves(columns, u_, false, shift_);
 }
 
 SplineSurface SplineSurface::elevated_u() const {
   std::vector<SplineCurve> rows;
   for (int j = 0; j < v_.count(); ++j) rows.push_back(row(j).elevated());
-  return from_rows(rows, v_);
+  return from_curves(rows, v_, true, rows.front().shift());
 }
 
 SplineSurface SplineSurface::elevated_v() const {
   std::vector<SplineCurve> columns;
   for (int i = 0; i < u_.count(); ++i) columns.push_back(column(i).elevated());
-  return from_columns(columns, u_, shift_);
+  return from_curves(columns, u_, false, shift_);
 }
 
 namespace {

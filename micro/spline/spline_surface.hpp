@@ -48,10 +48,13 @@ class SplineSurface {
   static SplineSurface extruded(const SplineCurve& top, double y_bottom, int v_degree, int v_spans);
 
  private:
-  // Builds a surface from curves along u (one per v function) or along v (one per u function).
-  static SplineSurface from_rows(const std::vector<SplineCurve>& rows, const SplineBasis& v_basis);
-  static SplineSurface from_columns(const std::vector<SplineCurve>& columns, const SplineBasis& u_basis,
-                                    const Eigen::Vector2d& shift);
+  // The curve whose control points are points_(indices) (a row or a column of the net).
+  SplineCurve curve_through(const SplineBasis& basis, const std::vector<int>& indices,
+                            const Eigen::Vector2d& shift) const;
+  // Builds a surface from curves along u (one per function of `across` = v) or along v (one per
+  // function of `across` = u).
+  static SplineSurface from_curves(const std::vector<SplineCurve>& curves, const SplineBasis& across,
+                                   bool curves_along_u, const Eigen::Vector2d& shift);
   SplineBasis u_, v_;
   Points2 points_;
   Eigen::VectorXd weights_;
