@@ -12,9 +12,13 @@
 #include "common/error.hpp"
 #include "micro/solid/time_integrator.hpp"
 #include "micro/spline/profile.hpp"
+#include "solid_test_support.hpp"
 
 namespace mufric::solid {
 namespace {
+
+using test::expect_tangent_matches_finite_differences;
+using test::solve_static;
 
 using spline::Points2;
 using spline::SplineBasis;
@@ -33,19 +37,6 @@ SplineSurface quad_patch(const Eigen::Vector2d& p00, const Eigen::Vector2d& p10,
 
 SplineSurface unit_square(int degree, int spans) {
   return quad_patch({0, 0}, {1, 0}, {0, 1}, {1, 1}, degree, spans, spans);
-}
-
-// One quasi-static step of a linear problem, solved to 1e-13 of its force scale.
-Eigen::VectorXd solve_static(SolidProblem& problem, LinearSolverKind solver = LinearSolverKind::lu) {
-  TimeIntegrationOptions options;
-  options.scheme = TimeScheme::quasi_static;
-  options.dt = options.end_time = 1.0;
-  options.relative_tolerance = 1e-13;
-  options.linear_solver = solver;
-  TimeIntegrator integrator(problem, options);
-  const IntegrationReport report = integrator.run();
-  EXPECT_TRUE(report.completed) << report.reason;
-  return integrator.u();
 }
 
 // ---- Johnson–Cook: plane-strain isochoric extension, F = diag(λ, 1/λ, 1), log strain e = ln λ.
@@ -157,24 +148,6 @@ TEST(JohnsonCook, RateTermNeverLowersTheYieldStressBelowItsReferenceValue) {
 }
 
 // ---- Consistent tangent: K w against central differences of f_int, elastic and plastic states.
-void expect_tangent_matches_finite_differences(const SolidProblem& problem, const Eigen::VectorXd& u, double dt,
-                                               const std::string& what) {
-  const auto at = problem.assemble(u, dt, true);
-  ASSERT_TRUE(at.ok) << at.reason;
-  std::mt19937_64 rng(1);
-  std::normal_distribution<double> normal;
-  for (int trial = 0; trial < 3; ++trial) {
-    Eigen::VectorXd w(u.size());
-    for (auto& x : w) x = normal(rng);
-    const double h = 1e-7 * (u.cwiseAbs().maxCoeff() + 1e-9) / w.cwiseAbs().maxCoeff();
-    const Eigen::VectorXd fd =
-        (problem.assemble(u + h * w, dt, false).internal - problem.assemble(u - h * w, dt, false).internal) / (2 * h);
-    const Eigen::VectorXd kw = at.tangent * w;
-    const double mismatch = std::sqrt((kw - fd).squaredNorm()), size = std::sqrt(kw.squaredNorm());
-    EXPECT_LT(mismatch, 2e-6 * size) << what;
-  }
-}
-
 TEST(SolidTangent, ConsistentTangentMatchesFiniteDifferencesElasticAndPlastic) {
   const auto material = std::make_shared<J2JohnsonCook>(JohnsonCookParameters());
   SolidProblem problem(IgaSpace(quad_patch({0, 0}, {1e-5, 0.1e-5}, {0, 1e-5}, {1.2e-5, 1.1e-5}, 2, 2, 2)), material);

@@ -109,7 +109,7 @@ IgaSpace::IgaSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
   }
 }
 
-std::vector<BoundaryPoint> IgaSpace::boundary(Side side) const {
+std::vector<BoundaryPoint> IgaSpace::boundary(Side side, int points_per_span) const {
   const bool along_u = side == Side::bottom || side == Side::top;
   if (!along_u && patch_.u_basis().is_periodic()) {
     throw Error("IGA patch: a periodic patch has no left or right side");
@@ -119,7 +119,7 @@ std::vector<BoundaryPoint> IgaSpace::boundary(Side side) const {
   const double fixed = (side == Side::bottom || side == Side::left) ? across.lo() : across.hi();
   const double outward = (side == Side::bottom || side == Side::left) ? -1.0 : 1.0;
   std::vector<double> g, w;
-  gauss_legendre(along.degree() + 1, g, w);
+  gauss_legendre(points_per_span > 0 ? points_per_span : along.degree() + 1, g, w);
   const auto breaks = along.breakpoints();
   std::vector<BoundaryPoint> out;
   for (size_t e = 0; e + 1 < breaks.size(); ++e) {

@@ -44,8 +44,9 @@ class IgaSpace {
   int dof_count() const { return 2 * node_count(); }
   int element_count() const { return elements_u_ * elements_v_; }
   const std::vector<QuadraturePoint>& quadrature() const { return points_; }
-  // Gauss points along a side (throws Error for left/right of a periodic patch: it has none).
-  std::vector<BoundaryPoint> boundary(Side side) const;
+  // Gauss points along a side, `points_per_span` per span (0: degree + 1). Throws Error for left or
+  // right of a periodic patch: it has none.
+  std::vector<BoundaryPoint> boundary(Side side, int points_per_span = 0) const;
   // Control points on a side (for Dirichlet conditions).
   std::vector<int> side_nodes(Side side) const;
   // The nodes' reference control-point positions (for linear fields: affine covariance).

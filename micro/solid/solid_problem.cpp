@@ -13,8 +13,25 @@ SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> mater
   build_pattern();
 }
 
+void TangentAccumulator::add(int row, int col, double value) {
+  const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
+  const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
+  const int* at = std::lower_bound(begin, end, row);
+  if (at == end || *at != row) throw Error("tangent: entry (" + std::to_string(row) + ", " + std::to_string(col) + ") is not in the pattern");
+  matrix_.valuePtr()[at - matrix_.innerIndexPtr()] += value;
+}
+
+void SolidProblem::add_interaction(std::shared_ptr<const BoundaryInteraction> interaction) {
+  interactions_.push_back(std::move(interaction));
+  mass_ = SparseMatrix();
+  build_pattern();
+}
+
 void SolidProblem::build_pattern() {
   const auto& qps = space_.quadrature();
+  element_first_point_.clear();
+  element_dofs_.clear();
+  element_slots_.clear();
   // Quadrature points are stored element by element.
   for (size_t k = 0; k < qps.size(); ++k) {
     if (k == 0 || qps[k].element != qps[k - 1].element) element_first_point_.push_back(static_cast<int>(k));
@@ -29,6 +46,17 @@ void SolidProblem::build_pattern() {
     for (const int n : nodes) dofs.insert(dofs.end(), {2 * n, 2 * n + 1});
     for (const int r : dofs) {
       for (const int c : dofs) triplets.emplace_back(r, c, 0.0);
+    }
+  }
+  for (const auto& interaction : interactions_) {
+    for (const auto& group : interaction->coupled_nodes()) {
+      for (const int a : group) {
+        for (const int b : group) {
+          for (int i = 0; i < 2; ++i) {
+            for (int k = 0; k < 2; ++k) triplets.emplace_back(2 * a + i, 2 * b + k, 0.0);
+          }
+        }
+      }
     }
   }
   pattern_.resize(space_.dof_count(), space_.dof_count());
@@ -128,6 +156,15 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
       const auto& slots = element_slots_[e];
       for (Eigen::Index c = 0; c < n; ++c) {
         for (Eigen::Index r = 0; r < n; ++r) values[slots[static_cast<size_t>(r + n * c)]] += local(r, c);
+      }
+    }
+  }
+  if (out.ok) {
+    TangentAccumulator accumulator(out.tangent);
+    for (const auto& interaction : interactions_) {
+      if (!interaction->add(u, out.internal, with_tangent ? &accumulator : nullptr, out.reason)) {
+        out.ok = false;
+        break;
       }
     }
   }

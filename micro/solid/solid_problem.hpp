@@ -31,6 +31,30 @@ struct SideLoad {
   TimeFunction scale;     // empty: 1
 };
 
+// Forces on the boundary that depend on the displacement (contact, later fluid loads): added to the
+// internal forces and the tangent by SolidProblem::assemble. Implemented beneath in contact/.
+class BoundaryInteraction {
+ public:
+  virtual ~BoundaryInteraction() = default;
+  // Groups of nodes whose dofs may couple in the tangent (each group is coupled all-to-all); used
+  // once, to extend the sparsity pattern.
+  virtual std::vector<std::vector<int>> coupled_nodes() const = 0;
+  // Adds the interaction's force (same sign convention as f_int: the residual is f_int + f − f_ext)
+  // and, when `tangent` is not null, its derivative. Returns false with a reason on failure.
+  virtual bool add(const Eigen::VectorXd& u, Eigen::VectorXd& force, class TangentAccumulator* tangent,
+                   std::string& reason) const = 0;
+};
+
+// Adds entries to a tangent whose pattern already holds them.
+class TangentAccumulator {
+ public:
+  explicit TangentAccumulator(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) : matrix_(matrix) {}
+  void add(int row, int col, double value);
+
+ private:
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix_;
+};
+
 class SolidProblem {
  public:
   SolidProblem(IgaSpace space, std::shared_ptr<const Material> material,
@@ -44,6 +68,8 @@ class SolidProblem {
   // Every control point of a side, one component.
   void fix_side(Side side, int component, double value = 0.0, TimeFunction scale = {});
   void add_load(SideLoad load);
+  // Displacement-dependent boundary forces (contact). Rebuilds the sparsity pattern.
+  void add_interaction(std::shared_ptr<const BoundaryInteraction> interaction);
   const std::vector<DirichletCondition>& dirichlet() const { return dirichlet_; }
   // true for each dof that carries a Dirichlet condition
   const std::vector<bool>& constrained() const { return constrained_; }
@@ -76,6 +102,7 @@ class SolidProblem {
   std::vector<DirichletCondition> dirichlet_;
   std::vector<bool> constrained_;
   std::vector<SideLoad> loads_;
+  std::vector<std::shared_ptr<const BoundaryInteraction>> interactions_;
   SparseMatrix pattern_;                       // structure of the tangent, values zero
   std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col)
   std::vector<std::vector<int>> element_dofs_;

@@ -1,0 +1,203 @@
+#include "micro/contact/mortar_contact.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "common/error.hpp"
+
+namespace mufric::contact {
+
+double RigidTool::lowest_y() const { return surface.points().col(1).minCoeff(); }
+
+MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty, int points_per_span)
+    : tool_(std::move(tool)), penalty_(penalty) {
+  if (!(penalty_ > 0.0)) throw Error("contact: the penalty factor must be positive");
+  surface_nodes_ = space.side_nodes(solid::Side::top);
+  std::unordered_map<int, int> surface_index;
+  for (size_t a = 0; a < surface_nodes_.size(); ++a) surface_index[surface_nodes_[a]] = static_cast<int>(a);
+  node_area_.assign(surface_nodes_.size(), 0.0);
+  node_points_.resize(surface_nodes_.size());
+  const int per_span = points_per_span > 0 ? points_per_span : space.patch().u_basis().degree() + 3;
+  for (const auto& bp : space.boundary(solid::Side::top, per_span)) {
+    SurfacePoint sp;
+    sp.weight = bp.weight;
+    sp.position = bp.position;
+    std::vector<double> values;
+    for (size_t k = 0; k < bp.nodes.size(); ++k) {
+      const double r = bp.values(static_cast<Eigen::Index>(k));
+      if (r == 0.0) continue;  // functions of the rows below the surface vanish there
+      const auto it = surface_index.find(bp.nodes[k]);
+      if (it == surface_index.end()) throw Error("contact: a non-surface function is non-zero on the top side");
+      sp.nodes.push_back(bp.nodes[k]);
+      sp.multipliers.push_back(it->second);
+      values.push_back(r);
+    }
+    sp.values = Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+    const auto q = static_cast<int>(points_.size());
+    for (size_t k = 0; k < sp.nodes.size(); ++k) {
+      node_area_[static_cast<size_t>(sp.multipliers[k])] += sp.values(static_cast<Eigen::Index>(k)) * sp.weight;
+      node_points_[static_cast<size_t>(sp.multipliers[k])].push_back(q);
+    }
+    surface_length_ += sp.weight;
+    points_.push_back(std::move(sp));
+  }
+}
+
+std::vector<std::vector<int>> MortarContact::coupled_nodes() const {
+  std::vector<std::vector<int>> groups;
+  for (const auto& support : node_points_) {
+    std::vector<int> group;
+    for (const int q : support) {
+      const auto& nodes = points_[static_cast<size_t>(q)].nodes;
+      group.insert(group.end(), nodes.begin(), nodes.end());
+    }
+    std::sort(group.begin(), group.end());
+    group.erase(std::unique(group.begin(), group.end()), group.end());
+    groups.push_back(std::move(group));
+  }
+  return groups;
+}
+
+std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& u, int& projections,
+                                                         std::string& reason, bool& ok) const {
+  const size_t n = points_.size();
+  std::vector<Eigen::Vector2d> x(n);
+  std::vector<bool> near(n, false);
+  const double lowest = tool_.lowest_y();
+  for (size_t q = 0; q < n; ++q) {
+    const auto& sp = points_[q];
+    x[q] = sp.position;
+    for (size_t k = 0; k < sp.nodes.size(); ++k) x[q] += sp.values(static_cast<Eigen::Index>(k)) * u.segment<2>(2 * sp.nodes[k]);
+    near[q] = x[q].y() >= lowest;  // below the tool's lowest point a point cannot penetrate it
+  }
+  // Points in the support of a surface node that has a point near the tool are evaluated: the
+  // weighted gap of such a node needs all of them. The rest of the surface is never searched.
+  std::vector<bool> needed(n, false);
+  for (const auto& support : node_points_) {
+    if (std::none_of(support.begin(), support.end(), [&](int q) { return near[static_cast<size_t>(q)]; })) continue;
+    for (const int q : support) needed[static_cast<size_t>(q)] = true;
+  }
+  std::vector<PointGap> out(n);
+  projections = 0;
+  for (size_t q = 0; q < n && ok; ++q) {
+    if (!needed[q]) continue;
+    const spline::Projection p = spline::project(tool_.surface, x[q]);
+    ++projections;
+    if (!p.converged) {
+      ok = false;
+      reason = "contact: closest-point projection failed at x = (" + std::to_string(x[q].x()) + ", " +
+               std::to_string(x[q].y()) + "): " + p.reason;
+      break;
+    }
+    const spline::Points2 d = tool_.surface.derivatives(p.u, 2);
+    const Eigen::Vector2d t = d.row(1).transpose(), c2 = d.row(2).transpose();
+    const double speed2 = t.squaredNorm();
+    PointGap& g = out[q];
+    g.evaluated = true;
+    g.normal = Eigen::Vector2d(t.y(), -t.x()) / std::sqrt(speed2);
+    g.gap = (p.foot - x[q]).dot(g.normal);
+    // ∂²g/∂x² = −∂n/∂x = (n·C'')/(|C'|²(|C'|² − d n·C'')) C'⊗C', d = −g the signed distance.
+    const double nc = g.normal.dot(c2);
+    const double denominator = speed2 * (speed2 + g.gap * nc);
+    g.hessian = denominator != 0.0 ? Eigen::Matrix2d(nc / denominator * t * t.transpose()) : Eigen::Matrix2d::Zero();
+  }
+  return out;
+}
+
+Eigen::VectorXd MortarContact::node_pressures(const std::vector<PointGap>& g) const {
+  Eigen::VectorXd pressure = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(surface_nodes_.size()));
+  for (size_t a = 0; a < surface_nodes_.size(); ++a) {
+    double weighted = 0.0;
+    bool complete = true;
+    for (const int q : node_points_[a]) {
+      const auto& sp = points_[static_cast<size_t>(q)];
+      if (!g[static_cast<size_t>(q)].evaluated) {
+        complete = false;
+        break;
+      }
+      const auto k = std::find(sp.multipliers.begin(), sp.multipliers.end(), static_cast<int>(a)) - sp.multipliers.begin();
+      weighted += sp.values(k) * sp.weight * g[static_cast<size_t>(q)].gap;
+    }
+    if (complete && weighted > 0.0) pressure(static_cast<Eigen::Index>(a)) = penalty_ * weighted / node_area_[a];
+  }
+  return pressure;
+}
+
+bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
+                        std::string& reason) const {
+  bool ok = true;
+  int projections = 0;
+  const std::vector<PointGap> g = gaps(u, projections, reason, ok);
+  if (!ok) return false;
+  const Eigen::VectorXd p = node_pressures(g);
+  // Mortar pressure at each point, P_q = Σ_a p_a N_a(q); force f_b = −Σ_q P_q w_q R_b n_q.
+  for (size_t q = 0; q < points_.size(); ++q) {
+    const auto& sp = points_[q];
+    double pq = 0.0;
+    for (size_t k = 0; k < sp.nodes.size(); ++k) pq += p(sp.multipliers[k]) * sp.values(static_cast<Eigen::Index>(k));
+    if (pq <= 0.0) continue;
+    for (size_t k = 0; k < sp.nodes.size(); ++k) {
+      force.segment<2>(2 * sp.nodes[k]) -= pq * sp.weight * sp.values(static_cast<Eigen::Index>(k)) * g[q].normal;
+    }
+    if (tangent == nullptr) continue;
+    // Σ_q P_q w_q R_b R_c ∂²g/∂x²: the turning of the tool's normal.
+    for (size_t b = 0; b < sp.nodes.size(); ++b) {
+      for (size_t c = 0; c < sp.nodes.size(); ++c) {
+        const Eigen::Matrix2d k = pq * sp.weight * sp.values(static_cast<Eigen::Index>(b)) *
+                                  sp.values(static_cast<Eigen::Index>(c)) * g[q].hessian;
+        for (int i = 0; i < 2; ++i) {
+          for (int j = 0; j < 2; ++j) tangent->add(2 * sp.nodes[b] + i, 2 * sp.nodes[c] + j, k(i, j));
+        }
+      }
+    }
+  }
+  if (tangent == nullptr) return true;
+  // ε A_a G_a G_aᵀ for every active node, G_a = ∂g_a/∂u = (1/A_a) Σ_q N_a(q) w_q (−R_b n_q).
+  for (size_t a = 0; a < surface_nodes_.size(); ++a) {
+    if (p(static_cast<Eigen::Index>(a)) <= 0.0) continue;
+    std::unordered_map<int, Eigen::Vector2d> gradient;  // node → ∂g_a/∂u_node
+    for (const int q : node_points_[a]) {
+      const auto& sp = points_[static_cast<size_t>(q)];
+      const auto k = std::find(sp.multipliers.begin(), sp.multipliers.end(), static_cast<int>(a)) - sp.multipliers.begin();
+      const double factor = sp.values(k) * sp.weight / node_area_[a];
+      for (size_t b = 0; b < sp.nodes.size(); ++b) {
+        auto [it, inserted] = gradient.try_emplace(sp.nodes[b], Eigen::Vector2d::Zero());
+        it->second -= factor * sp.values(static_cast<Eigen::Index>(b)) * g[static_cast<size_t>(q)].normal;
+      }
+    }
+    const double scale = penalty_ * node_area_[a];
+    for (const auto& [b, gb] : gradient) {
+      for (const auto& [c, gc] : gradient) {
+        for (int i = 0; i < 2; ++i) {
+          for (int j = 0; j < 2; ++j) tangent->add(2 * b + i, 2 * c + j, scale * gb(i) * gc(j));
+        }
+      }
+    }
+  }
+  return true;
+}
+
+ContactState MortarContact::state(const Eigen::VectorXd& u) const {
+  ContactState s;
+  bool ok = true;
+  std::string reason;
+  const std::vector<PointGap> g = gaps(u, s.projections, reason, ok);
+  if (!ok) throw Error(reason);
+  const Eigen::VectorXd p = node_pressures(g);
+  s.surface_length = surface_length_;
+  for (size_t q = 0; q < points_.size(); ++q) {
+    const auto& sp = points_[q];
+    double pq = 0.0;
+    for (size_t k = 0; k < sp.nodes.size(); ++k) pq += p(sp.multipliers[k]) * sp.values(static_cast<Eigen::Index>(k));
+    s.point_x.push_back(sp.position.x());
+    s.point_pressure.push_back(std::max(pq, 0.0));
+    s.point_normal.push_back(g[q].normal);
+    if (pq <= 0.0) continue;
+    s.force += pq * sp.weight * g[q].normal;  // the tool pushes the chip along its outward normal
+    s.contact_length += sp.weight;
+    s.max_pressure = std::max(s.max_pressure, pq);
+  }
+  return s;
+}
+
+}  // namespace mufric::contact

@@ -1,0 +1,80 @@
+#pragma once
+// Frictionless penalty contact between the chip's top surface and a rigid tool, in the mortar
+// knot-to-surface form of seed 000 eq. (14)–(16) (Temizer, Wriggers & Hughes, CMAME 200, 2011;
+// Dimitri et al., CMAME 269, 2014): the normal gap of every surface quadrature point to its closest
+// point on the tool, g = (x_p − x_q)·n_p (positive when the chip penetrates the tool), is averaged
+// per surface control point with its basis function, g_a = ∫N_a g dΓ / ∫N_a dΓ, and the control
+// point carries the pressure p_a = ε⟨g_a⟩. Integrals are over the reference surface. The tangent is
+// the exact linearisation, including the curvature of the tool.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "micro/solid/solid_problem.hpp"
+#include "micro/spline/closest_point.hpp"
+
+namespace mufric::contact {
+
+// Penalty factor of seed 000 section 4, Pa/m.
+inline constexpr double kDefaultPenalty = 2e18;
+
+// The rigid tool: a curve whose outward normal, for a curve running in +x, points down (−y side),
+// toward the chip below it. Periodic tools repeat with their shift (the interval).
+struct RigidTool {
+  spline::SplineCurve surface;
+  double lowest_y() const;  // below every point of the tool (its control polygon's lowest point)
+};
+
+// What the contact transmits at a displacement: the resultant force on the chip (eq. 17's
+// numerator and denominator), contact area, peak pressure.
+struct ContactState {
+  Eigen::Vector2d force = Eigen::Vector2d::Zero();  // ∫ T dΓ on the chip, N per unit depth
+  double contact_length = 0.0;                      // reference length where the pressure is > 0, m
+  double surface_length = 0.0;                      // reference length of the chip surface, m
+  double max_pressure = 0.0;                        // Pa
+  int projections = 0;                              // closest-point searches done
+  // Per surface quadrature point, for output and tests: reference x, pressure, normal.
+  std::vector<double> point_x, point_pressure;
+  std::vector<Eigen::Vector2d> point_normal;
+};
+
+class MortarContact final : public solid::BoundaryInteraction {
+ public:
+  // The chip surface is the patch's top side; `points_per_span` Gauss points per span.
+  MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty = kDefaultPenalty, int points_per_span = 0);
+
+  std::vector<std::vector<int>> coupled_nodes() const override;
+  bool add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
+           std::string& reason) const override;
+  ContactState state(const Eigen::VectorXd& u) const;
+  const RigidTool& tool() const { return tool_; }
+  double penalty() const { return penalty_; }
+
+ private:
+  struct SurfacePoint {
+    std::vector<int> nodes;    // nodes with non-zero basis value here
+    Eigen::VectorXd values;    // R_b
+    double weight;             // dΓ (reference)
+    Eigen::Vector2d position;  // X
+    std::vector<int> multipliers;  // index of each node in the surface-node list (for N_a)
+  };
+  struct PointGap {
+    bool evaluated = false;
+    double gap = 0.0;  // g, m
+    Eigen::Vector2d normal = Eigen::Vector2d::Zero();  // tool's outward normal at the foot
+    Eigen::Matrix2d hessian = Eigen::Matrix2d::Zero(); // ∂²g/∂x²
+  };
+  // Gaps at every point whose surface node could be in contact; the rest stay unevaluated.
+  std::vector<PointGap> gaps(const Eigen::VectorXd& u, int& projections, std::string& reason, bool& ok) const;
+  Eigen::VectorXd node_pressures(const std::vector<PointGap>& g) const;  // p_a per surface node
+
+  RigidTool tool_;
+  double penalty_;
+  std::vector<SurfacePoint> points_;
+  std::vector<int> surface_nodes_;         // global node of each surface node a
+  std::vector<double> node_area_;          // A_a = ∫ N_a dΓ
+  std::vector<std::vector<int>> node_points_;  // points in the support of N_a
+  double surface_length_ = 0.0;
+};
+
+}  // namespace mufric::contact
