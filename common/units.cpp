@@ -44,6 +44,7 @@ constexpr std::array kUnits{
     UnitEntry{"s", {QuantityKind::time, 1.0, 0.0}},
     UnitEntry{"ms", {QuantityKind::time, 1e-3, 0.0}},
     UnitEntry{"us", {QuantityKind::time, 1e-6, 0.0}},
+    UnitEntry{"ns", {QuantityKind::time, 1e-9, 0.0}},
     UnitEntry{"1", {QuantityKind::dimensionless, 1.0, 0.0}},
 };
 
@@ -113,7 +114,7 @@ UnitToSi unit_to_si(std::string_view unit) {
     if (entry.symbol == unit) return entry.to_si;
   }
   throw Error("unknown unit '" + std::string(unit) +
-              "' (known: Pa kPa MPa GPa, m/s m/min mm/s, K C degC, rad deg, m mm um nm, s ms us, 1)");
+              "' (known: Pa kPa MPa GPa, m/s m/min mm/s, K C degC, rad deg, m mm um nm, s ms us ns, 1)");
 }
 
 double parse_quantity(std::string_view text, QuantityKind expected, std::string_view field) {

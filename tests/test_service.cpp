@@ -336,13 +336,14 @@ TEST_F(Service, StatusCountsRequestsPointsErrorsAndLatencies) {
 }
 
 TEST_F(Service, AnEvaluationWhoseDeadlinePassedStopsEarly) {
-  // A GP heavy enough that 100 000 points with std take about a second (L⁻¹ of 1500² per point).
+  // A GP heavy enough that 80 000 points with std take about half a second (L⁻¹ of 1000² per point;
+  // ten chunks of 8192 points).
   GpTrainingOptions options;
   options.optimise = false;
   options.initial.length_scales = Eigen::Vector3d(0.3, 0.3, 0.3);
   options.initial.noise_variance = 1e-4;
-  save_model((dir_ / "heavy.h5").string(), train_gaussian_process(test::smooth_training_set(1500, 5), options));
-  const Points pts = random_points(100'000);
+  save_model((dir_ / "heavy.h5").string(), train_gaussian_process(test::smooth_training_set(1000, 5), options));
+  const Points pts = random_points(80'000);
   const EvaluationRequest what{.std = true};
   const auto start_local = std::chrono::steady_clock::now();
   client::connect("file://" + (dir_ / "heavy.h5").string())->evaluate(pts.block(), what);
