@@ -1,6 +1,8 @@
 // `mufric micro …`: the micro-model's user-facing steps. So far: surface profiles (measured or
 // synthetic), their roughness and their periodic spline fit.
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -8,6 +10,7 @@
 #include "app/commands.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
+#include "micro/scene/micro_run.hpp"
 #include "micro/spline/profile.hpp"
 
 namespace mufric::app {
@@ -61,6 +64,100 @@ void run_profile(const ProfileOptions& o) {
   }
 }
 
+struct RunCommandOptions {
+  std::string scene_path, out = "mufric-micro-out";
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  double tolerance = 0.007;
+  int max_levels = 4;
+};
+
+scene::Scene load_scene(const RunCommandOptions& o) {
+  nlohmann::json j = o.scene_path.empty() ? scene::default_scene_json() : scene::read_scene_json(o.scene_path);
+  for (const auto& assignment : o.overrides) scene::apply_override(j, assignment);
+  const std::string base = o.scene_path.empty() ? "." : std::filesystem::path(o.scene_path).parent_path().string();
+  return scene::parse_scene(j, o.scene_path.empty() ? "default dry scene" : o.scene_path, base.empty() ? "." : base);
+}
+
+std::string mu_text(const std::optional<double>& mu) {
+  if (!mu) return "  (no contact)";
+  char text[32];
+  std::snprintf(text, sizeof text, "%8.4f", *mu);
+  return text;
+}
+
+void print_progress(const scene::MicroStep& s, const scene::Scene& sc) {
+  std::fprintf(stderr, "t %7.1f ns / %.1f ns  mu %s  contact %5.1f %%  max p %8.1f MPa\n", s.time * 1e9,
+               sc.duration * 1e9, mu_text(s.mu).c_str(), 100.0 * s.contact_fraction, s.max_pressure / 1e6);
+}
+
+void print_summary(const scene::MicroResult& r, const scene::Scene& sc) {
+  if (r.completed) {
+    std::printf("mu = %.5f  (eq. 17, time average over [%.1f, %.1f] ns, %d steps)\n", r.mu, sc.average_from * 1e9,
+                sc.duration * 1e9, r.averaged_steps);
+  } else {
+    std::printf("run did not complete: %s\n", r.reason.c_str());
+  }
+  std::printf("contact area %.1f %% of the interval, max contact pressure %s, max plastic strain %.4f, max temperature %s\n",
+              100.0 * r.contact_fraction, format_human(r.max_contact_pressure, QuantityKind::pressure).c_str(),
+              r.max_plastic_strain, format_human(r.max_temperature, QuantityKind::temperature).c_str());
+  std::printf("%d elements, %d dofs, %zu steps, %d Newton iterations, %zu cut-backs, %.2f s (assembly %.2f s, solve %.2f s)\n",
+              r.elements, r.dofs, r.history.size(), r.newton_iterations, r.cutbacks.size(), r.wall_seconds,
+              r.seconds_assembly, r.seconds_solve);
+  for (const auto& c : r.cutbacks) std::printf("  cut-back at %.2f ns (dt %.3g s): %s\n", c.time * 1e9, c.dt_failed, c.reason.c_str());
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary);
+    if (!out) throw Error("--out: cannot write '" + path + "'");
+    out << j.dump(2) << "\n";
+  }
+  std::filesystem::rename(temporary, path);
+}
+
+int run_command(const RunCommandOptions& o) {
+  const scene::Scene sc = load_scene(o);
+  std::filesystem::create_directories(o.out);
+  scene::RunOptions options;
+  options.vtu_directory = o.out;
+  if (!o.quiet) options.on_step = print_progress;
+  const scene::MicroResult r = scene::run_micro(sc, options);
+  write_json(o.out + "/result.json", r.to_json(sc));
+  print_summary(r, sc);
+  std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu\n", o.out.c_str(), o.out.c_str(), o.out.c_str());
+  return r.completed ? 0 : 3;
+}
+
+int converge_command(const RunCommandOptions& o) {
+  scene::Scene sc = load_scene(o);
+  std::printf("| level | elements | dofs | mu | change | wall [s] |\n|---|---|---|---|---|---|\n");
+  std::optional<double> previous;
+  for (int level = 0; level <= o.max_levels; ++level) {
+    const scene::MicroResult r = scene::run_micro(sc);
+    if (!r.completed) {
+      std::printf("| %d | %d | %d | failed | | %.2f |\n", level, r.elements, r.dofs, r.wall_seconds);
+      std::printf("level %d did not complete: %s\n", level, r.reason.c_str());
+      return 3;
+    }
+    const double change = previous ? std::abs(r.mu - *previous) / std::max(std::abs(r.mu), 1e-12) : 0.0;
+    std::printf("| %d | %d | %d | %.5f | %s | %.2f |\n", level, r.elements, r.dofs, r.mu,
+                previous ? (std::to_string(100.0 * change).substr(0, 5) + " %").c_str() : "", r.wall_seconds);
+    std::fflush(stdout);
+    if (previous && change < o.tolerance) {
+      std::printf("converged at level %d: mu changed by %.2f %% (< %.2f %%) from the previous level\n", level,
+                  100.0 * change, 100.0 * o.tolerance);
+      return 0;
+    }
+    previous = r.mu;
+    sc.elements_x *= 2;
+    sc.elements_y *= 2;
+  }
+  std::printf("not converged within %d refinements (tolerance %.2f %%)\n", o.max_levels, 100.0 * o.tolerance);
+  return 3;
+}
+
 }  // namespace
 
 void add_micro_commands(CLI::App& app) {
@@ -86,6 +183,33 @@ void add_micro_commands(CLI::App& app) {
                   "the requested Ra exactly. The fit is a periodic least-squares B-spline with chord-length\n"
                   "parameters; its error is the distance from each datum to the curve at the datum's parameter.");
   profile->callback([o] { run_profile(*o); });
+
+  auto r = std::make_shared<RunCommandOptions>();
+  auto* run = micro->add_subcommand("run", "One high-fidelity dry run: mu by eq. 17 with its history and diagnostics");
+  run->add_option("scene", r->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
+  run->add_option("--set", r->overrides, "Override a scene value, e.g. --set load.pressure=1300MPa (repeatable)");
+  run->add_option("--out", r->out, "Directory for result.json, chip.vtu and tool.vtu")->capture_default_str();
+  run->add_flag("--quiet", r->quiet, "No per-step progress on stderr");
+  run->footer("Exit code 0 when the run completed and mu was averaged, 3 when it did not (result.json says why),\n"
+              "2 for a bad scene (the message names the key). The default scene is micro/scene/dry_default.json.");
+  run->callback([r] {
+    const int code = run_command(*r);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+
+  auto c = std::make_shared<RunCommandOptions>();
+  auto* converge = micro->add_subcommand(
+      "converge", "Refine the chip mesh uniformly until mu changes by less than the tolerance between levels");
+  converge->add_option("scene", c->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
+  converge->add_option("--set", c->overrides, "Override a scene value (repeatable)");
+  converge->add_option("--tolerance", c->tolerance, "Relative change of mu that counts as converged")
+      ->capture_default_str()->check(CLI::Range(1e-6, 1.0));
+  converge->add_option("--max-levels", c->max_levels, "Most refinements (each doubles elements_x and elements_y)")
+      ->capture_default_str()->check(CLI::Range(1, 8));
+  converge->callback([c] {
+    const int code = converge_command(*c);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
 }
 
 }  // namespace mufric::app

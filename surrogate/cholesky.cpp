@@ -6,8 +6,6 @@ extern "C" {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 void dpotri_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const int* lda, int* info);
-int openblas_get_num_threads(void);
-void openblas_set_num_threads(int);
 }
 
 namespace mufric {
@@ -71,7 +69,5 @@ bool invert_lower_triangular(Eigen::MatrixXd& lower) {
   return info == 0;
 }
 
-SingleThreadedBlas::SingleThreadedBlas() : previous_(openblas_get_num_threads()) { openblas_set_num_threads(1); }
-SingleThreadedBlas::~SingleThreadedBlas() { openblas_set_num_threads(previous_); }
 
 }  // namespace mufric

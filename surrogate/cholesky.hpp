@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include "common/blas_threads.hpp"
+
 namespace mufric {
 
 // Jitter ladder, relative to the mean of the diagonal: start tiny, ×10 per retry, give up past the cap.
@@ -28,17 +30,5 @@ bool inverse_from_cholesky(Eigen::MatrixXd& lower);
 
 // Overwrites the lower-triangular `lower` with its inverse (LAPACK dtrtri); false if singular.
 bool invert_lower_triangular(Eigen::MatrixXd& lower);
-
-// Limits OpenBLAS to one thread while the caller runs its own parallel loop; restores on exit.
-class SingleThreadedBlas {
- public:
-  SingleThreadedBlas();
-  ~SingleThreadedBlas();
-  SingleThreadedBlas(const SingleThreadedBlas&) = delete;
-  SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
-
- private:
-  int previous_;
-};
 
 }  // namespace mufric

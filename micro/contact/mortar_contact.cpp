@@ -12,6 +12,21 @@ double RigidTool::lowest_y() const { return surface.points().col(1).minCoeff(); 
 MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty, int points_per_span)
     : tool_(std::move(tool)), penalty_(penalty) {
   if (!(penalty_ > 0.0)) throw Error("contact: the penalty factor must be positive");
+  // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
+  const auto& basis = tool_.surface.basis();
+  if (basis.is_periodic() && tool_.surface.shift().y() == 0.0 && tool_.surface.shift().x() > 0.0) {
+    constexpr int kSamplesPerSpan = 16;
+    const int samples = kSamplesPerSpan * basis.count();
+    for (int k = 0; k <= samples; ++k) {
+      const double u = basis.lo() + basis.period() * k / samples;
+      const Eigen::Vector2d p = tool_.surface.point(u);
+      if (!graph_.empty() && !(p.x() > graph_.back().x)) {
+        graph_.clear();  // not a graph: fall back to the global search
+        break;
+      }
+      graph_.push_back({p.x(), p.y(), u});
+    }
+  }
   surface_nodes_ = space.side_nodes(solid::Side::top);
   std::unordered_map<int, int> surface_index;
   for (size_t a = 0; a < surface_nodes_.size(); ++a) surface_index[surface_nodes_[a]] = static_cast<int>(a);
@@ -41,6 +56,31 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
     surface_length_ += sp.weight;
     points_.push_back(std::move(sp));
   }
+}
+
+spline::ProjectionOptions MortarContact::search_window(const Eigen::Vector2d& x) const {
+  spline::ProjectionOptions options;
+  if (graph_.empty()) return options;
+  const double length = tool_.surface.shift().x(), period = tool_.surface.basis().period();
+  // Tool height and parameter at an x anywhere, through the periodic table.
+  auto at = [&](double xq) {
+    const double turns = std::floor((xq - graph_.front().x) / length);
+    const double xr = xq - turns * length;
+    auto it = std::upper_bound(graph_.begin(), graph_.end(), xr, [](double v, const GraphSample& g) { return v < g.x; });
+    if (it == graph_.begin()) it = graph_.begin() + 1;
+    if (it == graph_.end()) it = graph_.end() - 1;
+    const GraphSample& a = *(it - 1);
+    const GraphSample& b = *it;
+    const double t = (xr - a.x) / (b.x - a.x);
+    return std::make_pair(a.y + t * (b.y - a.y), a.u + t * (b.u - a.u) + turns * period);
+  };
+  // The curve point straight above or below x is at most the vertical distance away, so the
+  // closest point lies within that distance in x.
+  const double reach = std::abs(x.y() - at(x.x()).first) + 2.0 * (graph_[1].x - graph_[0].x);
+  const double du = graph_[1].u - graph_[0].u;
+  options.window_lo = at(x.x() - reach).second - du;
+  options.window_hi = at(x.x() + reach).second + du;
+  return options;
 }
 
 std::vector<std::vector<int>> MortarContact::coupled_nodes() const {
@@ -81,7 +121,7 @@ std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& 
   projections = 0;
   for (size_t q = 0; q < n && ok; ++q) {
     if (!needed[q]) continue;
-    const spline::Projection p = spline::project(tool_.surface, x[q]);
+    const spline::Projection p = spline::project(tool_.surface, x[q], search_window(x[q]));
     ++projections;
     if (!p.converged) {
       ok = false;

@@ -68,8 +68,16 @@ class MortarContact final : public solid::BoundaryInteraction {
   std::vector<PointGap> gaps(const Eigen::VectorXd& u, int& projections, std::string& reason, bool& ok) const;
   Eigen::VectorXd node_pressures(const std::vector<PointGap>& g) const;  // p_a per surface node
 
+  // The tool as a graph over x (when it is one): dense samples (x, y, u) over one period, used to
+  // bound each closest-point search to the spans within the point's vertical distance.
+  struct GraphSample {
+    double x, y, u;
+  };
+  spline::ProjectionOptions search_window(const Eigen::Vector2d& x) const;
+
   RigidTool tool_;
   double penalty_;
+  std::vector<GraphSample> graph_;  // empty: the tool is not a graph over x, search globally
   std::vector<SurfacePoint> points_;
   std::vector<int> surface_nodes_;         // global node of each surface node a
   std::vector<double> node_area_;          // A_a = ∫ N_a dΓ

@@ -199,7 +199,12 @@ spline::SplineSurface chip_patch(const spline::SplineCurve& surface, const ChipM
     }
     top = top.with_knot(0.5 * (b[longest] + b[longest + 1]));
   }
-  return spline::SplineSurface::extruded(top, options.y_bottom, options.degree, options.spans_y);
+  if (!(options.grading >= 1.0)) throw Error("chip patch: grading must be at least 1");
+  std::vector<double> v_knots;
+  for (int k = 1; k < options.spans_y; ++k) {
+    v_knots.push_back(1.0 - std::pow(1.0 - static_cast<double>(k) / options.spans_y, options.grading));
+  }
+  return spline::SplineSurface::extruded(top, options.y_bottom, options.degree, 1).refined_v(v_knots);
 }
 
 }  // namespace mufric::solid

@@ -71,6 +71,9 @@ struct ChipMeshOptions {
   int spans_x = 32;   // spans along the interval (at least the surface fit's own spans)
   int spans_y = 8;    // spans across the thickness
   double y_bottom = -5e-6;  // m, the loaded bottom Γ_B
+  // Spans across the thickness shrink toward the surface, where contact concentrates the
+  // gradients: knots at v_k = 1 − (1 − k/spans_y)^grading (1: uniform).
+  double grading = 1.0;
 };
 spline::SplineSurface chip_patch(const spline::SplineCurve& surface, const ChipMeshOptions& options);
 

@@ -2,11 +2,23 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
+#include "common/blas_threads.hpp"
 #include "common/error.hpp"
 
 namespace mufric::solid {
 namespace {
+
+// MUFRIC_TRACE_NEWTON=1 prints every Newton iteration's residual to stderr (diagnosing a run).
+bool trace_newton() {
+  static const bool on = [] {
+    const char* v = std::getenv("MUFRIC_TRACE_NEWTON");
+    return v != nullptr && *v != '\0' && *v != '0';
+  }();
+  return on;
+}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -81,7 +93,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   const double am = alpha_m(), af = alpha_f(), b = beta(), g = gamma();
   const double t1 = t0 + dt;
   const auto& constrained = problem_.constrained();
-  Eigen::VectorXd u1 = dynamic ? Eigen::VectorXd(u_ + dt * v_ + 0.5 * dt * dt * a_) : u_;
+  Eigen::VectorXd u1 = dynamic ? Eigen::VectorXd(u_ + dt * v_) : u_;
   problem_.apply_dirichlet(t1, u1);
   const Eigen::VectorXd f_ext1 = problem_.external(t1), f_ext0 = problem_.external(t0);
   const SparseMatrix* mass = dynamic ? &problem_.mass() : nullptr;
@@ -126,6 +138,9 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     }
     force_scale = std::max(force_scale, current.scale);
     const double tolerance = options_.relative_tolerance * force_scale + 1e-300;
+    if (trace_newton()) {
+      std::fprintf(stderr, "newton t %.4g dt %.3g it %d residual %.6e tolerance %.3e\n", t1, dt, it, current.norm, tolerance);
+    }
     at.record.residual = current.norm;
     at.record.newton_iterations = it;
     if (current.norm <= tolerance) break;
@@ -197,6 +212,8 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
 }
 
 IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>& on_step) {
+  // The sparse factorisations' dense blocks are small: OpenBLAS threads would only spin.
+  const SingleThreadedBlas single_threaded_blas;
   report_ = IntegrationReport();
   double t = 0.0, dt = options_.dt;
   int consecutive_cuts = 0;

@@ -115,7 +115,28 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
   // the period the point's position along the shift falls into.
   double lo = basis.lo(), hi = basis.hi();
   std::vector<double> breaks = basis.breakpoints();
-  if (basis.is_periodic() && !curve.shift().isZero() && options.periods > 1) {
+  const bool windowed = options.window_lo < options.window_hi;
+  if (windowed) {
+    // The spans meeting the window, continued periodically for periodic curves.
+    const double period = basis.period();
+    const int first = basis.is_periodic() ? static_cast<int>(std::floor((options.window_lo - lo) / period)) : 0;
+    const int last = basis.is_periodic() ? static_cast<int>(std::floor((options.window_hi - lo) / period)) : 0;
+    std::vector<double> spans;
+    for (int q = first; q <= last; ++q) {
+      const double offset = q * period;
+      for (size_t e = 0; e + 1 < breaks.size(); ++e) {
+        const double a = breaks[e] + offset, b = breaks[e + 1] + offset;
+        if (b < options.window_lo || a > options.window_hi) continue;
+        if (spans.empty() || spans.back() != a) spans.push_back(a);
+        spans.push_back(b);
+      }
+    }
+    if (spans.size() >= 2) {
+      breaks = std::move(spans);
+      lo = breaks.front();
+      hi = breaks.back();
+    }
+  } else if (basis.is_periodic() && !curve.shift().isZero() && options.periods > 1) {
     const Eigen::Vector2d s = curve.shift();
     const double along = (x - curve.point(lo)).dot(s) / s.squaredNorm();
     const int centre = static_cast<int>(std::floor(along));
@@ -137,7 +158,7 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
     }
   }
   samples.push_back({hi, (curve.point(hi) - x).squaredNorm()});
-  const bool closed = basis.is_periodic() && curve.shift().isZero();
+  const bool closed = basis.is_periodic() && curve.shift().isZero() && !windowed;
   const size_t count = samples.size();
   double length_scale = 0.0;
   for (size_t i = 1; i < count; ++i) {

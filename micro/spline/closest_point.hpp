@@ -22,6 +22,10 @@ struct ProjectionOptions {
   // Periodic curves with a shift (profiles): the parameter range searched, in periods, centred on
   // the period of the point's own x (for closed curves one period is everything).
   int periods = 3;
+  // When set (lo < hi), only the spans that meet [window_lo, window_hi] are searched: the caller
+  // knows the closest point lies there (e.g. a contact search that bounds the distance). For
+  // periodic curves the window may extend beyond one period.
+  double window_lo = 0.0, window_hi = 0.0;
 };
 
 struct Projection {

@@ -1,0 +1,264 @@
+#include "micro/scene/scene.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/units.hpp"
+
+namespace mufric::scene {
+namespace {
+
+using nlohmann::json;
+
+// One JSON object of the scene: typed reads with ranges, and a check that no key was left unread.
+class Section {
+ public:
+  Section(const json& j, std::string path, const std::string& source) : j_(j), path_(std::move(path)), source_(source) {
+    if (!j_.is_object()) fail("", "must be an object");
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+    throw Error(source_ + ": " + name(key) + ": " + message);
+  }
+  std::string name(const std::string& key) const { return path_.empty() ? key : key.empty() ? path_ : path_ + "." + key; }
+  bool has(const std::string& key) const { return j_.contains(key); }
+  const json* take(const std::string& key) {
+    used_.insert(key);
+    return j_.contains(key) ? &j_.at(key) : nullptr;
+  }
+  double quantity(const std::string& key, QuantityKind kind, double fallback, double lo, double hi) {
+    const json* v = take(key);
+    if (v == nullptr) return fallback;
+    if (!v->is_string()) {
+      fail(key, "give a value with its unit as a string, e.g. \"" + std::string(example_quantity(kind)) + "\"");
+    }
+    const double x = parse_quantity(v->get<std::string>(), kind, name(key));
+    if (!(x >= lo && x <= hi)) {
+      fail(key, v->get<std::string>() + " is outside [" + format_human(lo, kind) + ", " + format_human(hi, kind) + "]");
+    }
+    return x;
+  }
+  double number(const std::string& key, double fallback, double lo, double hi) {
+    const json* v = take(key);
+    if (v == nullptr) return fallback;
+    if (!v->is_number()) fail(key, "must be a number");
+    const double x = v->get<double>();
+    if (!(x >= lo && x <= hi)) fail(key, std::to_string(x) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return x;
+  }
+  int integer(const std::string& key, int fallback, int lo, int hi) {
+    const json* v = take(key);
+    if (v == nullptr) return fallback;
+    if (!v->is_number_integer()) fail(key, "must be an integer");
+    const auto x = v->get<long long>();
+    if (x < lo || x > hi) fail(key, std::to_string(x) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<int>(x);
+  }
+  bool boolean(const std::string& key, bool fallback) {
+    const json* v = take(key);
+    if (v == nullptr) return fallback;
+    if (!v->is_boolean()) fail(key, "must be true or false");
+    return v->get<bool>();
+  }
+  std::string text(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+    const json* v = take(key);
+    if (v == nullptr) return fallback;
+    if (!v->is_string()) fail(key, "must be a string");
+    const auto s = v->get<std::string>();
+    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      fail(key, "'" + s + "' is not one of: " + list);
+    }
+    return s;
+  }
+  Section child(const std::string& key) {
+    static const json empty = json::object();
+    const json* v = take(key);
+    return Section(v ? *v : empty, name(key), source_);
+  }
+  void finish() const {
+    for (const auto& [key, value] : j_.items()) {
+      if (!used_.count(key)) fail(key, "unknown key");
+    }
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const std::string& source_;
+  std::set<std::string> used_;
+};
+
+constexpr double kHuge = 1e300;
+
+SurfaceSpec read_surface(Section s, const std::string& base_directory) {
+  SurfaceSpec out;
+  const int kinds = s.has("csv") + s.has("synthetic") + s.has("flat");
+  if (kinds != 1) s.fail("", "give exactly one of csv, synthetic or flat");
+  if (s.has("csv")) {
+    out.csv = s.text("csv", "", {});
+    if (std::filesystem::path(out.csv).is_relative()) out.csv = (std::filesystem::path(base_directory) / out.csv).string();
+    if (!std::filesystem::exists(out.csv)) s.fail("csv", "no such file '" + out.csv + "'");
+  }
+  out.flat = s.boolean("flat", false);
+  if (s.has("flat") && !out.flat) s.fail("flat", "only `\"flat\": true` is meaningful");
+  if (s.has("synthetic")) {
+    Section g = s.child("synthetic");
+    out.synthetic.ra = g.quantity("ra", QuantityKind::length, out.synthetic.ra, 1e-12, 1e-3);
+    out.synthetic.correlation_length =
+        g.quantity("correlation_length", QuantityKind::length, out.synthetic.correlation_length, 1e-12, 1e-2);
+    out.synthetic.samples = g.integer("samples", out.synthetic.samples, 16, 1 << 20);
+    out.synthetic.seed = static_cast<std::uint64_t>(g.integer("seed", 1, 0, 2147483647));
+    g.finish();
+  }
+  Section fit = s.child("fit");
+  out.degree = fit.integer("degree", out.degree, 1, spline::kMaxDegree);
+  out.control_points = fit.integer("control_points", out.control_points, 4, 100000);
+  fit.finish();
+  out.shift_fraction = s.number("shift", 0.0, -1.0, 1.0);
+  out.mirror = s.boolean("mirror", false);
+  s.finish();
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json read_scene_json(const std::string& path) {
+  const auto text = read_whole_file(path);
+  if (!text) throw Error(path + ": cannot read the scene file");
+  try {
+    return json::parse(*text);
+  } catch (const json::parse_error& e) {
+    throw Error(path + ": not valid JSON: " + e.what());
+  }
+}
+
+void apply_override(nlohmann::json& scene, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) throw Error("--set '" + assignment + "': expected key.path=value");
+  const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  json value;
+  try {
+    value = json::parse(text);
+  } catch (const json::parse_error&) {
+    value = text;  // "800MPa" and other unit strings
+  }
+  json* node = &scene;
+  size_t start = 0;
+  while (true) {
+    const size_t dot = path.find('.', start);
+    const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (key.empty()) throw Error("--set '" + assignment + "': empty key in '" + path + "'");
+    if (dot == std::string::npos) {
+      (*node)[key] = value;
+      return;
+    }
+    if (!node->contains(key)) (*node)[key] = json::object();
+    node = &(*node)[key];
+    if (!node->is_object()) throw Error("--set '" + assignment + "': '" + key + "' is not an object");
+    start = dot + 1;
+  }
+}
+
+Scene parse_scene(const nlohmann::json& j, const std::string& source, const std::string& base_directory) {
+  Scene s;
+  s.source = source;
+  s.effective = j;
+  Section root(j, "", source);
+  s.physics = root.text("physics", "dry", {"dry", "lubricated"});
+  if (s.physics == "lubricated") {
+    root.fail("physics", "lubricated contact (the fluid in the pockets) is not implemented yet; use \"dry\"");
+  }
+  {
+    Section g = root.child("geometry");
+    s.interval = g.quantity("interval", QuantityKind::length, s.interval, 1e-9, 1e-2);
+    s.chip_height = g.quantity("chip_height", QuantityKind::length, s.chip_height, 1e-9, 1e-2);
+    s.initial_gap = g.quantity("initial_gap", QuantityKind::length, s.initial_gap, 0.0, 1e-3);
+    if (!g.has("chip_surface")) g.fail("chip_surface", "missing");
+    if (!g.has("tool_surface")) g.fail("tool_surface", "missing");
+    s.chip_surface = read_surface(g.child("chip_surface"), base_directory);
+    s.tool_surface = read_surface(g.child("tool_surface"), base_directory);
+    g.finish();
+  }
+  {
+    Section d = root.child("discretisation");
+    s.degree = d.integer("degree", s.degree, 1, 6);
+    s.elements_x = d.integer("elements_x", s.elements_x, 4, 100000);
+    s.elements_y = d.integer("elements_y", s.elements_y, 1, 100000);
+    s.grading = d.number("grading", s.grading, 1.0, 6.0);
+    s.contact_points_per_span = d.integer("contact_points_per_span", 0, 0, 20);
+    d.finish();
+  }
+  {
+    Section m = root.child("material");
+    auto& p = s.material;
+    p.youngs_modulus = m.quantity("youngs_modulus", QuantityKind::pressure, p.youngs_modulus, 1e6, 1e13);
+    p.poisson_ratio = m.number("poisson_ratio", p.poisson_ratio, -0.99, 0.499);
+    p.density = m.number("density", p.density, 1.0, 1e5);
+    p.a = m.quantity("a", QuantityKind::pressure, p.a, 1.0, 1e11);
+    p.b = m.quantity("b", QuantityKind::pressure, p.b, 0.0, 1e11);
+    p.c = m.number("c", p.c, 0.0, 10.0);
+    p.n = m.number("n", p.n, 0.0, 5.0);
+    p.m = m.number("m", p.m, 0.01, 10.0);
+    p.reference_strain_rate = m.number("reference_strain_rate", p.reference_strain_rate, 1e-12, 1e12);
+    p.transition_temperature = m.quantity("transition_temperature", QuantityKind::temperature, p.transition_temperature, 0.0, 1e4);
+    p.melting_temperature = m.quantity("melting_temperature", QuantityKind::temperature, p.melting_temperature, 1.0, 1e4);
+    if (!(p.melting_temperature > p.transition_temperature)) m.fail("melting_temperature", "must exceed transition_temperature");
+    p.specific_heat = m.number("specific_heat", p.specific_heat, 1.0, 1e5);
+    p.heat_fraction = m.number("heat_fraction", p.heat_fraction, 0.0, 1.0);
+    m.finish();
+  }
+  {
+    Section l = root.child("load");
+    if (l.has("pressure") == l.has("vertical_displacement")) {
+      l.fail("", "give exactly one of pressure or vertical_displacement");
+    }
+    s.pressure_controlled = l.has("pressure");
+    s.pressure = l.quantity("pressure", QuantityKind::pressure, s.pressure, 0.0, 1e11);
+    s.vertical_displacement = l.quantity("vertical_displacement", QuantityKind::length, 0.0, -1e-3, 1e-3);
+    s.velocity = l.quantity("velocity", QuantityKind::velocity, s.velocity, -1e3, 1e3);
+    s.temperature = l.quantity("temperature", QuantityKind::temperature, s.temperature, 0.0, 1e4);
+    s.ramp = l.quantity("ramp", QuantityKind::time, s.ramp, 0.0, 1.0);
+    l.finish();
+  }
+  {
+    Section t = root.child("time");
+    const std::string scheme = t.text("scheme", "generalized-alpha", {"generalized-alpha", "quasi-static"});
+    s.scheme = scheme == "quasi-static" ? solid::TimeScheme::quasi_static : solid::TimeScheme::generalized_alpha;
+    s.spectral_radius = t.number("spectral_radius", s.spectral_radius, 0.0, 1.0);
+    s.dt = t.quantity("step", QuantityKind::time, s.dt, 1e-15, 1.0);
+    s.duration = t.quantity("duration", QuantityKind::time, s.duration, 1e-15, 10.0);
+    if (s.dt > s.duration) t.fail("step", "is longer than the duration");
+    s.average_from = t.quantity("average_from", QuantityKind::time, 0.5 * s.duration, 0.0, kHuge);
+    if (s.average_from >= s.duration) t.fail("average_from", "must lie before the end of the run");
+    t.finish();
+  }
+  {
+    Section c = root.child("contact");
+    s.penalty = c.number("penalty", s.penalty, 1e3, 1e30);
+    c.finish();
+  }
+  {
+    Section v = root.child("solver");
+    s.relative_tolerance = v.number("relative_tolerance", s.relative_tolerance, 1e-15, 1e-2);
+    s.max_newton_iterations = v.integer("max_newton_iterations", s.max_newton_iterations, 1, 1000);
+    s.max_cutbacks = v.integer("max_cutbacks", s.max_cutbacks, 0, 40);
+    s.linear_solver = v.text("linear_solver", "lu", {"lu", "cholesky"}) == "cholesky" ? solid::LinearSolverKind::cholesky
+                                                                                    : solid::LinearSolverKind::lu;
+    v.finish();
+  }
+  root.finish();
+  return s;
+}
+
+nlohmann::json default_scene_json() {
+  static const char* const kText =
+#include "dry_default.json.inc"
+      ;
+  return json::parse(kText);
+}
+
+}  // namespace mufric::scene

@@ -1,0 +1,77 @@
+#pragma once
+// A micro-model scene: everything one high-fidelity run needs, read from JSON. Dimensional values
+// are strings with units ("800MPa", "10um", "500C", "5ns"); counts and ratios are numbers. Unknown
+// keys and out-of-range values are errors that name the key (e.g. "load.pressure").
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "micro/solid/materials.hpp"
+#include "micro/solid/time_integrator.hpp"
+#include "micro/spline/profile.hpp"
+
+namespace mufric::scene {
+
+// One rough surface: a measured profile (CSV), a synthetic one, or flat; fitted by a periodic spline.
+struct SurfaceSpec {
+  std::string csv;                 // measured profile; empty: synthetic or flat
+  bool flat = false;
+  spline::RoughnessSpec synthetic; // length is the scene's interval
+  int degree = 3;
+  int control_points = 64;
+  double shift_fraction = 0.0;     // moves the profile along x by this fraction of the interval
+  bool mirror = false;             // x → −x (a reflected profile, for symmetry studies)
+};
+
+struct Scene {
+  std::string source;  // file name, for messages
+  std::string physics = "dry";
+  // geometry
+  double interval = 10e-6;      // m, the periodic width (seed 000: 1e-5 m)
+  double chip_height = 5e-6;    // m, from the mean chip surface down to Γ_B
+  double initial_gap = 0.0;     // m, smallest vertical distance tool–chip at t = 0
+  SurfaceSpec chip_surface, tool_surface;
+  // discretisation
+  int degree = 2;
+  int elements_x = 64;
+  int elements_y = 12;
+  double grading = 2.0;          // spans across the height shrink toward the surface: v_k = 1 − (1 − k/n)^grading
+  int contact_points_per_span = 0;  // 0: degree + 3
+  // material (seed 000 Table 1)
+  solid::JohnsonCookParameters material;
+  // load on Γ_B
+  bool pressure_controlled = true;
+  double pressure = 800e6;            // Pa, pushing the chip toward the tool
+  double vertical_displacement = 0.0; // m, instead of a pressure (for comparisons with other codes)
+  double velocity = 100.0 / 60.0;     // m/s, horizontal, of Γ_B (chip moving in +x against a fixed tool)
+  double temperature = 773.15;        // K, initial
+  double ramp = 2.5e-8;               // s, the vertical load rises linearly over this time
+  // time
+  solid::TimeScheme scheme = solid::TimeScheme::generalized_alpha;
+  double spectral_radius = 0.8;
+  double dt = 5e-9;                   // s
+  double duration = 2.5e-7;           // s (seed 000 Figs. 3–5)
+  double average_from = 1.25e-7;      // s, μ is averaged over [average_from, duration]
+  // contact
+  double penalty = 2e18;              // Pa/m
+  // solver
+  double relative_tolerance = 1e-9;
+  int max_newton_iterations = 30;
+  int max_cutbacks = 8;
+  solid::LinearSolverKind linear_solver = solid::LinearSolverKind::lu;
+
+  nlohmann::json effective;  // the scene as read, with overrides applied (for the result's provenance)
+};
+
+// Reads a scene file (JSON); relative CSV paths are relative to the file. Throws Error naming the
+// file and key.
+nlohmann::json read_scene_json(const std::string& path);
+// Applies "a.b.c=value": value parsed as JSON if it is valid JSON, else taken as a string.
+void apply_override(nlohmann::json& scene, const std::string& assignment);
+Scene parse_scene(const nlohmann::json& json, const std::string& source, const std::string& base_directory = ".");
+
+// The default dry scene shipped with mufric (micro/scene/dry_default.json, compiled in).
+nlohmann::json default_scene_json();
+
+}  // namespace mufric::scene

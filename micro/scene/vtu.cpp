@@ -1,0 +1,134 @@
+#include "micro/scene/vtu.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+
+#include "common/error.hpp"
+
+namespace mufric::scene {
+namespace {
+
+constexpr int kSamplesPerElement = 4;  // sub-cells per element and direction
+constexpr int kVtkQuad = 9, kVtkPolyLine = 4;
+
+void commit(const std::string& temporary, const std::string& path) {
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw Error(path + ": cannot write (" + error.message() + ")");
+}
+
+// Linear interpolation of the contact pressure along the surface's reference x.
+double pressure_at(const contact::ContactState& c, double x) {
+  if (c.point_x.empty()) return 0.0;
+  const auto it = std::lower_bound(c.point_x.begin(), c.point_x.end(), x);
+  if (it == c.point_x.begin()) return c.point_pressure.front();
+  if (it == c.point_x.end()) return c.point_pressure.back();
+  const auto k = static_cast<size_t>(it - c.point_x.begin());
+  const double t = (x - c.point_x[k - 1]) / (c.point_x[k] - c.point_x[k - 1]);
+  return c.point_pressure[k - 1] + t * (c.point_pressure[k] - c.point_pressure[k - 1]);
+}
+
+}  // namespace
+
+void write_chip_vtu(const std::string& path, const solid::SolidProblem& problem, const Eigen::VectorXd& u,
+                    const contact::ContactState& contact) {
+  const auto& space = problem.space();
+  const auto& patch = space.patch();
+  const auto bu = patch.u_basis().breakpoints(), bv = patch.v_basis().breakpoints();
+  const int nu = static_cast<int>(bu.size() - 1) * kSamplesPerElement + 1;
+  const int nv = static_cast<int>(bv.size() - 1) * kSamplesPerElement + 1;
+  auto param = [&](const std::vector<double>& b, int k) {
+    const int e = std::min(k / kSamplesPerElement, static_cast<int>(b.size()) - 2);
+    return b[static_cast<size_t>(e)] + (b[static_cast<size_t>(e) + 1] - b[static_cast<size_t>(e)]) *
+                                           (k - e * kSamplesPerElement) / kSamplesPerElement;
+  };
+  // Element averages of the quadrature-point history.
+  std::vector<double> plastic(static_cast<size_t>(space.element_count()), 0.0), temperature(plastic), count(plastic);
+  for (size_t q = 0; q < space.quadrature().size(); ++q) {
+    const auto e = static_cast<size_t>(space.quadrature()[q].element);
+    plastic[e] += problem.states()[q].equivalent_plastic_strain;
+    temperature[e] += problem.states()[q].temperature;
+    count[e] += 1.0;
+  }
+  const std::string temporary = path + ".tmp";
+  std::ofstream out(temporary);
+  if (!out) throw Error(path + ": cannot write");
+  out << std::setprecision(10);
+  const int cells = (nu - 1) * (nv - 1);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << nu * nv << "\" NumberOfCells=\"" << cells << "\">\n"
+      << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  std::vector<Eigen::Vector2d> displacement;
+  std::vector<double> pressure;
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      const double pu = param(bu, i), pv = param(bv, j);
+      const Eigen::Vector2d x = patch.point(pu, pv), d = space.displacement(u, pu, pv);
+      displacement.push_back(d);
+      pressure.push_back(j == nv - 1 ? pressure_at(contact, x.x()) : 0.0);
+      out << x.x() + d.x() << " " << x.y() + d.y() << " 0\n";
+    }
+  }
+  out << "</DataArray></Points>\n<Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (int j = 0; j + 1 < nv; ++j) {
+    for (int i = 0; i + 1 < nu; ++i) {
+      const int a = i + nu * j;
+      out << a << " " << a + 1 << " " << a + 1 + nu << " " << a + nu << "\n";
+    }
+  }
+  out << "</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
+  for (int c = 1; c <= cells; ++c) out << 4 * c << "\n";
+  out << "</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (int c = 0; c < cells; ++c) out << kVtkQuad << "\n";
+  out << "</DataArray></Cells>\n<PointData Vectors=\"displacement\">\n"
+      << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& d : displacement) out << d.x() << " " << d.y() << " 0\n";
+  out << "</DataArray><DataArray type=\"Float64\" Name=\"contact_pressure\" format=\"ascii\">\n";
+  for (const double p : pressure) out << p << "\n";
+  out << "</DataArray></PointData>\n<CellData>\n";
+  const int elements_u = static_cast<int>(bu.size()) - 1;
+  auto element_of_cell = [&](int i, int j) {
+    return static_cast<size_t>(i / kSamplesPerElement + elements_u * (j / kSamplesPerElement));
+  };
+  for (const auto& [name, values] : {std::pair<const char*, const std::vector<double>*>{"equivalent_plastic_strain", &plastic},
+                                     std::pair<const char*, const std::vector<double>*>{"temperature", &temperature}}) {
+    out << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+    for (int j = 0; j + 1 < nv; ++j) {
+      for (int i = 0; i + 1 < nu; ++i) {
+        const size_t e = element_of_cell(i, j);
+        out << (*values)[e] / std::max(count[e], 1.0) << "\n";
+      }
+    }
+    out << "</DataArray>\n";
+  }
+  out << "</CellData>\n</Piece></UnstructuredGrid></VTKFile>\n";
+  out.close();
+  if (!out) throw Error(path + ": write failed");
+  commit(temporary, path);
+}
+
+void write_tool_vtu(const std::string& path, const spline::SplineCurve& tool) {
+  constexpr int kPoints = 2000;
+  const std::string temporary = path + ".tmp";
+  std::ofstream out(temporary);
+  if (!out) throw Error(path + ": cannot write");
+  out << std::setprecision(10);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << kPoints + 1 << "\" NumberOfCells=\"1\">\n"
+      << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (int k = 0; k <= kPoints; ++k) {
+    const Eigen::Vector2d x = tool.point(tool.basis().lo() + (tool.basis().hi() - tool.basis().lo()) * k / kPoints);
+    out << x.x() << " " << x.y() << " 0\n";
+  }
+  out << "</DataArray></Points>\n<Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (int k = 0; k <= kPoints; ++k) out << k << "\n";
+  out << "</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n" << kPoints + 1
+      << "\n</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n" << kVtkPolyLine
+      << "\n</DataArray></Cells>\n</Piece></UnstructuredGrid></VTKFile>\n";
+  out.close();
+  if (!out) throw Error(path + ": write failed");
+  commit(temporary, path);
+}
+
+}  // namespace mufric::scene
