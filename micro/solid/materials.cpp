@@ -76,18 +76,18 @@ double temperature_factor(const JohnsonCookParameters& p, double temperature) {
   return 1.0 - std::pow(hat, p.m);
 }
 
-// σy at ε̄ = ε̄n + √(2/3)Δγ and rate √(2/3)Δγ/dt, with its derivative in Δγ.
+// σy at ε̄ = ε̄n + √(2/3)Δγ and rate √(2/3)Δγ/dt, with its derivative in Δγ; `thermal` is the
+// temperature factor (1 − θ̂^m), constant during a step.
 YieldWithSlope yield_along_return(const JohnsonCookParameters& p, double start_strain, double dgamma, double dt,
-                                  double temperature) {
+                                  double thermal) {
   const double strain = start_strain + kSqrtTwoThirds * dgamma;
   const double rate = kSqrtTwoThirds * dgamma / dt;
-  const double hardening = p.a + p.b * std::pow(strain, p.n);
-  const double hardening_slope = strain > 0.0 ? p.b * p.n * std::pow(strain, p.n - 1.0)
-                                              : std::numeric_limits<double>::infinity();
+  const double power = std::pow(strain, p.n);  // one pow: the slope is n·power/strain
+  const double hardening = p.a + p.b * power;
+  const double hardening_slope = strain > 0.0 ? p.b * p.n * power / strain : std::numeric_limits<double>::infinity();
   const double ratio = rate / p.reference_strain_rate;
   const double rate_factor = 1.0 + p.c * std::log(std::max(ratio, 1.0));
   const double rate_slope = ratio > 1.0 ? p.c / rate : 0.0;  // d(rate factor)/d(rate)
-  const double thermal = temperature_factor(p, temperature);
   return {hardening * rate_factor * thermal,
           thermal * kSqrtTwoThirds * (hardening_slope * rate_factor + hardening * rate_slope / dt)};
 }
@@ -192,6 +192,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   const KirchhoffTrial<double> trial = trial_strain<double>(f, start);
   const double q_trial = 2.0 * mu_ * trial.norm;  // ‖dev τ_trial‖
   const double theta = start.temperature;
+  const double thermal = temperature_factor(p_, theta);
   const double eps_n = start.equivalent_plastic_strain;
   const double yield_start = johnson_cook_yield_stress(p_, eps_n, 0.0, theta);
   double dgamma = 0.0, slope = 0.0;
@@ -201,7 +202,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
     dgamma = 0.5 * hi;
     bool converged = false;
     for (int it = 0; it < kReturnMapMaxIterations; ++it) {
-      const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, theta);
+      const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, thermal);
       const double r = q_trial - 2.0 * mu_ * dgamma - kSqrtTwoThirds * y.stress;
       slope = -2.0 * mu_ - kSqrtTwoThirds * y.slope;
       if (std::abs(r) <= kReturnMapRelativeTolerance * q_trial) {
@@ -238,7 +239,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   const D q = 2.0 * mu_ * t.norm;
   D scale = D(1.0);
   if (dgamma > 0.0) {
-    const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, theta);
+    const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, thermal);
     const D r = q - 2.0 * mu_ * dgamma - kSqrtTwoThirds * y.stress;
     const D dg = dgamma - r / slope;
     scale = 1.0 - 2.0 * mu_ * dg / q;
@@ -276,7 +277,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
                                       std::exp(2.0 * (trial.dev_zz * keep + third))};
   const double d_eps = kSqrtTwoThirds * dgamma;
   out.state.equivalent_plastic_strain = eps_n + d_eps;
-  const double yield_end = yield_along_return(p_, eps_n, dgamma, dt, theta).stress;
+  const double yield_end = yield_along_return(p_, eps_n, dgamma, dt, thermal).stress;
   out.state.yield_stress = yield_end;
   out.state.temperature = theta + p_.heat_fraction * yield_end * d_eps / (p_.density * p_.specific_heat);
   return out;

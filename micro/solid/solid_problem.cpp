@@ -114,28 +114,33 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
   out.states.resize(states_.size());
   out.stresses.resize(states_.size());
   if (with_tangent) out.tangent = pattern_;
-  double* values = with_tangent ? out.tangent.valuePtr() : nullptr;
   const auto& qps = space_.quadrature();
-  const size_t elements = element_first_point_.size() - 1;
-  Eigen::MatrixXd local;
-  for (size_t e = 0; e < elements && out.ok; ++e) {
-    const auto& dofs = element_dofs_[e];
-    const auto n = static_cast<Eigen::Index>(dofs.size());
-    if (with_tangent) local.setZero(n, n);
-    for (int k = element_first_point_[e]; k < element_first_point_[e + 1]; ++k) {
+  const auto elements = static_cast<long>(element_first_point_.size() - 1);
+  // Elements are independent: their local vectors and matrices are computed in parallel and
+  // scattered afterwards in element order (so the sums do not depend on the thread count).
+  std::vector<Eigen::VectorXd> local_f(static_cast<size_t>(elements));
+  std::vector<Eigen::MatrixXd> local_k(with_tangent ? static_cast<size_t>(elements) : 0);
+  std::vector<std::string> failure(static_cast<size_t>(elements));
+#pragma omp parallel for schedule(dynamic, 16)
+  for (long e = 0; e < elements; ++e) {
+    const auto ue = static_cast<size_t>(e);
+    const auto n = static_cast<Eigen::Index>(element_dofs_[ue].size());
+    Eigen::VectorXd& f = local_f[ue];
+    f.setZero(n);
+    if (with_tangent) local_k[ue].setZero(n, n);
+    for (int k = element_first_point_[ue]; k < element_first_point_[ue + 1]; ++k) {
       const QuadraturePoint& q = qps[static_cast<size_t>(k)];
       const StressResponse r = material_->update(IgaSpace::gradient(q, u), states_[static_cast<size_t>(k)], dt);
       if (!r.ok) {
-        out.ok = false;
-        out.reason = r.reason + " at X = (" + std::to_string(q.position.x()) + ", " + std::to_string(q.position.y()) + ")";
+        failure[ue] = r.reason + " at X = (" + std::to_string(q.position.x()) + ", " + std::to_string(q.position.y()) + ")";
         break;
       }
       out.states[static_cast<size_t>(k)] = r.state;
       out.stresses[static_cast<size_t>(k)] = r.stress;
       const Eigen::Index nen = q.gradients.cols();
-      // f_int[a, i] += S_ij ∂R_a/∂X_j w
+      // f_int[a, i] += S_ij ∂R_a/∂X_j w (the element's nodes are the quadrature point's, in order)
       const Eigen::Matrix2Xd sg = r.stress * q.gradients * q.weight;
-      for (Eigen::Index a = 0; a < nen; ++a) out.internal.segment<2>(2 * q.nodes[static_cast<size_t>(a)]) += sg.col(a);
+      for (Eigen::Index a = 0; a < nen; ++a) f.segment<2>(2 * a) += sg.col(a);
       if (!with_tangent) continue;
       // K[(a,i),(b,k)] += ∂R_a/∂X_j A_(ij)(kl) ∂R_b/∂X_l w: per node pair, G_aᵀ A G_b with G_a the
       // 4×2 map from δu_a to δH.
@@ -146,17 +151,29 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
           ag.col(2 * b + kk) = r.tangent.col(2 * kk) * q.gradients(0, b) + r.tangent.col(2 * kk + 1) * q.gradients(1, b);
         }
       }
+      Eigen::MatrixXd& local = local_k[ue];
       for (Eigen::Index a = 0; a < nen; ++a) {
         for (int i = 0; i < 2; ++i) {
           local.row(2 * a + i) += q.weight * (ag.row(2 * i) * q.gradients(0, a) + ag.row(2 * i + 1) * q.gradients(1, a));
         }
       }
     }
-    if (with_tangent && out.ok) {
-      const auto& slots = element_slots_[e];
-      for (Eigen::Index c = 0; c < n; ++c) {
-        for (Eigen::Index r = 0; r < n; ++r) values[slots[static_cast<size_t>(r + n * c)]] += local(r, c);
-      }
+  }
+  for (long e = 0; e < elements; ++e) {
+    const auto ue = static_cast<size_t>(e);
+    if (!failure[ue].empty()) {
+      out.ok = false;
+      out.reason = failure[ue];
+      return out;
+    }
+    const auto& dofs = element_dofs_[ue];
+    const auto n = static_cast<Eigen::Index>(dofs.size());
+    for (Eigen::Index r = 0; r < n; ++r) out.internal(dofs[static_cast<size_t>(r)]) += local_f[ue](r);
+    if (!with_tangent) continue;
+    double* values = out.tangent.valuePtr();
+    const auto& slots = element_slots_[ue];
+    for (Eigen::Index c = 0; c < n; ++c) {
+      for (Eigen::Index r = 0; r < n; ++r) values[slots[static_cast<size_t>(r + n * c)]] += local_k[ue](r, c);
     }
   }
   if (out.ok) {

@@ -239,7 +239,9 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     report_.steps.push_back(at.record);
     report_.newton_iterations += at.record.newton_iterations;
     if (on_step) on_step(StepView{t, u_, v_, a_, reactions_, stresses_, problem_});
-    dt = std::min(options_.dt, 2.0 * dt);  // grow back after a cut-back
+    // After a cut-back, grow back only from steps that converged easily: growing after a hard step
+    // invites the next failure, which costs a whole Newton run.
+    if (at.record.newton_iterations <= kEasyStepIterations) dt = std::min(options_.dt, 2.0 * this_dt);
   }
   report_.completed = true;
   report_.symbolic_analyses = solver_.analyses();

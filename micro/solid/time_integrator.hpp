@@ -22,6 +22,8 @@ enum class TimeScheme { generalized_alpha, quasi_static };
 inline constexpr double kNewtonStagnationIncrement = 1e-14;
 inline constexpr double kLineSearchSufficientDecrease = 1e-4;  // Armijo constant on ‖G‖²
 inline constexpr int kLineSearchMaxReductions = 8;
+// A step that converged in at most this many Newton iterations lets a cut-back step grow again.
+inline constexpr int kEasyStepIterations = 8;
 
 struct TimeIntegrationOptions {
   TimeScheme scheme = TimeScheme::generalized_alpha;

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The dry micro-model over the corners and the centre of seed 000's parameter box (section 4:
+# 300–1300 MPa, 22.5–200 m/min, 25–900 °C): mu, contact, plastic strain, heating, Newton work and
+# wall time per point, as a markdown table. Every run's result.json is kept in the output directory.
+# Usage: bash bench/micro_sweep.sh [build-dir] [out-dir] [extra --set overrides...]
+set -uo pipefail
+build=${1:-build}
+out=${2:-micro-sweep}
+shift 2 2>/dev/null || true
+mufric=$build/app/mufric
+mkdir -p "$out"
+echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; overrides: $*"
+printf '| p | v | T | mu | contact | max p [MPa] | max plastic strain | max T [C] | Newton | cut-backs | wall [s] |\n|---|---|---|---|---|---|---|---|---|---|---|\n'
+run() {
+  local p=$1 v=$2 t=$3 dir="$out/p${1}_v${2}_T${3}"
+  mkdir -p "$dir"
+  "$mufric" micro run --quiet --out "$dir" --set "load.pressure=$p" --set "load.velocity=$v" --set "load.temperature=$t" "$@" \
+    > "$dir/summary.txt" 2>&1
+  /usr/bin/python3 - "$dir/result.json" "$p" "$v" "$t" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1])); d = r["diagnostics"]
+mu = f'{r["mu"]:.4f}' if r["completed"] else "failed: " + r.get("reason", "")[:60]
+print(f'| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {mu} | {100*d["contact_area_fraction"]:.1f} % | '
+      f'{d["max_contact_pressure_pa"]/1e6:.0f} | {d["max_plastic_strain"]:.3f} | {d["max_temperature_k"]-273.15:.0f} | '
+      f'{d["newton_iterations"]} | {d["cutbacks"]} | {d["wall_seconds"]:.1f} |')
+PY
+}
+for p in 300MPa 1300MPa; do
+  for v in 22.5m/min 200m/min; do
+    for t in 25C 900C; do run $p $v $t "$@"; done
+  done
+done
+run 800MPa 111.25m/min 462.5C "$@"
