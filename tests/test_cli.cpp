@@ -167,6 +167,30 @@ TEST_F(Cli, MicroProfileReportsRoughnessAndFitError) {
   EXPECT_NE(r.output.find("bad.csv:5"), std::string::npos) << r.output;
 }
 
+TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
+  const std::string small =
+      " --set discretisation.elements_x=32 --set discretisation.elements_y=4"
+      " --set geometry.chip_surface.fit.control_points=32 --set geometry.tool_surface.fit.control_points=32"
+      " --set time.duration=12ns --set time.average_from=8ns --set load.ramp=8ns --quiet";
+  CommandResult r = run("micro run --out " + path("run") + small);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("mu = "), std::string::npos) << r.output;
+  for (const char* file : {"result.json", "chip.vtu", "tool.vtu"}) {
+    EXPECT_TRUE(std::filesystem::exists(path("run") + "/" + file)) << file;
+  }
+  std::ifstream in(path("run") + "/result.json");
+  std::string json, line;
+  while (std::getline(in, line)) json += line;
+  EXPECT_NE(json.find("\"history\""), std::string::npos);
+  EXPECT_NE(json.find("\"contact_area_fraction\""), std::string::npos);
+  r = run("micro run --out " + path("run2") + " --set load.presure=1GPa");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("load.presure: unknown key"), std::string::npos) << r.output;
+  r = run("micro run --out " + path("run3") + " --set physics=lubricated");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("physics"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, CorruptModelIsRefused) {
   std::ofstream(path("bad.h5")) << "not a model";
   const CommandResult r = run("predict --model " + path("bad.h5") + " --p 800MPa --v 100m/min --T 500C");

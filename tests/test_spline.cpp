@@ -312,7 +312,14 @@ TEST(ClosestPoint, AgreesWithBruteForceOnRoughProfilesOfEveryDegree) {
     std::mt19937_64 rng(degree);
     std::uniform_real_distribution<double> ux(-0.2, 1.2), uy(-0.3, 0.4);
     for (int trial = 0; trial < 25; ++trial) {
-      expect_matches_brute_force(c, {ux(rng), uy(rng)}, "degree " + std::to_string(degree));
+      const Eigen::Vector2d x(ux(rng), uy(rng));
+      expect_matches_brute_force(c, x, "degree " + std::to_string(degree));
+      // A search bounded to a window around the answer (as the contact search does) finds it too.
+      const Projection global = project(c, x);
+      ProjectionOptions window;
+      window.window_lo = global.u - 0.07;
+      window.window_hi = global.u + 0.05;
+      EXPECT_NEAR(project(c, x, window).distance, global.distance, 1e-14);
     }
   }
 }
