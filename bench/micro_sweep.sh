@@ -12,10 +12,16 @@ mkdir -p "$out"
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; overrides: $*"
 printf '| p | v | T | mu | contact | max p [MPa] | max plastic strain | max T [C] | Newton | cut-backs | wall [s] |\n|---|---|---|---|---|---|---|---|---|---|---|\n'
 run() {
-  local p=$1 v=$2 t=$3 dir="$out/p${1}_v${2}_T${3}"
+  local p=$1 v=$2 t=$3
+  shift 3
+  local dir="$out/p${p}_v${v//\//_}_T${t}"
   mkdir -p "$dir"
   "$mufric" micro run --quiet --out "$dir" --set "load.pressure=$p" --set "load.velocity=$v" --set "load.temperature=$t" "$@" \
     > "$dir/summary.txt" 2>&1
+  if [[ ! -s $dir/result.json ]]; then
+    echo "| $p | $v | $t | error: $(tail -1 "$dir/summary.txt") | | | | | | | |"
+    return
+  fi
   /usr/bin/python3 - "$dir/result.json" "$p" "$v" "$t" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1])); d = r["diagnostics"]
