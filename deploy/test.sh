@@ -13,11 +13,11 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DMUFRIC_BUILD_TESTS=ON
 cmake --build build -j "$jobs"
 ctest --test-dir build -j "$jobs" --output-on-failure --timeout 600
 
-echo "== AddressSanitizer + UndefinedBehaviorSanitizer build: unit, service and CLI tests"
+echo "== AddressSanitizer + UndefinedBehaviorSanitizer build: unit (incl. micro-solver), service and CLI tests"
 # Portable code generation here: the sanitizers check correctness, and GCC 12 emits false
 # uninitialised-variable warnings inside its AVX-512 intrinsics under -fsanitize.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMUFRIC_SANITIZE=ON -DMUFRIC_NATIVE=OFF \
   -DMUFRIC_BUILD_BENCH=OFF -DMUFRIC_BUILD_TESTS=ON
-cmake --build build-asan -j "$jobs" --target mufric mufric_unit_tests mufric_service_tests mufric_cli_tests
+cmake --build build-asan -j "$jobs" --target mufric mufric_unit_tests mufric_micro_tests mufric_service_tests mufric_cli_tests
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan -j "$jobs" -L "unit|service|cli" --output-on-failure --timeout 600
