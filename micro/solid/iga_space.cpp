@@ -5,57 +5,6 @@
 #include "common/error.hpp"
 
 namespace mufric::solid {
-namespace {
-
-// Rational basis functions of the patch at (u, v) with their parametric derivatives, and the
-// geometry there (periodic control points moved by their period's shift).
-struct Basis2 {
-  std::vector<int> nodes;
-  Eigen::VectorXd r, r_u, r_v;
-  Eigen::Vector2d x;
-  Eigen::Matrix2d jacobian;  // columns ∂X/∂u, ∂X/∂v
-};
-
-Basis2 evaluate_basis(const spline::SplineSurface& s, double u, double v) {
-  const auto& bu = s.u_basis();
-  const auto& bv = s.v_basis();
-  const auto au = bu.locate(u), av = bv.locate(v);
-  const Eigen::MatrixXd nu = bu.derivatives(au.span, au.u, 1), nv = bv.derivatives(av.span, av.u, 1);
-  const int p = bu.degree(), q = bv.degree(), count = (p + 1) * (q + 1);
-  Basis2 b;
-  b.nodes.resize(static_cast<size_t>(count));
-  b.r.resize(count), b.r_u.resize(count), b.r_v.resize(count);
-  double w = 0.0, w_u = 0.0, w_v = 0.0;
-  std::vector<Eigen::Vector2d> positions(static_cast<size_t>(count));
-  for (int j = 0; j <= q; ++j) {
-    for (int i = 0; i <= p; ++i) {
-      const int a = i + (p + 1) * j;
-      const int node = s.index(bu.function_index(au.span, i), bv.function_index(av.span, j));
-      const double weight = s.is_rational() ? s.weights()(node) : 1.0;
-      b.nodes[static_cast<size_t>(a)] = node;
-      b.r(a) = nu(0, i) * nv(0, j) * weight;
-      b.r_u(a) = nu(1, i) * nv(0, j) * weight;
-      b.r_v(a) = nu(0, i) * nv(1, j) * weight;
-      w += b.r(a), w_u += b.r_u(a), w_v += b.r_v(a);
-      positions[static_cast<size_t>(a)] =
-          s.points().row(node).transpose() + (bu.function_period(au.span, i) + au.periods) * s.shift();
-    }
-  }
-  // Quotient rule: R = N w / W, R_u = (N_u w − R W_u) / W.
-  b.r /= w;
-  b.r_u = (b.r_u - b.r * w_u) / w;
-  b.r_v = (b.r_v - b.r * w_v) / w;
-  b.x.setZero();
-  b.jacobian.setZero();
-  for (int a = 0; a < count; ++a) {
-    b.x += b.r(a) * positions[static_cast<size_t>(a)];
-    b.jacobian.col(0) += b.r_u(a) * positions[static_cast<size_t>(a)];
-    b.jacobian.col(1) += b.r_v(a) * positions[static_cast<size_t>(a)];
-  }
-  return b;
-}
-
-}  // namespace
 
 void gauss_legendre(int count, std::vector<double>& nodes, std::vector<double>& weights) {
   Eigen::MatrixXd jacobi = Eigen::MatrixXd::Zero(count, count);
@@ -86,7 +35,7 @@ IgaSpace::IgaSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
         for (size_t a = 0; a < gu.size(); ++a) {
           const double u = 0.5 * (u0 + u1) + 0.5 * (u1 - u0) * gu[a];
           const double v = 0.5 * (v0 + v1) + 0.5 * (v1 - v0) * gv[b];
-          const Basis2 basis = evaluate_basis(patch_, u, v);
+          const spline::RationalBasis basis = patch_.basis_at(u, v);
           const double det = basis.jacobian.determinant();
           if (!(det > 0.0)) {
             throw Error("IGA patch: the parameterisation is not orientation-preserving (det J = " +
@@ -125,7 +74,7 @@ std::vector<BoundaryPoint> IgaSpace::boundary(Side side, int points_per_span) co
   for (size_t e = 0; e + 1 < breaks.size(); ++e) {
     for (size_t k = 0; k < g.size(); ++k) {
       const double t = 0.5 * (breaks[e] + breaks[e + 1]) + 0.5 * (breaks[e + 1] - breaks[e]) * g[k];
-      const Basis2 b = along_u ? evaluate_basis(patch_, t, fixed) : evaluate_basis(patch_, fixed, t);
+      const spline::RationalBasis b = along_u ? patch_.basis_at(t, fixed) : patch_.basis_at(fixed, t);
       const Eigen::Vector2d tangent = b.jacobian.col(along_u ? 0 : 1);
       const Eigen::Vector2d inward_direction = b.jacobian.col(along_u ? 1 : 0);
       Eigen::Vector2d normal(tangent.y(), -tangent.x());
@@ -169,7 +118,7 @@ Eigen::Matrix2d IgaSpace::gradient(const QuadraturePoint& q, const Eigen::Vector
 }
 
 Eigen::Vector2d IgaSpace::displacement(const Eigen::VectorXd& u, double pu, double pv) const {
-  const Basis2 b = evaluate_basis(patch_, pu, pv);
+  const spline::RationalBasis b = patch_.basis_at(pu, pv);
   Eigen::Vector2d out = Eigen::Vector2d::Zero();
   for (size_t a = 0; a < b.nodes.size(); ++a) out += b.r(static_cast<Eigen::Index>(a)) * u.segment<2>(2 * b.nodes[a]);
   return out;

@@ -22,51 +22,41 @@ SplineSurface::SplineSurface(SplineBasis u_basis, SplineBasis v_basis, Points2 p
   if (!u_.is_periodic() && !shift_.isZero()) throw Error("spline surface: a shift needs a periodic u basis");
 }
 
-Eigen::Matrix2d SplineSurface::jacobian(double u, double v) const {
+RationalBasis SplineSurface::basis_at(double u, double v) const {
   const auto au = u_.locate(u), av = v_.locate(v);
   const Eigen::MatrixXd nu = u_.derivatives(au.span, au.u, 1), nv = v_.derivatives(av.span, av.u, 1);
-  // Homogeneous sums A (point·w) and W with their first derivatives (A4.4 to first order).
-  Eigen::Vector2d a = Eigen::Vector2d::Zero(), a_u = a, a_v = a;
+  const int p = u_.degree(), q = v_.degree(), count = (p + 1) * (q + 1);
+  RationalBasis b;
+  b.nodes.resize(static_cast<size_t>(count));
+  b.r.resize(count), b.r_u.resize(count), b.r_v.resize(count);
   double w = 0.0, w_u = 0.0, w_v = 0.0;
-  for (int jv = 0; jv <= v_.degree(); ++jv) {
-    const int j = v_.function_index(av.span, jv);
-    for (int iu = 0; iu <= u_.degree(); ++iu) {
-      const int i = u_.function_index(au.span, iu);
-      const int k = index(i, j);
-      const double weight = is_rational() ? weights_(k) : 1.0;
-      const Eigen::Vector2d p =
-          points_.row(k).transpose() + (u_.function_period(au.span, iu) + au.periods) * shift_;
-      const double n00 = nu(0, iu) * nv(0, jv), n10 = nu(1, iu) * nv(0, jv), n01 = nu(0, iu) * nv(1, jv);
-      a += n00 * weight * p, a_u += n10 * weight * p, a_v += n01 * weight * p;
-      w += n00 * weight, w_u += n10 * weight, w_v += n01 * weight;
+  std::vector<Eigen::Vector2d> positions(static_cast<size_t>(count));
+  for (int j = 0; j <= q; ++j) {
+    for (int i = 0; i <= p; ++i) {
+      const int a = i + (p + 1) * j;
+      const int node = index(u_.function_index(au.span, i), v_.function_index(av.span, j));
+      const double weight = is_rational() ? weights_(node) : 1.0;
+      b.nodes[static_cast<size_t>(a)] = node;
+      b.r(a) = nu(0, i) * nv(0, j) * weight;
+      b.r_u(a) = nu(1, i) * nv(0, j) * weight;
+      b.r_v(a) = nu(0, i) * nv(1, j) * weight;
+      w += b.r(a), w_u += b.r_u(a), w_v += b.r_v(a);
+      positions[static_cast<size_t>(a)] =
+          points_.row(node).transpose() + (u_.function_period(au.span, i) + au.periods) * shift_;
     }
   }
-  const Eigen::Vector2d s = a / w;
-  Eigen::Matrix2d j;
-  j.col(0) = (a_u - w_u * s) / w;
-  j.col(1) = (a_v - w_v * s) / w;
-  return j;
-}
-
-Eigen::Vector2d SplineSurface::point(double u, double v) const {
-  // Evaluate as the column curve at u: exact and reuses the curve algorithm.
-  const auto au = u_.locate(u);
-  const Eigen::VectorXd nu = u_.values(au.span, au.u);
-  const auto av = v_.locate(v);
-  const Eigen::VectorXd nv = v_.values(av.span, av.u);
-  Eigen::Vector2d a = Eigen::Vector2d::Zero();
-  double w = 0.0;
-  for (int jv = 0; jv <= v_.degree(); ++jv) {
-    for (int iu = 0; iu <= u_.degree(); ++iu) {
-      const int k = index(u_.function_index(au.span, iu), v_.function_index(av.span, jv));
-      const double weight = is_rational() ? weights_(k) : 1.0;
-      const Eigen::Vector2d p =
-          points_.row(k).transpose() + (u_.function_period(au.span, iu) + au.periods) * shift_;
-      a += nu(iu) * nv(jv) * weight * p;
-      w += nu(iu) * nv(jv) * weight;
-    }
+  // Quotient rule: R = N w / W, R_u = (N_u w − R W_u) / W.
+  b.r /= w;
+  b.r_u = (b.r_u - b.r * w_u) / w;
+  b.r_v = (b.r_v - b.r * w_v) / w;
+  b.x.setZero();
+  b.jacobian.setZero();
+  for (int a = 0; a < count; ++a) {
+    b.x += b.r(a) * positions[static_cast<size_t>(a)];
+    b.jacobian.col(0) += b.r_u(a) * positions[static_cast<size_t>(a)];
+    b.jacobian.col(1) += b.r_v(a) * positions[static_cast<size_t>(a)];
   }
-  return a / w;
+  return b;
 }
 
 SplineCurve SplineSurface::curve_through(const SplineBasis& basis, const std::vector<int>& indices,

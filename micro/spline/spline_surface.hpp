@@ -11,6 +11,15 @@
 
 namespace mufric::spline {
 
+// The rational basis functions that are non-zero at a parameter point, with their parametric
+// derivatives, and the geometry there (periodic control points moved by their period's shift).
+struct RationalBasis {
+  std::vector<int> nodes;        // control-point index of each function (point of (i, j): i + nu·j)
+  Eigen::VectorXd r, r_u, r_v;   // R_a and ∂R_a/∂u, ∂R_a/∂v
+  Eigen::Vector2d x;             // S(u, v)
+  Eigen::Matrix2d jacobian;      // columns ∂S/∂u, ∂S/∂v
+};
+
 class SplineSurface {
  public:
   // points(i + nu·j) is the control point of function i along u and j along v; weights likewise
@@ -26,9 +35,11 @@ class SplineSurface {
   const Eigen::Vector2d& shift() const { return shift_; }
   int index(int i, int j) const { return i + u_.count() * j; }
 
-  Eigen::Vector2d point(double u, double v) const;
+  // Rational basis and geometry at (u, v) (A3.5 with the quotient rule of A4.4, first order).
+  RationalBasis basis_at(double u, double v) const;
+  Eigen::Vector2d point(double u, double v) const { return basis_at(u, v).x; }
   // Columns: ∂S/∂u, ∂S/∂v (the 2×2 Jacobian of the parameterisation).
-  Eigen::Matrix2d jacobian(double u, double v) const;
+  Eigen::Matrix2d jacobian(double u, double v) const { return basis_at(u, v).jacobian; }
 
   // The curve of row j (along u) or column i (along v).
   SplineCurve row(int j) const;
