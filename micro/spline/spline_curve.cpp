@@ -34,28 +34,28 @@ Eigen::Vector2d SplineCurve::extended_point(int index, int period) const {
   return points_.row(index).transpose() + period * shift_;
 }
 
-Points2 SplineCurve::derivatives(double u, int n) const {
+Eigen::Matrix<double, Eigen::Dynamic, 3> SplineCurve::homogeneous_derivatives(double u, int n) const {
   const auto at = basis_.locate(u);
   const Eigen::MatrixXd ders = basis_.derivatives(at.span, at.u, n);
-  const int p = basis_.degree();
-  // Homogeneous numerator A and weight w derivatives (weights 1 for a B-spline).
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n + 1, 2);
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(n + 1);
-  for (int j = 0; j <= p; ++j) {
+  Eigen::Matrix<double, Eigen::Dynamic, 3> h = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(n + 1, 3);
+  for (int j = 0; j <= basis_.degree(); ++j) {
     const int i = basis_.function_index(at.span, j);
     const double weight = extended_weight(i);
-    const Eigen::Vector2d point = extended_point(i, basis_.function_period(at.span, j) + at.periods);
-    for (int r = 0; r <= n; ++r) {
-      a.row(r) += ders(r, j) * weight * point.transpose();
-      w(r) += ders(r, j) * weight;
-    }
+    Eigen::RowVector3d weighted;
+    weighted << weight * extended_point(i, basis_.function_period(at.span, j) + at.periods).transpose(), weight;
+    for (int r = 0; r <= n; ++r) h.row(r) += ders(r, j) * weighted;
   }
+  return h;
+}
+
+Points2 SplineCurve::derivatives(double u, int n) const {
+  const auto h = homogeneous_derivatives(u, n);
   // A4.2: C^(k) = (A^(k) − Σ_{i=1..k} C(k,i) w^(i) C^(k−i)) / w.
   Points2 c(n + 1, 2);
   for (int k = 0; k <= n; ++k) {
-    Eigen::RowVector2d v = a.row(k);
-    for (int i = 1; i <= k; ++i) v -= binomial(k, i) * w(i) * c.row(k - i);
-    c.row(k) = v / w(0);
+    Eigen::RowVector2d v = h.row(k).head<2>();
+    for (int i = 1; i <= k; ++i) v -= binomial(k, i) * h(i, 2) * c.row(k - i);
+    c.row(k) = v / h(0, 2);
   }
   return c;
 }
@@ -139,16 +139,7 @@ SplineCurve SplineCurve::elevated() const {
       shift_count(r, i) += n(j) * (high.function_period(at.span, j) + at.periods);
     }
     // The homogeneous curve at g, in the same period as the collocation row.
-    const auto old_at = basis_.locate(g);
-    const Eigen::VectorXd n_old = basis_.values(old_at.span, old_at.u);
-    Eigen::Vector3d h = Eigen::Vector3d::Zero();
-    for (int j = 0; j <= basis_.degree(); ++j) {
-      const int i = basis_.function_index(old_at.span, j);
-      const double w = extended_weight(i);
-      h.head<2>() += n_old(j) * w * extended_point(i, basis_.function_period(old_at.span, j) + old_at.periods);
-      h(2) += n_old(j) * w;
-    }
-    rhs.row(r) = h.transpose();
+    rhs.row(r) = homogeneous_derivatives(g, 0).row(0);
   }
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(collocation);
   const Eigen::VectorXd weights = lu.solve(rhs.col(2));

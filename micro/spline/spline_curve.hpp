@@ -48,6 +48,10 @@ class SplineCurve {
   SplineCurve elevated() const;
 
  private:
+  // Rows r = 0..n: d^r/du^r of the homogeneous curve (w·C, w) at u (A3.2 applied to the weighted
+  // control points; A4.2 turns it into the curve's derivatives).
+  Eigen::Matrix<double, Eigen::Dynamic, 3> homogeneous_derivatives(double u, int n) const;
+
   SplineBasis basis_;
   Points2 points_;
   Eigen::VectorXd weights_;
