@@ -51,7 +51,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
     const auto q = static_cast<int>(points_.size());
     for (size_t k = 0; k < sp.nodes.size(); ++k) {
       node_area_[static_cast<size_t>(sp.multipliers[k])] += sp.values(static_cast<Eigen::Index>(k)) * sp.weight;
-      node_points_[static_cast<size_t>(sp.multipliers[k])].push_back(q);
+      node_points_[static_cast<size_t>(sp.multipliers[k])].push_back({q, static_cast<int>(k)});
     }
     surface_length_ += sp.weight;
     points_.push_back(std::move(sp));
@@ -87,7 +87,7 @@ std::vector<std::vector<int>> MortarContact::coupled_nodes() const {
   std::vector<std::vector<int>> groups;
   for (const auto& support : node_points_) {
     std::vector<int> group;
-    for (const int q : support) {
+    for (const auto& [q, local] : support) {
       const auto& nodes = points_[static_cast<size_t>(q)].nodes;
       group.insert(group.end(), nodes.begin(), nodes.end());
     }
@@ -114,8 +114,9 @@ std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& 
   // weighted gap of such a node needs all of them. The rest of the surface is never searched.
   std::vector<bool> needed(n, false);
   for (const auto& support : node_points_) {
-    if (std::none_of(support.begin(), support.end(), [&](int q) { return near[static_cast<size_t>(q)]; })) continue;
-    for (const int q : support) needed[static_cast<size_t>(q)] = true;
+    const auto is_near = [&](const SupportPoint& s) { return near[static_cast<size_t>(s.point)]; };
+    if (std::none_of(support.begin(), support.end(), is_near)) continue;
+    for (const auto& s : support) needed[static_cast<size_t>(s.point)] = true;
   }
   std::vector<PointGap> out(n);
   projections = 0;
@@ -149,18 +150,26 @@ Eigen::VectorXd MortarContact::node_pressures(const std::vector<PointGap>& g) co
   for (size_t a = 0; a < surface_nodes_.size(); ++a) {
     double weighted = 0.0;
     bool complete = true;
-    for (const int q : node_points_[a]) {
+    for (const auto& [q, local] : node_points_[a]) {
       const auto& sp = points_[static_cast<size_t>(q)];
       if (!g[static_cast<size_t>(q)].evaluated) {
         complete = false;
         break;
       }
-      const auto k = std::find(sp.multipliers.begin(), sp.multipliers.end(), static_cast<int>(a)) - sp.multipliers.begin();
-      weighted += sp.values(k) * sp.weight * g[static_cast<size_t>(q)].gap;
+      weighted += sp.values(local) * sp.weight * g[static_cast<size_t>(q)].gap;
     }
     if (complete && weighted > 0.0) pressure(static_cast<Eigen::Index>(a)) = penalty_ * weighted / node_area_[a];
   }
   return pressure;
+}
+
+double MortarContact::point_pressure(size_t q, const Eigen::VectorXd& node_pressure) const {
+  const auto& sp = points_[q];
+  double pq = 0.0;
+  for (size_t k = 0; k < sp.nodes.size(); ++k) {
+    pq += node_pressure(sp.multipliers[k]) * sp.values(static_cast<Eigen::Index>(k));
+  }
+  return pq;
 }
 
 bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
@@ -173,8 +182,7 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
   // Mortar pressure at each point, P_q = Σ_a p_a N_a(q); force f_b = −Σ_q P_q w_q R_b n_q.
   for (size_t q = 0; q < points_.size(); ++q) {
     const auto& sp = points_[q];
-    double pq = 0.0;
-    for (size_t k = 0; k < sp.nodes.size(); ++k) pq += p(sp.multipliers[k]) * sp.values(static_cast<Eigen::Index>(k));
+    const double pq = point_pressure(q, p);
     if (pq <= 0.0) continue;
     for (size_t k = 0; k < sp.nodes.size(); ++k) {
       force.segment<2>(2 * sp.nodes[k]) -= pq * sp.weight * sp.values(static_cast<Eigen::Index>(k)) * g[q].normal;
@@ -196,10 +204,9 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
   for (size_t a = 0; a < surface_nodes_.size(); ++a) {
     if (p(static_cast<Eigen::Index>(a)) <= 0.0) continue;
     std::unordered_map<int, Eigen::Vector2d> gradient;  // node → ∂g_a/∂u_node
-    for (const int q : node_points_[a]) {
+    for (const auto& [q, local] : node_points_[a]) {
       const auto& sp = points_[static_cast<size_t>(q)];
-      const auto k = std::find(sp.multipliers.begin(), sp.multipliers.end(), static_cast<int>(a)) - sp.multipliers.begin();
-      const double factor = sp.values(k) * sp.weight / node_area_[a];
+      const double factor = sp.values(local) * sp.weight / node_area_[a];
       for (size_t b = 0; b < sp.nodes.size(); ++b) {
         auto [it, inserted] = gradient.try_emplace(sp.nodes[b], Eigen::Vector2d::Zero());
         it->second -= factor * sp.values(static_cast<Eigen::Index>(b)) * g[static_cast<size_t>(q)].normal;
@@ -227,8 +234,7 @@ ContactState MortarContact::state(const Eigen::VectorXd& u) const {
   s.surface_length = surface_length_;
   for (size_t q = 0; q < points_.size(); ++q) {
     const auto& sp = points_[q];
-    double pq = 0.0;
-    for (size_t k = 0; k < sp.nodes.size(); ++k) pq += p(sp.multipliers[k]) * sp.values(static_cast<Eigen::Index>(k));
+    const double pq = point_pressure(q, p);
     s.point_x.push_back(sp.position.x());
     s.point_pressure.push_back(std::max(pq, 0.0));
     s.point_normal.push_back(g[q].normal);

@@ -67,6 +67,8 @@ class MortarContact final : public solid::BoundaryInteraction {
   // Gaps at every point whose surface node could be in contact; the rest stay unevaluated.
   std::vector<PointGap> gaps(const Eigen::VectorXd& u, int& projections, std::string& reason, bool& ok) const;
   Eigen::VectorXd node_pressures(const std::vector<PointGap>& g) const;  // p_a per surface node
+  // The mortar pressure at a point, P_q = Σ_a p_a N_a(q).
+  double point_pressure(size_t q, const Eigen::VectorXd& node_pressure) const;
 
   // The tool as a graph over x (when it is one): dense samples (x, y, u) over one period, used to
   // bound each closest-point search to the spans within the point's vertical distance.
@@ -81,7 +83,11 @@ class MortarContact final : public solid::BoundaryInteraction {
   std::vector<SurfacePoint> points_;
   std::vector<int> surface_nodes_;         // global node of each surface node a
   std::vector<double> node_area_;          // A_a = ∫ N_a dΓ
-  std::vector<std::vector<int>> node_points_;  // points in the support of N_a
+  // The points in the support of N_a, each with N_a's position in that point's node list.
+  struct SupportPoint {
+    int point, local;
+  };
+  std::vector<std::vector<SupportPoint>> node_points_;
   double surface_length_ = 0.0;
 };
 
