@@ -100,8 +100,24 @@ void SolidProblem::fix_side(Side side, int component, double value, TimeFunction
 }
 
 void SolidProblem::add_load(SideLoad load) {
-  space_.boundary(load.side);  // throws for a side the patch does not have
+  load_points_.push_back(space_.boundary(load.side));  // throws for a side the patch does not have
   loads_.push_back(std::move(load));
+}
+
+void SolidProblem::constrain(SparseMatrix& matrix) const {
+  for (int col = 0; col < matrix.outerSize(); ++col) {
+    for (SparseMatrix::InnerIterator it(matrix, col); it; ++it) {
+      if (constrained_[static_cast<size_t>(it.row())] || constrained_[static_cast<size_t>(col)]) {
+        it.valueRef() = it.row() == col ? 1.0 : 0.0;
+      }
+    }
+  }
+}
+
+void SolidProblem::zero_constrained(Eigen::VectorXd& vector) const {
+  for (Eigen::Index i = 0; i < vector.size(); ++i) {
+    if (constrained_[static_cast<size_t>(i)]) vector(i) = 0.0;
+  }
 }
 
 void SolidProblem::apply_dirichlet(double t, Eigen::VectorXd& u) const {
@@ -190,9 +206,10 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
 
 Eigen::VectorXd SolidProblem::external(double t) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(dof_count());
-  for (const auto& load : loads_) {
+  for (size_t l = 0; l < loads_.size(); ++l) {
+    const SideLoad& load = loads_[l];
     const double s = load.scale ? load.scale(t) : 1.0;
-    for (const auto& bp : space_.boundary(load.side)) {
+    for (const auto& bp : load_points_[l]) {
       const Eigen::Vector2d traction = s * (load.traction - load.pressure * bp.normal);
       for (size_t a = 0; a < bp.nodes.size(); ++a) {
         f.segment<2>(2 * bp.nodes[a]) += bp.values(static_cast<Eigen::Index>(a)) * bp.weight * traction;

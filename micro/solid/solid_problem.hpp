@@ -75,6 +75,11 @@ class SolidProblem {
   const std::vector<bool>& constrained() const { return constrained_; }
   // Prescribed values at time t written into u (other entries untouched).
   void apply_dirichlet(double t, Eigen::VectorXd& u) const;
+  // Rows and columns of constrained dofs become identity rows and columns (symmetry kept), so a
+  // Newton increment leaves those dofs at their prescribed values.
+  void constrain(SparseMatrix& matrix) const;
+  // Zeroes the entries of constrained dofs (a right-hand side for the constrained matrix).
+  void zero_constrained(Eigen::VectorXd& vector) const;
 
   struct Assembly {
     Eigen::VectorXd internal;           // f_int(u)
@@ -102,6 +107,7 @@ class SolidProblem {
   std::vector<DirichletCondition> dirichlet_;
   std::vector<bool> constrained_;
   std::vector<SideLoad> loads_;
+  std::vector<std::vector<BoundaryPoint>> load_points_;  // quadrature of each load's side, computed once
   std::vector<std::shared_ptr<const BoundaryInteraction>> interactions_;
   SparseMatrix pattern_;                       // structure of the tangent, values zero
   std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col)

@@ -24,17 +24,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Rows and columns of constrained dofs become identity rows/columns (symmetry kept).
-void constrain(SparseMatrix& k, const std::vector<bool>& constrained) {
-  for (int col = 0; col < k.outerSize(); ++col) {
-    for (SparseMatrix::InnerIterator it(k, col); it; ++it) {
-      if (constrained[static_cast<size_t>(it.row())] || constrained[static_cast<size_t>(col)]) {
-        it.valueRef() = it.row() == col ? 1.0 : 0.0;
-      }
-    }
-  }
-}
-
 double free_norm(const Eigen::VectorXd& g, const std::vector<bool>& constrained) {
   double s = 0.0;
   for (Eigen::Index i = 0; i < g.size(); ++i) {
@@ -76,11 +65,9 @@ void TimeIntegrator::set_initial(const Eigen::VectorXd& u, const Eigen::VectorXd
   a_.setZero(u_.size());
   if (options_.scheme == TimeScheme::generalized_alpha) {
     SparseMatrix m = problem_.mass();
-    constrain(m, problem_.constrained());
+    problem_.constrain(m);
     Eigen::VectorXd rhs = problem_.external(0.0) - f_int_;
-    for (Eigen::Index i = 0; i < rhs.size(); ++i) {
-      if (problem_.constrained()[static_cast<size_t>(i)]) rhs(i) = 0.0;
-    }
+    problem_.zero_constrained(rhs);
     LinearSolver mass_solver(LinearSolverKind::cholesky);
     if (!mass_solver.factorize(m)) throw Error("time integration: the mass matrix is singular");
     a_ = mass_solver.solve(rhs);
@@ -156,11 +143,9 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
       Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
           mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
     }
-    constrain(k, constrained);
+    problem_.constrain(k);
     Eigen::VectorXd rhs = -current.residual;
-    for (Eigen::Index i = 0; i < rhs.size(); ++i) {
-      if (constrained[static_cast<size_t>(i)]) rhs(i) = 0.0;
-    }
+    problem_.zero_constrained(rhs);
     const auto start = std::chrono::steady_clock::now();
     if (!solver_.factorize(k)) {
       at.reason = solver_.reason();
