@@ -3,12 +3,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <memory>
 #include <string>
 
 #include "app/commands.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/units.hpp"
 #include "micro/scene/micro_run.hpp"
 #include "micro/spline/profile.hpp"
@@ -52,14 +53,14 @@ void run_profile(const ProfileOptions& o) {
               format_human(fit.max_error, QuantityKind::length).c_str(), r.rz > 0.0 ? 100.0 * fit.max_error / r.rz : 0.0);
   if (!o.out.empty()) {
     // Data and fitted curve side by side, for a plot: the curve at each datum's parameter.
-    std::ofstream out(o.out);
-    if (!out) throw Error("--out: cannot write '" + o.out + "'");
+    std::ostringstream out;
     out << "x[um],height[um],fit_x[um],fit_height[um]\n";
     out.precision(10);
     for (size_t k = 0; k < profile.x.size(); ++k) {
       const Eigen::Vector2d c = fit.curve.point(fit.parameters[k]);
       out << profile.x[k] * 1e6 << "," << profile.height[k] * 1e6 << "," << c.x() * 1e6 << "," << c.y() * 1e6 << "\n";
     }
+    write_file_atomically(o.out, out.str());
     std::printf("wrote %s\n", o.out.c_str());
   }
 }
@@ -107,16 +108,6 @@ void print_summary(const scene::MicroResult& r, const scene::Scene& sc) {
   for (const auto& c : r.cutbacks) std::printf("  cut-back at %.2f ns (dt %.3g s): %s\n", c.time * 1e9, c.dt_failed, c.reason.c_str());
 }
 
-void write_json(const std::string& path, const nlohmann::json& j) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary);
-    if (!out) throw Error("--out: cannot write '" + path + "'");
-    out << j.dump(2) << "\n";
-  }
-  std::filesystem::rename(temporary, path);
-}
-
 int run_command(const RunCommandOptions& o) {
   const scene::Scene sc = load_scene(o);
   std::filesystem::create_directories(o.out);
@@ -124,7 +115,7 @@ int run_command(const RunCommandOptions& o) {
   options.vtu_directory = o.out;
   if (!o.quiet) options.on_step = print_progress;
   const scene::MicroResult r = scene::run_micro(sc, options);
-  write_json(o.out + "/result.json", r.to_json(sc));
+  write_file_atomically(o.out + "/result.json", r.to_json(sc).dump(2) + "\n");
   print_summary(r, sc);
   std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu\n", o.out.c_str(), o.out.c_str(), o.out.c_str());
   return r.completed ? 0 : 3;

@@ -5,4 +5,7 @@
 namespace mufric {
 // The whole content of a file, or nothing if it cannot be opened (the caller names it in its error).
 std::optional<std::string> read_whole_file(const std::string& path);
+// Writes `text` to a temporary file beside `path` and renames it over `path`: a crash never leaves
+// half a file. Throws Error naming the path.
+void write_file_atomically(const std::string& path, const std::string& text);
 }  // namespace mufric

@@ -1,22 +1,15 @@
 #include "micro/scene/vtu.hpp"
 
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
+#include <sstream>
 
-#include "common/error.hpp"
+#include "common/files.hpp"
 
 namespace mufric::scene {
 namespace {
 
 constexpr int kSamplesPerElement = 4;  // sub-cells per element and direction
 constexpr int kVtkQuad = 9, kVtkPolyLine = 4;
-
-void commit(const std::string& temporary, const std::string& path) {
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw Error(path + ": cannot write (" + error.message() + ")");
-}
 
 // Linear interpolation of the contact pressure along the surface's reference x.
 double pressure_at(const contact::ContactState& c, double x) {
@@ -51,9 +44,7 @@ void write_chip_vtu(const std::string& path, const solid::SolidProblem& problem,
     temperature[e] += problem.states()[q].temperature;
     count[e] += 1.0;
   }
-  const std::string temporary = path + ".tmp";
-  std::ofstream out(temporary);
-  if (!out) throw Error(path + ": cannot write");
+  std::ostringstream out;
   out << std::setprecision(10);
   const int cells = (nu - 1) * (nv - 1);
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
@@ -103,16 +94,12 @@ void write_chip_vtu(const std::string& path, const solid::SolidProblem& problem,
     out << "</DataArray>\n";
   }
   out << "</CellData>\n</Piece></UnstructuredGrid></VTKFile>\n";
-  out.close();
-  if (!out) throw Error(path + ": write failed");
-  commit(temporary, path);
+  write_file_atomically(path, out.str());
 }
 
 void write_tool_vtu(const std::string& path, const spline::SplineCurve& tool) {
   constexpr int kPoints = 2000;
-  const std::string temporary = path + ".tmp";
-  std::ofstream out(temporary);
-  if (!out) throw Error(path + ": cannot write");
+  std::ostringstream out;
   out << std::setprecision(10);
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "<UnstructuredGrid><Piece NumberOfPoints=\"" << kPoints + 1 << "\" NumberOfCells=\"1\">\n"
@@ -126,9 +113,7 @@ void write_tool_vtu(const std::string& path, const spline::SplineCurve& tool) {
   out << "</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n" << kPoints + 1
       << "\n</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n" << kVtkPolyLine
       << "\n</DataArray></Cells>\n</Piece></UnstructuredGrid></VTKFile>\n";
-  out.close();
-  if (!out) throw Error(path + ": write failed");
-  commit(temporary, path);
+  write_file_atomically(path, out.str());
 }
 
 }  // namespace mufric::scene
