@@ -76,6 +76,11 @@ double temperature_factor(const JohnsonCookParameters& p, double temperature) {
   return 1.0 - std::pow(hat, p.m);
 }
 
+// 1 + C ln(max(ε̇/ε̇0, 1)): the log term never lowers the yield stress below its ε̇0 value.
+double rate_factor(const JohnsonCookParameters& p, double rate) {
+  return 1.0 + p.c * std::log(std::max(rate / p.reference_strain_rate, 1.0));
+}
+
 // σy at ε̄ = ε̄n + √(2/3)Δγ and rate √(2/3)Δγ/dt, with its derivative in Δγ; `thermal` is the
 // temperature factor (1 − θ̂^m), constant during a step.
 YieldWithSlope yield_along_return(const JohnsonCookParameters& p, double start_strain, double dgamma, double dt,
@@ -85,19 +90,18 @@ YieldWithSlope yield_along_return(const JohnsonCookParameters& p, double start_s
   const double power = std::pow(strain, p.n);  // one pow: the slope is n·power/strain
   const double hardening = p.a + p.b * power;
   const double hardening_slope = strain > 0.0 ? p.b * p.n * power / strain : std::numeric_limits<double>::infinity();
-  const double ratio = rate / p.reference_strain_rate;
-  const double rate_factor = 1.0 + p.c * std::log(std::max(ratio, 1.0));
-  const double rate_slope = ratio > 1.0 ? p.c / rate : 0.0;  // d(rate factor)/d(rate)
-  return {hardening * rate_factor * thermal,
-          thermal * kSqrtTwoThirds * (hardening_slope * rate_factor + hardening * rate_slope / dt)};
+  const double factor = rate_factor(p, rate);
+  const double rate_slope = rate > p.reference_strain_rate ? p.c / rate : 0.0;  // d(rate factor)/d(rate)
+  return {hardening * factor * thermal,
+          thermal * kSqrtTwoThirds * (hardening_slope * factor + hardening * rate_slope / dt)};
 }
 
 }  // namespace
 
 double johnson_cook_yield_stress(const JohnsonCookParameters& p, double plastic_strain, double plastic_strain_rate,
                                  double temperature) {
-  const double rate_factor = 1.0 + p.c * std::log(std::max(plastic_strain_rate / p.reference_strain_rate, 1.0));
-  return (p.a + p.b * std::pow(plastic_strain, p.n)) * rate_factor * temperature_factor(p, temperature);
+  return (p.a + p.b * std::pow(plastic_strain, p.n)) * rate_factor(p, plastic_strain_rate) *
+         temperature_factor(p, temperature);
 }
 
 LinearElastic::LinearElastic(double youngs_modulus, double poisson_ratio, double density, PlaneKind kind)
