@@ -198,17 +198,22 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   const double theta = start.temperature;
   const double thermal = temperature_factor(p_, theta);
   const double eps_n = start.equivalent_plastic_strain;
-  const double yield_start = johnson_cook_yield_stress(p_, eps_n, 0.0, theta);
+  // σy at the start of the step, at rest (the rate factor is 1 below ε̇0): one pow for hardening.
+  const double yield_start = (p_.a + p_.b * std::pow(eps_n, p_.n)) * thermal;
   double dgamma = 0.0, slope = 0.0;
+  YieldWithSlope yield_end{yield_start, 0.0};
   if (q_trial - kSqrtTwoThirds * yield_start > kReturnMapRelativeTolerance * q_trial) {
     // r(Δγ) = q − 2μΔγ − √(2/3) σy(Δγ), decreasing; r(0) > 0 ≥ r(q/2μ): bracketed Newton (rtsafe).
     double lo = 0.0, hi = q_trial / (2.0 * mu_);
-    dgamma = 0.5 * hi;
+    // Start from the perfectly plastic answer (yield stress frozen at its start value): hardening
+    // and rate only raise σy, so the root lies below it, and it is close because 2μ ≫ dσy/dΔγ.
+    dgamma = std::clamp((q_trial - kSqrtTwoThirds * yield_start) / (2.0 * mu_), 0.01 * hi, 0.99 * hi);
     bool converged = false;
     for (int it = 0; it < kReturnMapMaxIterations; ++it) {
       const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, thermal);
       const double r = q_trial - 2.0 * mu_ * dgamma - kSqrtTwoThirds * y.stress;
       slope = -2.0 * mu_ - kSqrtTwoThirds * y.slope;
+      yield_end = y;
       if (std::abs(r) <= kReturnMapRelativeTolerance * q_trial) {
         converged = true;
         break;
@@ -243,8 +248,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   const D q = 2.0 * mu_ * t.norm;
   D scale = D(1.0);
   if (dgamma > 0.0) {
-    const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, thermal);
-    const D r = q - 2.0 * mu_ * dgamma - kSqrtTwoThirds * y.stress;
+    const D r = q - 2.0 * mu_ * dgamma - kSqrtTwoThirds * yield_end.stress;
     const D dg = dgamma - r / slope;
     scale = 1.0 - 2.0 * mu_ * dg / q;
   }
@@ -281,9 +285,8 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
                                       std::exp(2.0 * (trial.dev_zz * keep + third))};
   const double d_eps = kSqrtTwoThirds * dgamma;
   out.state.equivalent_plastic_strain = eps_n + d_eps;
-  const double yield_end = yield_along_return(p_, eps_n, dgamma, dt, thermal).stress;
-  out.state.yield_stress = yield_end;
-  out.state.temperature = theta + p_.heat_fraction * yield_end * d_eps / (p_.density * p_.specific_heat);
+  out.state.yield_stress = yield_end.stress;
+  out.state.temperature = theta + p_.heat_fraction * yield_end.stress * d_eps / (p_.density * p_.specific_heat);
   return out;
 }
 
