@@ -46,6 +46,7 @@ TEST(Scene, ErrorsNameTheKey) {
       {"discretisation.degree=9", "discretisation.degree: 9 is outside"},
       {"physics=lubricated", "not implemented yet"},
       {"time.average_from=\"1s\"", "time.average_from"},
+      {"time.max_step=\"0.5ns\"", "time.max_step: is shorter than time.step"},
       {"geometry.chip_surface.flat=true", "exactly one of csv, synthetic or flat"}};
   for (const auto& [assignment, expected] : cases) {
     nlohmann::json bad = j;

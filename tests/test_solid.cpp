@@ -477,5 +477,32 @@ TEST(TimeIntegration, AFailingStepIsCutBackAndReported) {
   EXPECT_GT(coarse.steps.size(), 1u);
 }
 
+// The step-size control: a linear problem converges in one Newton iteration per step, so each step
+// doubles (the growth limit) until max_dt; without max_dt every step keeps the first step's length.
+TEST(TimeIntegration, EasyStepsGrowToTheLongestAllowedStepAndNoFurther) {
+  auto step_lengths = [](double max_dt) {
+    SolidProblem problem(IgaSpace(unit_square(2, 2)), std::make_shared<LinearElastic>(200e9, 0.3, 7800.0));
+    problem.fix_side(Side::bottom, 1);
+    problem.fix_side(Side::left, 0);
+    problem.add_load({Side::top, Eigen::Vector2d::Zero(), 1e8, [](double t) { return t; }});
+    TimeIntegrationOptions options;
+    options.scheme = TimeScheme::quasi_static;
+    options.dt = 1.0;
+    options.max_dt = max_dt;
+    options.end_time = 20.0;
+    TimeIntegrator integrator(problem, options);
+    const IntegrationReport report = integrator.run();
+    EXPECT_TRUE(report.completed) << report.reason;
+    std::vector<double> lengths;
+    for (const auto& s : report.steps) {
+      EXPECT_LE(s.newton_iterations, 2);
+      lengths.push_back(s.dt);
+    }
+    return lengths;
+  };
+  EXPECT_EQ(step_lengths(4.0), (std::vector<double>{1, 2, 4, 4, 4, 4, 1}));
+  EXPECT_EQ(step_lengths(0.0), std::vector<double>(20, 1.0));
+}
+
 }  // namespace
 }  // namespace mufric::solid

@@ -108,7 +108,10 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
                       {"dofs", dofs},
                       {"elements", elements},
                       {"wall_seconds", wall_seconds},
+                      {"assemblies", assemblies},
+                      {"line_search_reductions", line_search_reductions},
                       {"assembly_seconds", seconds_assembly},
+                      {"contact_seconds", seconds_contact},
                       {"solve_seconds", seconds_solve}};
   auto& cuts = j["cutbacks"] = nlohmann::json::array();
   for (const auto& c : cutbacks) cuts.push_back({{"time_s", c.time}, {"dt_failed_s", c.dt_failed}, {"reason", c.reason}});
@@ -164,6 +167,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   o.scheme = scene.scheme;
   o.spectral_radius = scene.spectral_radius;
   o.dt = scene.dt;
+  o.max_dt = scene.max_dt;
   o.end_time = scene.duration;
   o.relative_tolerance = scene.relative_tolerance;
   o.max_newton_iterations = scene.max_newton_iterations;
@@ -203,6 +207,9 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   result.cutbacks = report.cutbacks;
   result.seconds_assembly = report.seconds_assembly;
   result.seconds_solve = report.seconds_solve;
+  result.seconds_contact = report.seconds_contact;
+  result.assemblies = report.assemblies;
+  result.line_search_reductions = report.line_search_reductions;
   result.contact_fraction = last.surface_length > 0.0 ? last.contact_length / last.surface_length : 0.0;
   result.max_contact_pressure = last.max_pressure;
   for (const auto& s : problem.states()) {

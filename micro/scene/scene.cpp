@@ -232,6 +232,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     s.dt = t.quantity("step", QuantityKind::time, s.dt, 1e-15, 1.0);
     s.duration = t.quantity("duration", QuantityKind::time, s.duration, 1e-15, 10.0);
     if (s.dt > s.duration) t.fail("step", "is longer than the duration");
+    s.max_dt = t.quantity("max_step", QuantityKind::time, s.dt, 1e-15, 1.0);
+    if (s.max_dt < s.dt) t.fail("max_step", "is shorter than time.step");
     s.average_from = t.quantity("average_from", QuantityKind::time, 0.5 * s.duration, 0.0, kHuge);
     if (s.average_from >= s.duration) t.fail("average_from", "must lie before the end of the run");
     t.finish();

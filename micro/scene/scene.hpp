@@ -50,7 +50,8 @@ struct Scene {
   // time
   solid::TimeScheme scheme = solid::TimeScheme::generalized_alpha;
   double spectral_radius = 0.8;
-  double dt = 1e-9;                   // s
+  double dt = 1e-9;                   // s, the first step
+  double max_dt = 1e-9;               // s, the longest step the step-size control may take
   double duration = 2.5e-7;           // s (seed 000 Figs. 3–5)
   double average_from = 1.25e-7;      // s, μ is averaged over [average_from, duration]
   // contact

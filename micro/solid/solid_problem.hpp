@@ -88,6 +88,7 @@ class SolidProblem {
     std::vector<Eigen::Matrix2d> stresses;  // S at each quadrature point
     bool ok = true;
     std::string reason;
+    double seconds_interactions = 0.0;  // of which contact and other boundary interactions
   };
   // Internal forces at u from the committed states (step length dt for rates); never commits.
   Assembly assemble(const Eigen::VectorXd& u, double dt, bool with_tangent) const;

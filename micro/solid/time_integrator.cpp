@@ -1,5 +1,6 @@
 #include "micro/solid/time_integrator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -98,6 +99,8 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     const auto start = std::chrono::steady_clock::now();
     e.assembly = problem_.assemble(u, dt, with_tangent);
     report_.seconds_assembly += seconds_since(start);
+    report_.seconds_contact += e.assembly.seconds_interactions;
+    ++report_.assemblies;
     if (!e.assembly.ok) return e;
     if (dynamic) {
       e.a1 = (u - u_ - dt * v_ - dt * dt * (0.5 - b) * a_) / (b * dt * dt);
@@ -156,7 +159,9 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     // Line search on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction.
     const double phi0 = current.norm * current.norm;
     double s = 1.0;
-    Evaluation trial = evaluate(u1 + delta, false);
+    // The full step is usually accepted: evaluating it with its tangent makes it the next
+    // iteration's linearisation, one material update per iteration instead of two.
+    Evaluation trial = evaluate(u1 + delta, true);
     if (options_.line_search) {
       for (int r = 0; r < kLineSearchMaxReductions; ++r) {
         const double phi1 = trial.assembly.ok ? trial.norm * trial.norm : std::numeric_limits<double>::infinity();
@@ -170,7 +175,9 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     u1 += s * delta;
     const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
                            trial.norm <= 1e3 * tolerance;
-    current = evaluate(u1, !stagnated);
+    // `trial` was evaluated at the new u1; it lacks a tangent only after a line-search reduction.
+    const bool trial_has_tangent = s == 1.0;
+    current = stagnated || trial_has_tangent ? std::move(trial) : evaluate(u1, true);
     if (stagnated && current.assembly.ok) {
       at.record.newton_iterations = it + 1;
       at.record.residual = current.norm;
@@ -194,6 +201,14 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   at.record.time = t1;
   at.record.dt = dt;
   return at;
+}
+
+double TimeIntegrator::next_step(double dt, int newton_iterations) const {
+  const double max_dt = options_.max_dt > 0.0 ? std::max(options_.max_dt, options_.dt) : options_.dt;
+  const double factor = std::clamp(static_cast<double>(kTargetNewtonIterations) / std::max(newton_iterations, 1),
+                                   kMaxStepShrink, kMaxStepGrowth);
+  const double shortest = std::min(dt, kShortestControlledStep * options_.dt);  // never grow a cut-back step by shrinking
+  return std::clamp(factor * dt, shortest, max_dt);
 }
 
 IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>& on_step) {
@@ -223,10 +238,9 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     t += this_dt;
     report_.steps.push_back(at.record);
     report_.newton_iterations += at.record.newton_iterations;
+    report_.line_search_reductions += at.record.line_search_reductions;
     if (on_step) on_step(StepView{t, u_, v_, a_, reactions_, stresses_, problem_});
-    // After a cut-back, grow back only from steps that converged easily: growing after a hard step
-    // invites the next failure, which costs a whole Newton run.
-    if (at.record.newton_iterations <= kEasyStepIterations) dt = std::min(options_.dt, 2.0 * this_dt);
+    dt = next_step(this_dt, at.record.newton_iterations);
   }
   report_.completed = true;
   report_.symbolic_analyses = solver_.analyses();

@@ -22,13 +22,21 @@ enum class TimeScheme { generalized_alpha, quasi_static };
 inline constexpr double kNewtonStagnationIncrement = 1e-14;
 inline constexpr double kLineSearchSufficientDecrease = 1e-4;  // Armijo constant on ‖G‖²
 inline constexpr int kLineSearchMaxReductions = 8;
-// A step that converged in at most this many Newton iterations lets a cut-back step grow again.
-inline constexpr int kEasyStepIterations = 8;
+// Step-size control by Newton iteration count (the iteration-count heuristic of e.g. Wriggers,
+// Nonlinear Finite Element Methods 2008, sec. 5.2.3, and Abaqus' automatic incrementation): the next
+// step is the last one × kTargetNewtonIterations / iterations, within [1/2, 2] and at most max_dt.
+// Steps that needed many iterations shrink before they fail, but not below dt ×
+// kShortestControlledStep: where iterations stay high however short the step (an active contact set
+// that keeps changing), shrinking further would only multiply the steps. Cut-backs go below it.
+inline constexpr int kTargetNewtonIterations = 8;
+inline constexpr double kMaxStepGrowth = 2.0, kMaxStepShrink = 0.5;
+inline constexpr double kShortestControlledStep = 0.25;
 
 struct TimeIntegrationOptions {
   TimeScheme scheme = TimeScheme::generalized_alpha;
   double spectral_radius = 0.8;  // ρ∞ ∈ [0, 1]: 1 conserves energy (trapezoidal), 0 damps the highest modes at once
-  double dt = 1e-8;              // s
+  double dt = 1e-8;              // s, the first step
+  double max_dt = 0.0;           // s, the longest step the controller may take (0: dt)
   double end_time = 1e-7;        // s
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
@@ -55,7 +63,10 @@ struct IntegrationReport {
   std::vector<CutBack> cutbacks;
   int newton_iterations = 0;
   int symbolic_analyses = 0;  // sparse symbolic factorisations (1 per run: the pattern is fixed)
+  int assemblies = 0;              // residual evaluations (with or without tangent)
+  int line_search_reductions = 0;
   double seconds_assembly = 0.0, seconds_solve = 0.0;
+  double seconds_contact = 0.0;    // part of seconds_assembly spent in boundary interactions
 };
 
 // The fields at the end of an accepted step, for callers that watch the run.
@@ -88,6 +99,7 @@ class TimeIntegrator {
     StepRecord record;
   };
   Attempt step(double t0, double dt);
+  double next_step(double dt, int newton_iterations) const;
   double alpha_m() const, alpha_f() const, beta() const, gamma() const;
   SolidProblem& problem_;
   TimeIntegrationOptions options_;
