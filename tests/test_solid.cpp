@@ -444,7 +444,13 @@ TEST(ChipPatch, FromConfigurationKeepsTheSurfaceAndHasTheRequestedMesh) {
   for (int s = 0; s <= 500; ++s) worst = std::max(worst, (patch.top().point(s / 500.0) - surface.point(s / 500.0)).norm());
   EXPECT_LT(worst, 1e-18);
   EXPECT_NEAR(patch.point(0.3, 0.0).y(), -4e-6, 1e-20);
-  EXPECT_THROW(chip_patch(surface, {.degree = 1}), Error);
+  // Degree 1 asked for a quadratic surface: quadratic along x (the geometry is kept exactly), linear
+  // across the thickness.
+  const SplineSurface mixed = chip_patch(surface, {.degree = 1, .spans_x = 20, .spans_y = 2, .y_bottom = -4e-6});
+  EXPECT_EQ(mixed.u_basis().degree(), 2);
+  EXPECT_EQ(mixed.v_basis().degree(), 1);
+  EXPECT_LT((mixed.top().point(0.37) - surface.point(0.37)).norm(), 1e-18);
+  EXPECT_THROW(chip_patch(surface, {.degree = 0}), Error);
   EXPECT_THROW(chip_patch(surface, {.degree = 2, .spans_x = 10}), Error);
 }
 

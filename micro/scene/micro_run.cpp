@@ -138,7 +138,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
                 ") must be at least the chip surface fit's " + std::to_string(fit_spans) + " spans");
   }
   const spline::SplineSurface patch =
-      solid::chip_patch(geometry.chip_surface, {.degree = std::max(scene.degree, scene.chip_surface.degree),
+      solid::chip_patch(geometry.chip_surface, {.degree = scene.degree,
                                                 .spans_x = scene.elements_x,
                                                 .spans_y = scene.elements_y,
                                                 .y_bottom = -scene.chip_height,

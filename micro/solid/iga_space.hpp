@@ -64,8 +64,9 @@ class IgaSpace {
 };
 
 // The chip patch of one periodic interval from its configuration: the surface curve (periodic,
-// shift (L, 0)) raised to `degree` along x and refined to `spans_x` spans, extruded down to
-// y_bottom with `degree` and `spans_y` spans across the thickness.
+// shift (L, 0)) raised to `degree` along x (a surface fit of higher degree keeps its own: lowering
+// it would change the geometry) and refined to `spans_x` spans, extruded down to y_bottom with
+// `degree` and `spans_y` spans across the thickness.
 struct ChipMeshOptions {
   int degree = 2;
   int spans_x = 32;   // spans along the interval (at least the surface fit's own spans)

@@ -172,6 +172,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
         ++at.record.line_search_reductions;
       }
     }
+    if (trace_newton()) std::fprintf(stderr, "newton   step length %.3g after %d reductions\n", s, at.record.line_search_reductions);
     u1 += s * delta;
     const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
                            trial.norm <= 1e3 * tolerance;

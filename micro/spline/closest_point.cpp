@@ -11,6 +11,7 @@ namespace {
 struct Sample {
   double u;
   double distance_squared;
+  Eigen::Vector2d point;  // C(u), kept for the length scale
 };
 
 struct LocalResult {
@@ -154,15 +155,17 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
   for (size_t e = 0; e + 1 < breaks.size(); ++e) {
     for (int q = 0; q < per_span; ++q) {
       const double u = breaks[e] + (breaks[e + 1] - breaks[e]) * q / per_span;
-      samples.push_back({u, (curve.point(u) - x).squaredNorm()});
+      const Eigen::Vector2d c = curve.point(u);
+      samples.push_back({u, (c - x).squaredNorm(), c});
     }
   }
-  samples.push_back({hi, (curve.point(hi) - x).squaredNorm()});
+  const Eigen::Vector2d c_hi = curve.point(hi);
+  samples.push_back({hi, (c_hi - x).squaredNorm(), c_hi});
   const bool closed = basis.is_periodic() && curve.shift().isZero() && !windowed;
   const size_t count = samples.size();
   double length_scale = 0.0;
   for (size_t i = 1; i < count; ++i) {
-    length_scale = std::max(length_scale, (curve.point(samples[i].u) - curve.point(samples[i - 1].u)).norm());
+    length_scale = std::max(length_scale, (samples[i].point - samples[i - 1].point).norm());
   }
   Projection out;
   out.distance = std::numeric_limits<double>::infinity();
