@@ -8,6 +8,7 @@
 
 #include "common/error.hpp"
 #include "common/version.hpp"
+#include "surrogate/sampling.hpp"
 
 namespace mufric {
 namespace {
@@ -60,19 +61,13 @@ Dataset sample_model(const FrictionModel& model, const SamplingOptions& options,
   const auto n = static_cast<Eigen::Index>(options.samples);
   const auto d = static_cast<Eigen::Index>(model.inputs().size());
   std::mt19937_64 rng(options.seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   Dataset data;
   data.inputs = model.inputs();
+  const Eigen::MatrixXd u = latin_hypercube(n, d, rng);
   data.x.resize(n, d);
-  std::vector<Eigen::Index> strata(static_cast<size_t>(n));
   for (Eigen::Index j = 0; j < d; ++j) {
-    std::iota(strata.begin(), strata.end(), Eigen::Index{0});
-    std::shuffle(strata.begin(), strata.end(), rng);
     const auto& input = data.inputs[static_cast<size_t>(j)];
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double u = (static_cast<double>(strata[static_cast<size_t>(i)]) + unit(rng)) / static_cast<double>(n);
-      data.x(i, j) = input.lo + u * (input.hi - input.lo);
-    }
+    data.x.col(j) = (input.lo + u.col(j).array() * (input.hi - input.lo)).matrix();
   }
   const Evaluation e = model.evaluate(data.x, {});
   data.mu = e.mu;
