@@ -47,6 +47,22 @@ Dataset read_hdf5_dataset(const std::string& path) {
     }
   }
   if (in.has("/plan/inputs")) d.plan = in.matrix("/plan/inputs");
+  if (d.plan.rows() > 0 && d.plan.cols() != dims) {
+    in.fail("/plan/inputs", "has " + std::to_string(d.plan.cols()) + " columns, " + std::to_string(dims) +
+                                " inputs are declared");
+  }
+  if (in.has("/samples/plan_index")) {
+    d.plan_index = in.ints("/samples/plan_index");
+    if (static_cast<Eigen::Index>(d.plan_index.size()) != n) in.fail("/samples/plan_index", "length differs from /samples/inputs");
+    for (size_t i = 0; i < d.plan_index.size(); ++i) {
+      if (d.plan_index[i] < -1 || d.plan_index[i] >= d.plan.rows()) {
+        in.fail("/samples/plan_index", "row " + std::to_string(i) + " points to plan row " + std::to_string(d.plan_index[i]) +
+                                           " of " + std::to_string(d.plan.rows()));
+      }
+    }
+  }
+  if (in.has_attribute("/plan", "design")) d.plan_design = in.string_attribute("/plan", "design");
+  if (in.has_attribute("/plan", "seed")) d.plan_seed = in.int_attribute("/plan", "seed");
   if (in.has_attribute("/", "source")) d.source = in.string_attribute("/", "source");
   if (in.has_attribute("/", "scene_json")) d.scene_json = in.string_attribute("/", "scene_json");
   if (in.has_attribute("/", "code_version")) d.code_version = in.string_attribute("/", "code_version");
@@ -94,7 +110,8 @@ Dataset read_dataset(const std::string& path) {
 void write_dataset(const std::string& path, const Dataset& d) {
   const auto n = d.x.rows();
   if (d.mu.size() != n || static_cast<Eigen::Index>(d.status.size()) != n ||
-      static_cast<Eigen::Index>(d.failure_reason.size()) != n) {
+      static_cast<Eigen::Index>(d.failure_reason.size()) != n ||
+      (!d.plan_index.empty() && static_cast<Eigen::Index>(d.plan_index.size()) != n)) {
     throw Error("write_dataset '" + path + "': samples arrays differ in length");
   }
   h5::Writer out(path);
@@ -113,8 +130,13 @@ void write_dataset(const std::string& path, const Dataset& d) {
   out.strings("/samples/failure_reason", d.failure_reason);
   out.group("/samples/diagnostics");
   for (const auto& [name, values] : d.diagnostics) out.doubles("/samples/diagnostics/" + name, values);
+  if (!d.plan_index.empty()) out.ints("/samples/plan_index", d.plan_index);
   out.group("/plan");
   out.matrix("/plan/inputs", d.plan);
+  if (!d.plan_design.empty()) {
+    out.string_attribute("/plan", "design", d.plan_design);
+    out.int_attribute("/plan", "seed", d.plan_seed);
+  }
   out.commit();
 }
 

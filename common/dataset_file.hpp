@@ -2,6 +2,8 @@
 // The training database (ARCHITECTURE.md "Dataset"): one HDF5 file, SI units, self-describing.
 //   /samples/inputs n×d, /samples/mu n, /samples/status n (0 converged, 1 failed),
 //   /samples/failure_reason n, /samples/diagnostics/<name> n (optional), /plan/inputs m×d;
+//   /samples/plan_index n (optional: the plan row each sample answers, −1 for none), /plan
+//   attributes design and seed (optional);
 //   root attributes: format, schema_version, input_names/units (in /inputs), box, provenance.
 // A CSV with unit-annotated header ("contact_pressure[MPa],...,mu") is accepted for training too.
 #include <map>
@@ -28,6 +30,9 @@ struct Dataset {
   std::vector<std::string> failure_reason;  // n, empty when converged
   std::map<std::string, Eigen::VectorXd> diagnostics;  // each n
   h5::RowMatrix plan;               // m × d requested points
+  std::vector<long long> plan_index;  // n, row of `plan` each sample answers (−1: none); empty: unknown
+  std::string plan_design;          // how the plan was drawn ("sobol", ...), empty if unknown
+  long long plan_seed = 0;
   std::string source;               // how the samples were made (scene hash, law name, ...)
   std::string scene_json;           // scene text when made by the micro-model
   std::string code_version;

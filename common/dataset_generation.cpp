@@ -1,0 +1,278 @@
+#include "common/dataset_generation.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "common/error.hpp"
+#include "common/version.hpp"
+
+namespace mufric {
+
+Shard parse_shard(const std::string& text, const std::string& field) {
+  const auto slash = text.find('/');
+  Shard s;
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("no slash");
+    size_t used = 0;
+    s.index = std::stoll(text.substr(0, slash), &used);
+    if (used != slash) throw std::invalid_argument("index");
+    const std::string count = text.substr(slash + 1);
+    s.count = std::stoll(count, &used);
+    if (used != count.size()) throw std::invalid_argument("count");
+  } catch (const std::exception&) {
+    throw Error(field + " '" + text + "': give i/N, e.g. 0/4");
+  }
+  if (s.count < 1 || s.index < 0 || s.index >= s.count) {
+    throw Error(field + " '" + text + "': needs N >= 1 and 0 <= i < N");
+  }
+  return s;
+}
+
+namespace {
+
+bool same_inputs(const InputSpace& a, const InputSpace& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t j = 0; j < a.size(); ++j) {
+    if (a[j].name != b[j].name || a[j].unit != b[j].unit || a[j].lo != b[j].lo || a[j].hi != b[j].hi) return false;
+  }
+  return true;
+}
+
+Dataset empty_database(const Dataset& plan) {
+  Dataset d;
+  d.inputs = plan.inputs;
+  d.x.resize(0, static_cast<Eigen::Index>(plan.inputs.size()));
+  d.mu.resize(0);
+  d.plan = plan.plan;
+  d.plan_design = plan.plan_design;
+  d.plan_seed = plan.plan_seed;
+  d.source = plan.source;
+  d.scene_json = plan.scene_json;
+  d.code_version = code_version();
+  return d;
+}
+
+}  // namespace
+
+Dataset open_database(const std::string& db_path, const Dataset& plan) {
+  if (plan.plan.rows() == 0) throw Error("the plan has no points (/plan/inputs is empty)");
+  if (!std::filesystem::exists(db_path)) return empty_database(plan);
+  Dataset d = read_dataset(db_path);
+  if (!same_inputs(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
+  if (d.plan.rows() != plan.plan.rows() || d.plan.cols() != plan.plan.cols() || d.plan != plan.plan) {
+    throw Error(db_path + ": was made from a different plan (" + std::to_string(d.plan.rows()) + " rows, the plan has " +
+                std::to_string(plan.plan.rows()) + " or different points); use another --db");
+  }
+  if (d.scene_json != plan.scene_json) {
+    throw Error(db_path + ": was made with a different scene (sha256 " + sha256_hex(d.scene_json).substr(0, 12) +
+                ", now " + sha256_hex(plan.scene_json).substr(0, 12) + "); use another --db");
+  }
+  if (d.plan_index.size() != static_cast<size_t>(d.size())) throw Error(db_path + ": has samples without plan rows");
+  return d;
+}
+
+void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, const SampleOutcome& outcome) {
+  const Eigen::Index n = d.size();
+  d.x.conservativeResize(n + 1, Eigen::NoChange);
+  d.x.row(n) = x.transpose();
+  d.mu.conservativeResize(n + 1);
+  d.mu(n) = outcome.converged ? outcome.mu : std::numeric_limits<double>::quiet_NaN();
+  d.status.push_back(static_cast<long long>(outcome.converged ? SampleStatus::converged : SampleStatus::failed));
+  d.failure_reason.push_back(outcome.converged ? "" : outcome.failure_reason);
+  d.plan_index.push_back(plan_row);
+  for (auto& [name, values] : d.diagnostics) {
+    values.conservativeResize(n + 1);
+    const auto it = outcome.diagnostics.find(name);
+    values(n) = it != outcome.diagnostics.end() ? it->second : std::numeric_limits<double>::quiet_NaN();
+  }
+  for (const auto& [name, value] : outcome.diagnostics) {
+    if (d.diagnostics.count(name)) continue;
+    Eigen::VectorXd values = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::quiet_NaN());
+    values(n) = value;
+    d.diagnostics[name] = values;
+  }
+}
+
+namespace {
+
+// Removes the samples answering `rows` (failed ones about to be retried).
+void remove_rows(Dataset& d, const std::set<long long>& rows) {
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    if (!rows.count(d.plan_index[static_cast<size_t>(i)])) keep.push_back(i);
+  }
+  Dataset k = d;
+  const auto m = static_cast<Eigen::Index>(keep.size());
+  k.x.resize(m, d.x.cols());
+  k.mu.resize(m);
+  k.status.clear();
+  k.failure_reason.clear();
+  k.plan_index.clear();
+  for (auto& [name, values] : k.diagnostics) values.resize(m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Eigen::Index i = keep[static_cast<size_t>(r)];
+    k.x.row(r) = d.x.row(i);
+    k.mu(r) = d.mu(i);
+    k.status.push_back(d.status[static_cast<size_t>(i)]);
+    k.failure_reason.push_back(d.failure_reason[static_cast<size_t>(i)]);
+    k.plan_index.push_back(d.plan_index[static_cast<size_t>(i)]);
+    for (auto& [name, values] : k.diagnostics) values(r) = d.diagnostics.at(name)(i);
+  }
+  d = std::move(k);
+}
+
+}  // namespace
+
+GenerationReport generate_dataset(const Dataset& plan, const std::string& db_path, const SampleEvaluator& evaluate,
+                                  const GenerationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.jobs < 1) throw Error("--jobs must be at least 1");
+  Dataset db = open_database(db_path, plan);
+  GenerationReport report;
+  std::set<long long> done, failed_rows;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    const long long row = db.plan_index[static_cast<size_t>(i)];
+    const bool failed = db.status[static_cast<size_t>(i)] != static_cast<long long>(SampleStatus::converged);
+    if (failed && options.retry_failed) {
+      failed_rows.insert(row);
+    } else {
+      done.insert(row);
+    }
+  }
+  if (!failed_rows.empty()) remove_rows(db, failed_rows);
+  std::vector<long long> pending;
+  for (long long row = 0; row < plan.plan.rows(); ++row) {
+    if (row % options.shard.count != options.shard.index) continue;
+    ++report.planned;
+    if (done.count(row)) {
+      ++report.already_done;
+    } else if (options.limit < 0 || static_cast<long long>(pending.size()) < options.limit) {
+      pending.push_back(row);
+    }
+  }
+  write_dataset(db_path, db);  // the database exists (and is valid) before the first sample finishes
+
+  std::mutex lock;
+  std::atomic<size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::exception_ptr write_failure;
+  auto worker = [&] {
+    while (!stop) {
+      const size_t k = next++;
+      if (k >= pending.size()) return;
+      const long long row = pending[k];
+      const Eigen::VectorXd x = plan.plan.row(row).transpose();
+      const auto sample_start = std::chrono::steady_clock::now();
+      SampleOutcome outcome;
+      try {
+        outcome = evaluate(x);
+        if (outcome.converged && !std::isfinite(outcome.mu)) {
+          outcome.converged = false;
+          outcome.failure_reason = "the evaluator returned a non-finite mu";
+        }
+      } catch (const std::exception& e) {
+        outcome = SampleOutcome{};
+        outcome.failure_reason = std::string("exception: ") + e.what();
+      }
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sample_start).count();
+      outcome.diagnostics["wall_seconds"] = seconds;
+      std::lock_guard<std::mutex> guard(lock);
+      if (stop) return;
+      try {
+        append_sample(db, x, row, outcome);
+        write_dataset(db_path, db);
+      } catch (...) {
+        write_failure = std::current_exception();
+        stop = true;
+        return;
+      }
+      ++report.ran;
+      (outcome.converged ? report.converged : report.failed) += 1;
+      if (options.on_sample) {
+        GenerationProgress p;
+        p.finished = report.ran;
+        p.to_run = static_cast<long long>(pending.size());
+        p.failed = report.failed;
+        p.plan_row = row;
+        p.outcome = &outcome;
+        p.sample_seconds = seconds;
+        p.elapsed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        options.on_sample(p);
+      }
+    }
+  };
+  const int threads = static_cast<int>(std::min<size_t>(static_cast<size_t>(options.jobs), std::max<size_t>(pending.size(), 1)));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  if (write_failure) std::rethrow_exception(write_failure);
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, MergeReport& report) {
+  if (paths.empty()) throw Error("merge: no input files");
+  report = MergeReport{};
+  Dataset merged;
+  std::map<long long, Eigen::Index> row_of_plan;  // plan row -> merged sample
+  for (size_t f = 0; f < paths.size(); ++f) {
+    const Dataset d = read_dataset(paths[f]);
+    ++report.files;
+    if (f == 0) {
+      merged = d;
+      merged.x.resize(0, d.x.cols());
+      merged.mu.resize(0);
+      merged.status.clear();
+      merged.failure_reason.clear();
+      merged.plan_index.clear();
+      merged.diagnostics.clear();
+    } else {
+      if (!same_inputs(d.inputs, merged.inputs)) throw Error("merge: " + paths[f] + ": inputs or box differ from " + paths[0]);
+      if (d.plan != merged.plan) throw Error("merge: " + paths[f] + ": comes from a different plan than " + paths[0]);
+      if (!allow_mixed && d.scene_json != merged.scene_json) {
+        throw Error("merge: " + paths[f] + ": made with a different scene than " + paths[0] + " (--allow-mixed to merge anyway)");
+      }
+      if (!allow_mixed && d.code_version != merged.code_version) {
+        throw Error("merge: " + paths[f] + ": made by code version " + d.code_version + ", " + paths[0] + " by " +
+                    merged.code_version + " (--allow-mixed to merge anyway)");
+      }
+    }
+    if (d.plan_index.size() != static_cast<size_t>(d.size())) throw Error("merge: " + paths[f] + ": samples without plan rows");
+    for (Eigen::Index i = 0; i < d.size(); ++i) {
+      ++report.samples_read;
+      const long long row = d.plan_index[static_cast<size_t>(i)];
+      SampleOutcome o;
+      o.converged = d.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged);
+      o.mu = d.mu(i);
+      o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
+      for (const auto& [name, values] : d.diagnostics) o.diagnostics[name] = values(i);
+      const auto it = row_of_plan.find(row);
+      if (it != row_of_plan.end()) {
+        ++report.duplicates_removed;
+        const bool kept_converged = merged.status[static_cast<size_t>(it->second)] == static_cast<long long>(SampleStatus::converged);
+        if (kept_converged || !o.converged) continue;
+        remove_rows(merged, {row});  // a converged answer replaces a failed one
+        row_of_plan.clear();
+        for (Eigen::Index k = 0; k < merged.size(); ++k) row_of_plan[merged.plan_index[static_cast<size_t>(k)]] = k;
+      }
+      append_sample(merged, d.x.row(i).transpose(), row, o);
+      row_of_plan[row] = merged.size() - 1;
+    }
+  }
+  for (Eigen::Index i = 0; i < merged.size(); ++i) {
+    (merged.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged) ? report.converged : report.failed) += 1;
+  }
+  report.plan_rows = merged.plan.rows();
+  report.plan_rows_missing = report.plan_rows - static_cast<long long>(row_of_plan.size());
+  if (allow_mixed) merged.source += " (merged with --allow-mixed)";
+  return merged;
+}
+
+}  // namespace mufric

@@ -1,0 +1,194 @@
+// Dataset generation from a plan: every plan row answered once, resumable, sharded, merged; the
+// evaluator here is a closed-form function so the bookkeeping is checked against exact values.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <set>
+
+#include "common/dataset_generation.hpp"
+#include "common/error.hpp"
+
+namespace mufric {
+namespace {
+
+std::string temp_path(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mufric_gen_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+Dataset small_plan(Eigen::Index rows, const std::string& scene = "{\"scene\": 1}") {
+  Dataset p;
+  p.inputs = default_friction_box();
+  p.plan.resize(rows, 3);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    p.plan.row(i) << 300e6 + 10e6 * static_cast<double>(i), 1.0 + 0.01 * static_cast<double>(i), 400.0 + static_cast<double>(i);
+  }
+  p.plan_design = "test";
+  p.scene_json = scene;
+  p.source = "test plan";
+  return p;
+}
+
+double exact_mu(const Eigen::VectorXd& x) { return 0.1 + 1e-10 * x(0) + 0.01 * x(1) + 1e-5 * x(2); }
+
+// Converges everywhere except at plan rows whose pressure ends in 30 MPa steps (rows 3, 6, ...).
+SampleOutcome fake(const Eigen::VectorXd& x) {
+  SampleOutcome o;
+  const auto row = static_cast<long long>(std::lround((x(0) - 300e6) / 10e6));
+  if (row % 3 == 0 && row > 0) {
+    o.failure_reason = "did not converge at row " + std::to_string(row);
+    o.diagnostics["newton_iterations"] = 30;
+    return o;
+  }
+  o.converged = true;
+  o.mu = exact_mu(x);
+  o.diagnostics["newton_iterations"] = 5;
+  o.diagnostics["contact_area_fraction"] = 0.5;
+  return o;
+}
+
+void expect_each_row_once(const Dataset& d, long long rows) {
+  std::set<long long> seen;
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    const long long row = d.plan_index[static_cast<size_t>(i)];
+    EXPECT_TRUE(seen.insert(row).second) << "plan row " << row << " twice";
+    EXPECT_EQ(d.x.row(i), d.plan.row(row));
+    if (d.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged)) {
+      EXPECT_DOUBLE_EQ(d.mu(i), exact_mu(d.x.row(i).transpose()));
+    } else {
+      EXPECT_NE(d.failure_reason[static_cast<size_t>(i)].find("did not converge"), std::string::npos);
+      EXPECT_TRUE(std::isnan(d.mu(i)));
+    }
+  }
+  EXPECT_EQ(static_cast<long long>(seen.size()), rows);
+}
+
+TEST(DatasetGeneration, EveryPlanRowIsAnsweredOnceWithFailuresKept) {
+  const Dataset plan = small_plan(10);
+  const std::string db = temp_path("all.h5");
+  std::filesystem::remove(db);
+  GenerationOptions options;
+  options.jobs = 3;
+  const GenerationReport r = generate_dataset(plan, db, fake, options);
+  EXPECT_EQ(r.ran, 10);
+  EXPECT_EQ(r.failed, 3);  // rows 3, 6, 9
+  const Dataset d = read_dataset(db);
+  expect_each_row_once(d, 10);
+  EXPECT_EQ(d.scene_json, plan.scene_json);
+  ASSERT_TRUE(d.diagnostics.count("wall_seconds"));
+  ASSERT_TRUE(d.diagnostics.count("contact_area_fraction"));
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    const bool failed = d.status[static_cast<size_t>(i)] != 0;
+    EXPECT_EQ(std::isnan(d.diagnostics.at("contact_area_fraction")(i)), failed);  // missing on failed samples
+  }
+  // Training uses the converged ones only.
+  EXPECT_EQ(training_set(d, db).x.rows(), 7);
+}
+
+TEST(DatasetGeneration, AnInterruptedRunResumesWhereItStopped) {
+  const Dataset plan = small_plan(9);
+  const std::string db = temp_path("resume.h5");
+  std::filesystem::remove(db);
+  std::atomic<int> calls{0};
+  const SampleEvaluator counting = [&](const Eigen::VectorXd& x) {
+    ++calls;
+    return fake(x);
+  };
+  GenerationOptions first;
+  first.limit = 4;  // as if killed after four samples
+  EXPECT_EQ(generate_dataset(plan, db, counting, first).ran, 4);
+  EXPECT_EQ(read_dataset(db).size(), 4);
+  calls = 0;
+  const GenerationReport second = generate_dataset(plan, db, counting, GenerationOptions{});
+  EXPECT_EQ(second.already_done, 4);
+  EXPECT_EQ(second.ran, 5);
+  EXPECT_EQ(calls.load(), 5);
+  expect_each_row_once(read_dataset(db), 9);
+  // Nothing left: a third run evaluates nothing; with retry_failed the failed rows run again.
+  calls = 0;
+  EXPECT_EQ(generate_dataset(plan, db, counting, GenerationOptions{}).ran, 0);
+  GenerationOptions retry;
+  retry.retry_failed = true;
+  EXPECT_EQ(generate_dataset(plan, db, counting, retry).ran, 2);  // rows 3 and 6
+  EXPECT_EQ(calls.load(), 2);
+  expect_each_row_once(read_dataset(db), 9);
+}
+
+TEST(DatasetGeneration, AnEvaluatorExceptionIsAFailedSampleNotACrash) {
+  const Dataset plan = small_plan(3);
+  const std::string db = temp_path("throws.h5");
+  std::filesystem::remove(db);
+  const SampleEvaluator throwing = [](const Eigen::VectorXd&) -> SampleOutcome { throw Error("scene exploded"); };
+  EXPECT_EQ(generate_dataset(plan, db, throwing, GenerationOptions{}).failed, 3);
+  const Dataset d = read_dataset(db);
+  EXPECT_EQ(d.failure_reason[0], "exception: scene exploded");
+}
+
+TEST(DatasetGeneration, ADatabaseOfAnotherPlanOrSceneIsRefused) {
+  const std::string db = temp_path("other.h5");
+  std::filesystem::remove(db);
+  generate_dataset(small_plan(4), db, fake, GenerationOptions{});
+  try {
+    generate_dataset(small_plan(5), db, fake, GenerationOptions{});
+    ADD_FAILURE() << "a different plan was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("different plan"), std::string::npos) << e.what();
+  }
+  try {
+    generate_dataset(small_plan(4, "{\"scene\": 2}"), db, fake, GenerationOptions{});
+    ADD_FAILURE() << "a different scene was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("different scene"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DatasetGeneration, ShardsPartitionThePlanAndMergeBackWithoutDuplicates) {
+  const Dataset plan = small_plan(11);
+  std::vector<std::string> shards;
+  for (int i = 0; i < 3; ++i) {
+    shards.push_back(temp_path("shard" + std::to_string(i) + ".h5"));
+    std::filesystem::remove(shards.back());
+    GenerationOptions o;
+    o.shard = parse_shard(std::to_string(i) + "/3");
+    const GenerationReport r = generate_dataset(plan, shards.back(), fake, o);
+    EXPECT_EQ(r.planned, i < 2 ? 4 : 3);  // rows i, i+3, i+6, i+9
+  }
+  MergeReport report;
+  std::vector<std::string> with_duplicate = shards;
+  with_duplicate.push_back(shards[1]);
+  const Dataset merged = merge_datasets(with_duplicate, false, report);
+  expect_each_row_once(merged, 11);
+  EXPECT_EQ(report.files, 4);
+  EXPECT_EQ(report.duplicates_removed, 4);
+  EXPECT_EQ(report.plan_rows_missing, 0);
+  EXPECT_EQ(report.failed, 3);
+  // Only the first two shards: the rows of the third are reported missing.
+  const Dataset partial = merge_datasets({shards[0], shards[1]}, false, report);
+  EXPECT_EQ(report.plan_rows_missing, 3);
+  EXPECT_EQ(partial.size(), 8);
+}
+
+TEST(DatasetGeneration, MergeRefusesMixedScenesUnlessAsked) {
+  const std::string a = temp_path("scene_a.h5"), b = temp_path("scene_b.h5");
+  std::filesystem::remove(a);
+  std::filesystem::remove(b);
+  GenerationOptions first, second;
+  first.shard = parse_shard("0/2");
+  second.shard = parse_shard("1/2");
+  generate_dataset(small_plan(4, "{\"a\": 1}"), a, fake, first);
+  generate_dataset(small_plan(4, "{\"b\": 1}"), b, fake, second);
+  MergeReport report;
+  EXPECT_THROW(merge_datasets({a, b}, false, report), Error);
+  EXPECT_EQ(merge_datasets({a, b}, true, report).size(), 4);
+}
+
+TEST(DatasetGeneration, ShardTextIsChecked) {
+  EXPECT_EQ(parse_shard("2/5").index, 2);
+  EXPECT_EQ(parse_shard("2/5").count, 5);
+  for (const char* bad : {"5/5", "-1/3", "1", "a/b", "1/0", "1/2x"}) EXPECT_THROW(parse_shard(bad), Error) << bad;
+}
+
+}  // namespace
+}  // namespace mufric
