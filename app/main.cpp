@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   mufric::app::add_bench_command(app);
   mufric::app::add_service_commands(app);
   mufric::app::add_micro_commands(app);
+  mufric::app::add_dataset_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

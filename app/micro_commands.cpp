@@ -73,12 +73,7 @@ struct RunCommandOptions {
   int max_levels = 4;
 };
 
-scene::Scene load_scene(const RunCommandOptions& o) {
-  nlohmann::json j = o.scene_path.empty() ? scene::default_scene_json() : scene::read_scene_json(o.scene_path);
-  for (const auto& assignment : o.overrides) scene::apply_override(j, assignment);
-  const std::string base = o.scene_path.empty() ? "." : std::filesystem::path(o.scene_path).parent_path().string();
-  return scene::parse_scene(j, o.scene_path.empty() ? "default dry scene" : o.scene_path, base.empty() ? "." : base);
-}
+scene::Scene load_scene(const RunCommandOptions& o) { return scene::load_scene(o.scene_path, o.overrides); }
 
 std::string mu_text(const std::optional<double>& mu) {
   if (!mu) return "  (no contact)";

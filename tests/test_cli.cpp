@@ -198,4 +198,84 @@ TEST_F(Cli, CorruptModelIsRefused) {
   EXPECT_NE(r.output.find("not an HDF5 file"), std::string::npos) << r.output;
 }
 
+// A scene small enough that a sample takes a fraction of a second.
+const std::string kTinyScene =
+    " --set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16"
+    " --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set time.duration=6ns"
+    " --set time.average_from=3ns --set load.ramp=3ns";
+
+TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
+  CommandResult r = run("dataset plan --out " + path("plan.h5") + " --samples 6 --design lhs --seed 4 --p 500MPa:900MPa" + kTinyScene);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("500MPa .. 900MPa"), std::string::npos) << r.output;
+  // Two shards; the first stops after one sample and is resumed.
+  r = run("dataset run --plan " + path("plan.h5") + " --db " + path("s0.h5") + " --shard 0/2 --limit 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("3 plan rows in this shard, 0 already done, 1 run now"), std::string::npos) << r.output;
+  r = run("dataset run --plan " + path("plan.h5") + " --db " + path("s0.h5") + " --shard 0/2");
+  EXPECT_NE(r.output.find("1 already done, 2 run now"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("sample 1/2 (plan row "), std::string::npos) << r.output;  // plain progress lines off a terminal
+  ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("s1.h5") + " --shard 1/2 --jobs 2").exit_code, 0);
+  r = run("dataset merge --out " + path("all.h5") + " " + path("s0.h5") + " " + path("s1.h5") + " " + path("s1.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("9 samples read, 3 duplicates removed -> 6 samples"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("0 of 6 plan rows not yet run"), std::string::npos) << r.output;
+  r = run("train --data " + path("all.h5") + " --out " + path("gp.h5"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  // A database of this plan refuses another scene.
+  r = run("dataset run --plan " + path("plan.h5") + " --db " + path("s0.h5") + " --shard 0/2 --set load.ramp=2ns");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("different scene"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, DatasetErrorsNameTheFlag) {
+  CommandResult r = run("dataset plan --out " + path("p.h5") + " --p 900MPa:500MPa");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--p '900MPa:500MPa'"), std::string::npos) << r.output;
+  r = run("dataset plan --out " + path("p.h5") + " --design halton");
+  EXPECT_NE(r.output.find("design 'halton'"), std::string::npos) << r.output;
+  r = run("dataset plan --out " + path("p.h5") + " --set load.vertical_displacement=\\\"-1nm\\\" --set load.pressure=null");
+  EXPECT_NE(r.exit_code, 0);
+  ASSERT_EQ(run("dataset plan --out " + path("p.h5") + " --samples 2" + kTinyScene).exit_code, 0);
+  r = run("dataset run --plan " + path("p.h5") + " --db " + path("d.h5") + " --shard 2/2");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--shard '2/2'"), std::string::npos) << r.output;
+}
+
+// kill -9 in the middle of a run loses at most the samples in flight: the database stays readable
+// and a second run completes the plan with every row once.
+TEST_F(Cli, DatasetRunSurvivesKillNine) {
+  const std::string slower = kTinyScene + " --set time.duration=12ns --set time.average_from=6ns";
+  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 6 --design sobol" + slower).exit_code, 0);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    freopen(path("run.log").c_str(), "w", stdout);
+    execl(MUFRIC_EXE, MUFRIC_EXE, "dataset", "run", "--plan", path("plan.h5").c_str(), "--db", path("db.h5").c_str(),
+          "--threads", "1", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until two samples are recorded, then kill without warning.
+  bool recorded = false;
+  for (int i = 0; i < 600 && !recorded; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::ifstream log(path("run.log"));
+    std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    recorded = text.find("sample 2/6") != std::string::npos;
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(recorded) << "the run did not record two samples";
+  CommandResult r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;  // readable after the kill
+  EXPECT_EQ(r.output.find(" 0 samples read"), std::string::npos) << r.output;
+  r = run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find(" 0 already done"), std::string::npos) << r.output;
+  r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
+  EXPECT_NE(r.output.find("0 duplicates removed -> 6 samples"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("0 of 6 plan rows not yet run"), std::string::npos) << r.output;
+}
+
 }  // namespace

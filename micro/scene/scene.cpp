@@ -263,4 +263,11 @@ nlohmann::json default_scene_json() {
   return json::parse(kText);
 }
 
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  nlohmann::json j = path.empty() ? default_scene_json() : read_scene_json(path);
+  for (const auto& assignment : overrides) apply_override(j, assignment);
+  const std::string base = path.empty() ? "." : std::filesystem::path(path).parent_path().string();
+  return parse_scene(j, path.empty() ? "default dry scene" : path, base.empty() ? "." : base);
+}
+
 }  // namespace mufric::scene

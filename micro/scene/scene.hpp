@@ -75,4 +75,7 @@ Scene parse_scene(const nlohmann::json& json, const std::string& source, const s
 // The default dry scene shipped with mufric (micro/scene/dry_default.json, compiled in).
 nlohmann::json default_scene_json();
 
+// A scene file (or, for an empty path, the default scene) with "key=value" overrides applied.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides);
+
 }  // namespace mufric::scene

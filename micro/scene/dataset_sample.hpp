@@ -1,0 +1,15 @@
+#pragma once
+// One dataset sample = one micro-model run of a scene at a plan point: the plan's inputs set the
+// scene's load (contact_pressure → load.pressure, sliding_velocity → load.velocity, temperature →
+// load.temperature); μ and the run's diagnostics become the sample.
+#include "common/dataset_generation.hpp"
+#include "micro/scene/scene.hpp"
+
+namespace mufric::scene {
+
+// Throws Error when an input has no counterpart in the scene (e.g. fibre_angle), a required one is
+// missing, or the scene is loaded by a displacement instead of a pressure. Each run uses
+// `threads_per_sample` OpenMP threads (several samples may run at once).
+SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, int threads_per_sample);
+
+}  // namespace mufric::scene
