@@ -16,6 +16,11 @@
 #include "common/units.hpp"
 #include "micro/scene/dataset_sample.hpp"
 #include "micro/scene/micro_run.hpp"
+#include "common/csv_table.hpp"
+#include "surrogate/accuracy.hpp"
+#include "surrogate/active_learning.hpp"
+#include "surrogate/gp_training.hpp"
+#include "surrogate/model_file.hpp"
 #include "surrogate/sampling.hpp"
 
 namespace mufric::app {
@@ -119,29 +124,38 @@ void print_progress(const GenerationProgress& p, const InputSpace& inputs, const
   std::fflush(stdout);
 }
 
-void run_command(const RunOptions& o) {
-  Dataset plan = read_dataset(o.plan);
-  if (plan.plan.rows() == 0) throw Error(o.plan + ": has no plan (/plan/inputs is empty); make one with mufric dataset plan");
-  // The scene: --scene (or the plan's own), then --set.
+// The scene of a run: --scene (or the one stored with the plan, or the default), then --set.
+scene::Scene run_scene(const std::string& scene_path, const std::vector<std::string>& overrides, const Dataset& plan,
+                       const std::string& plan_path) {
   nlohmann::json scene_json;
   std::string scene_source;
-  if (!o.scene_path.empty()) {
-    scene_json = scene::read_scene_json(o.scene_path);
-    scene_source = o.scene_path;
+  if (!scene_path.empty()) {
+    scene_json = scene::read_scene_json(scene_path);
+    scene_source = scene_path;
   } else if (!plan.scene_json.empty()) {
     scene_json = nlohmann::json::parse(plan.scene_json);
-    scene_source = "the scene of " + o.plan;
+    scene_source = "the scene of " + plan_path;
   } else {
     scene_json = scene::default_scene_json();
     scene_source = "default dry scene";
   }
-  for (const auto& assignment : o.overrides) scene::apply_override(scene_json, assignment);
-  const std::string base = o.scene_path.empty() ? "." : std::filesystem::path(o.scene_path).parent_path().string();
-  const scene::Scene sc = scene::parse_scene(scene_json, scene_source, base.empty() ? "." : base);
+  for (const auto& assignment : overrides) scene::apply_override(scene_json, assignment);
+  const std::string base = scene_path.empty() ? "." : std::filesystem::path(scene_path).parent_path().string();
+  return scene::parse_scene(scene_json, scene_source, base.empty() ? "." : base);
+}
+
+int threads_per_job(int jobs, int threads) {
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return threads > 0 ? threads : std::max(1, cores / jobs);
+}
+
+void run_command(const RunOptions& o) {
+  Dataset plan = read_dataset(o.plan);
+  if (plan.plan.rows() == 0) throw Error(o.plan + ": has no plan (/plan/inputs is empty); make one with mufric dataset plan");
+  const scene::Scene sc = run_scene(o.scene_path, o.overrides, plan, o.plan);
   plan.scene_json = sc.effective.dump(2);
 
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int threads = o.threads > 0 ? o.threads : std::max(1, cores / o.jobs);
+  const int threads = threads_per_job(o.jobs, o.threads);
   const SampleEvaluator evaluate = scene::micro_evaluator(sc, plan.inputs, threads);
   GenerationOptions options;
   options.shard = parse_shard(o.shard);
@@ -159,6 +173,102 @@ void run_command(const RunOptions& o) {
   const GenerationReport r = generate_dataset(plan, o.db, evaluate, options);
   std::printf("%s: %lld plan rows in this shard, %lld already done, %lld run now (%lld converged, %lld failed) in %s\n",
               o.db.c_str(), r.planned, r.already_done, r.ran, r.converged, r.failed, duration_text(r.seconds).c_str());
+}
+
+struct RefineOptions {
+  std::string db, test, candidates_csv, model_out;
+  long long budget = 0;
+  int batch = 8, jobs = 1, threads = 0, restarts = 2;
+  long long candidate_count = 4096;
+  unsigned long long seed = 1;
+};
+
+// Candidate points: a Sobol' set in the box (shifted per round), plus the rows of a CSV with unit
+// headers such as the server's wide-interval log (points outside the box are dropped: the plan box
+// is what the micro-model is run on).
+Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box, int round) {
+  Eigen::MatrixXd c = plan_in_box(PlanDesign::sobol, o.candidate_count, box, o.seed + static_cast<unsigned long long>(round));
+  if (o.candidates_csv.empty()) return c;
+  const CsvTable table = read_csv_table(o.candidates_csv);
+  std::vector<std::vector<double>> columns;
+  for (const auto& input : box) columns.push_back(table.si_column(input.name));
+  std::vector<Eigen::RowVectorXd> rows;
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    Eigen::RowVectorXd r(static_cast<Eigen::Index>(box.size()));
+    bool inside = true;
+    for (size_t j = 0; j < box.size(); ++j) {
+      r(static_cast<Eigen::Index>(j)) = columns[j][i];
+      inside = inside && columns[j][i] >= box[j].lo && columns[j][i] <= box[j].hi;
+    }
+    if (inside) rows.push_back(r);
+  }
+  Eigen::MatrixXd all(c.rows() + static_cast<Eigen::Index>(rows.size()), c.cols());
+  all.topRows(c.rows()) = c;
+  for (size_t i = 0; i < rows.size(); ++i) all.row(c.rows() + static_cast<Eigen::Index>(i)) = rows[i];
+  return all;
+}
+
+void report_round(int round, const GaussianProcess& gp, const TrainingSet& data, const RefineOptions& o) {
+  const auto& sum = gp.state().summary;
+  std::printf("round %d: %lld training samples, LOO mean relative error %.3f %%, max %.3f %%", round,
+              static_cast<long long>(data.x.rows()), 100.0 * sum.loo_mean_relative_error, 100.0 * sum.loo_max_relative_error);
+  if (!o.test.empty()) {
+    const AccuracyReport r = held_out_accuracy(gp, training_set(read_dataset(o.test), o.test), 0.95);
+    std::printf("; held-out (%s, %lld points) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", o.test.c_str(), r.points,
+                100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, 100.0 * r.coverage);
+  }
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
+void refine_command(const RefineOptions& o) {
+  Dataset db = read_dataset(o.db);
+  if (db.plan.rows() == 0 || db.plan_index.size() != static_cast<size_t>(db.size())) {
+    throw Error(o.db + ": not a micro-model database (no plan rows); start with mufric dataset plan and run");
+  }
+  const scene::Scene sc = run_scene("", {}, db, o.db);
+  const SampleEvaluator evaluate = scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads));
+  GpTrainingOptions training;
+  training.restarts = o.restarts;
+  training.seed = o.seed;
+  long long spent = 0;
+  for (int round = 1;; ++round) {
+    const TrainingSet data = training_set(db, o.db);
+    const GaussianProcess gp = train_gaussian_process(data, training);
+    report_round(round, gp, data, o);
+    if (!o.model_out.empty()) save_model(o.model_out, gp);
+    if (spent >= o.budget) break;
+    const int batch = static_cast<int>(std::min<long long>(o.batch, o.budget - spent));
+    const Eigen::MatrixXd candidates = refine_candidates(o, db.inputs, round);
+    std::vector<Eigen::Index> failed_rows;
+    for (Eigen::Index i = 0; i < db.size(); ++i) {
+      if (db.status[static_cast<size_t>(i)] != static_cast<long long>(SampleStatus::converged)) failed_rows.push_back(i);
+    }
+    Eigen::MatrixXd failed(static_cast<Eigen::Index>(failed_rows.size()), db.x.cols());
+    for (size_t k = 0; k < failed_rows.size(); ++k) failed.row(static_cast<Eigen::Index>(k)) = db.x.row(failed_rows[k]);
+    const auto picks = pick_by_posterior_variance(gp, candidates, batch, failed);
+    // The picks become plan rows, so the database accounts for them like any planned point.
+    const Eigen::Index first = db.plan.rows();
+    db.plan.conservativeResize(first + static_cast<Eigen::Index>(picks.size()), Eigen::NoChange);
+    for (size_t k = 0; k < picks.size(); ++k) {
+      db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(picks[k].candidate);
+      std::printf("  pick %zu: plan row %lld, predicted std %.4f\n", k + 1, static_cast<long long>(first) + static_cast<long long>(k),
+                  picks[k].std_at_pick);
+    }
+    db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
+    write_dataset(o.db, db);
+    GenerationOptions options;
+    options.jobs = o.jobs;
+    options.on_sample = [&](const GenerationProgress& p) {
+      print_progress(p, db.inputs, db.plan.row(p.plan_row).transpose(), false);
+    };
+    const GenerationReport r = generate_dataset(db, o.db, evaluate, options);
+    spent += r.ran;
+    db = read_dataset(o.db);
+    if (r.ran == 0) break;  // nothing new could be run
+  }
+  std::printf("%s: %lld micro-model runs spent of a budget of %lld%s%s\n", o.db.c_str(), spent, o.budget,
+              o.model_out.empty() ? "" : "; final model ", o.model_out.c_str());
 }
 
 struct MergeOptions {
@@ -213,6 +323,29 @@ void add_dataset_commands(CLI::App& app) {
               "not converge is recorded as failed with its reason. Shards write separate databases; combine them\n"
               "with mufric dataset merge.");
   run->callback([r] { run_command(*r); });
+
+  auto f = std::make_shared<RefineOptions>();
+  auto* refine = dataset->add_subcommand(
+      "refine", "Active learning: run the micro-model where the surrogate is least certain, retrain, repeat");
+  refine->add_option("--db", f->db, "Micro-model database to extend (from dataset plan + run)")->required()->check(CLI::ExistingFile);
+  refine->add_option("--budget", f->budget, "Micro-model runs to spend")->required()->check(CLI::Range(0LL, 1000000LL));
+  refine->add_option("--batch", f->batch, "Runs per round (picked jointly, then run, then the GP is retrained)")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
+  refine->add_option("--test", f->test, "Held-out database: its error is reported after every round")->check(CLI::ExistingFile);
+  refine->add_option("--candidates", f->candidates_csv,
+                     "CSV of extra candidate points with unit headers, e.g. the server's --log-uncertain file")
+      ->check(CLI::ExistingFile);
+  refine->add_option("--candidate-count", f->candidate_count, "Sobol' candidates per round")->capture_default_str()
+      ->check(CLI::Range(16LL, 100000LL));
+  refine->add_option("--model-out", f->model_out, "Write the GP trained after each round here");
+  refine->add_option("--jobs", f->jobs, "Runs at once")->capture_default_str()->check(CLI::Range(1, 1024));
+  refine->add_option("--threads", f->threads, "Threads per run (default: cores / jobs)")->check(CLI::Range(1, 1024));
+  refine->add_option("--restarts", f->restarts, "GP optimiser restarts per round")->capture_default_str();
+  refine->add_option("--seed", f->seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
+  refine->footer("Each round trains a GP on the converged samples, picks --batch candidates by the largest posterior\n"
+                 "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"
+                 "scene, and reports the leave-one-out error (and the held-out error with --test).");
+  refine->callback([f] { refine_command(*f); });
 
   auto m = std::make_shared<MergeOptions>();
   auto* merge = dataset->add_subcommand("merge", "Combine shard databases of one plan");

@@ -242,6 +242,20 @@ TEST_F(Cli, DatasetErrorsNameTheFlag) {
   EXPECT_NE(r.output.find("--shard '2/2'"), std::string::npos) << r.output;
 }
 
+TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
+  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 6 --p 700MPa:1300MPa" + kTinyScene).exit_code, 0);
+  ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5")).exit_code, 0);
+  CommandResult r = run("dataset refine --db " + path("db.h5") + " --budget 3 --batch 2 --restarts 0 --model-out " + path("gp.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("round 3: "), std::string::npos) << r.output;  // 2 + 1 runs, a GP after each round
+  EXPECT_NE(r.output.find("3 micro-model runs spent of a budget of 3"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("pick 2: plan row 7"), std::string::npos) << r.output;  // picks extend the plan
+  r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
+  EXPECT_NE(r.output.find("-> 9 samples"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("0 of 9 plan rows not yet run"), std::string::npos) << r.output;
+  EXPECT_EQ(run("describe " + path("gp.h5")).exit_code, 0);
+}
+
 // kill -9 in the middle of a run loses at most the samples in flight: the database stays readable
 // and a second run completes the plan with every row once.
 TEST_F(Cli, DatasetRunSurvivesKillNine) {
