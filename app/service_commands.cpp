@@ -56,6 +56,13 @@ void add_service_commands(CLI::App& app) {
   cmd->add_option("--tls-key", o->tls_key, "PEM private key of --tls-cert")->check(CLI::ExistingFile);
   cmd->add_option("--tls-client-ca", o->tls_client_ca, "PEM CA: mutual TLS, clients need a certificate it signed")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--log-uncertain", o->uncertain_log_directory,
+                  "Append queries whose 95 % interval is wider than --uncertain-width to DIR/<model>.csv, candidate "
+                  "points for mufric dataset refine --candidates (makes every call compute the std)");
+  cmd->add_option("--uncertain-width", o->uncertain_width, "Interval width (in mu) above which a query is logged")
+      ->capture_default_str()->check(CLI::Range(1e-9, 1e9));
+  cmd->add_option("--uncertain-max-rows", o->uncertain_max_rows, "Most logged queries per model")->capture_default_str()
+      ->check(CLI::Range(1LL, 1'000'000'000LL));
   cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"
               "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
               "server reflection are on. Logs go to stderr, one line per event. A call whose deadline passes (or that\n"

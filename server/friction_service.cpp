@@ -134,6 +134,9 @@ grpc::Status FrictionService::evaluate(const grpc::CallbackServerContext& contex
   response.set_model(served->name);
   response.set_version(served->version);
   const EvaluationRequest what{.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()};
+  UncertainQueryLog* const log = model.has_uncertainty() ? limits_.uncertain_log : nullptr;
+  EvaluationRequest computed = what;
+  computed.std = what.std || log != nullptr;
   response.mutable_mu()->Reserve(n);
   if (what.std) response.mutable_std()->Reserve(n);
   if (what.ci_level > 0.0) {
@@ -155,8 +158,9 @@ grpc::Status FrictionService::evaluate(const grpc::CallbackServerContext& contex
       return gone;
     }
     const int count = std::min(n - first, static_cast<int>(kPointsBetweenDeadlineChecks));
-    const Evaluation e = count == n ? model.evaluate(batch, what)
-                                    : model.evaluate(QueryBatch(batch.middleRows(first, count)), what);
+    const Evaluation e = count == n ? model.evaluate(batch, computed)
+                                    : model.evaluate(QueryBatch(batch.middleRows(first, count)), computed);
+    if (log != nullptr) log->record(served->name, model.inputs(), batch.middleRows(first, count), e.std);
     response.mutable_mu()->Add(e.mu.data(), e.mu.data() + count);
     if (what.std) response.mutable_std()->Add(e.std.data(), e.std.data() + count);
     if (what.ci_level > 0.0) {

@@ -8,6 +8,7 @@
 
 #include "mufric/v1/friction.grpc.pb.h"
 #include "server/model_registry.hpp"
+#include "server/uncertain_log.hpp"
 
 namespace mufric::server {
 
@@ -20,6 +21,8 @@ struct ServiceLimits {
   // evaluations in flight each gets max(1, threads / k), so concurrent clients do not oversubscribe
   // the machine with nested thread teams.
   int evaluation_threads = 1;
+  // When set, points with a wide interval are logged there (computing std for every call).
+  UncertainQueryLog* uncertain_log = nullptr;
 };
 
 // Points evaluated between two looks at the caller's deadline and cancellation: a few ms of work.

@@ -75,8 +75,15 @@ void run_server(const ServerOptions& options) {
     if (token.empty()) throw Error("--token-file: '" + options.token_file + "' is empty");
   }
   const int threads = options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  FrictionService service(registry,
-                          {.max_points_per_request = options.max_points, .bearer_token = token, .evaluation_threads = threads});
+  std::unique_ptr<UncertainQueryLog> uncertain_log;
+  if (!options.uncertain_log_directory.empty()) {
+    uncertain_log = std::make_unique<UncertainQueryLog>(options.uncertain_log_directory, options.uncertain_width,
+                                                        options.uncertain_max_rows);
+  }
+  FrictionService service(registry, {.max_points_per_request = options.max_points,
+                                     .bearer_token = token,
+                                     .evaluation_threads = threads,
+                                     .uncertain_log = uncertain_log.get()});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

@@ -20,6 +20,9 @@ struct ServerOptions {
   std::string token_file;             // bearer token required of every client (file, not argv)
   std::string tls_cert, tls_key;      // PEM server certificate chain and key: TLS instead of plaintext
   std::string tls_client_ca;          // PEM CA: mutual TLS, clients must present a certificate it signed
+  std::string uncertain_log_directory;  // log wide-interval queries per model here (empty: off)
+  double uncertain_width = 0.05;      // width of the 95 % interval in μ above which a query is logged
+  long long uncertain_max_rows = 100'000;  // per model
 };
 
 // Plaintext, TLS or mutual TLS from the options; throws Error naming an unreadable file.

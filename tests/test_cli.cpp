@@ -245,7 +245,11 @@ TEST_F(Cli, DatasetErrorsNameTheFlag) {
 TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
   ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 6 --p 700MPa:1300MPa" + kTinyScene).exit_code, 0);
   ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5")).exit_code, 0);
-  CommandResult r = run("dataset refine --db " + path("db.h5") + " --budget 3 --batch 2 --restarts 0 --model-out " + path("gp.h5"));
+  // Candidates may also come from the server's log of uncertain queries (unit header, extra columns).
+  std::ofstream(path("uncertain.csv")) << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width\n"
+                                           "1.0e9,1.5,700,0.3\n2.0e9,1.5,700,0.3\n";  // the second lies outside the box
+  CommandResult r = run("dataset refine --db " + path("db.h5") + " --budget 3 --batch 2 --restarts 0 --model-out " +
+                        path("gp.h5") + " --candidates " + path("uncertain.csv"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("round 3: "), std::string::npos) << r.output;  // 2 + 1 runs, a GP after each round
   EXPECT_NE(r.output.find("3 micro-model runs spent of a budget of 3"), std::string::npos) << r.output;

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "client/friction_client.hpp"
+#include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
 #include "server/friction_service.hpp"
@@ -110,6 +111,44 @@ TEST_F(Service, GrpcAnswersEqualInProcessAnswersAcrossChunks) {
   EXPECT_EQ(a.model, "gp");
   EXPECT_EQ(a.version.size(), 16u);
   EXPECT_EQ(remote->describe().inputs.size(), 3u);
+}
+
+// --log-uncertain: exactly the queried points whose 95 % interval is wider than the threshold land
+// in DIR/<model>.csv, in SI with a unit header that the dataset tools read back; a caller that
+// asked for μ only still gets μ only; a law (no uncertainty) logs nothing.
+TEST_F(Service, UncertainQueriesAreLoggedForActiveLearning) {
+  const Points pts = random_points(400);
+  const auto local = client::connect("file://" + (dir_ / "gp.h5").string());
+  const client::Answer reference = local->evaluate(pts.block(), {.std = true});
+  std::vector<double> widths;
+  for (const double s : reference.std) widths.push_back(2.0 * 1.959963984540054 * s);
+  std::vector<double> sorted = widths;
+  std::nth_element(sorted.begin(), sorted.begin() + 300, sorted.end());
+  const double threshold = sorted[300];  // about a quarter of the points are wider
+  server::UncertainQueryLog log((dir_ / "uncertain").string(), threshold, 1000);
+  LoopbackServer server(dir_, 0, {.evaluation_threads = 2, .uncertain_log = &log});
+  const auto remote = client::connect("grpc://" + server.address() + "/gp");
+  const client::Answer a = remote->evaluate(pts.block(), {});
+  EXPECT_TRUE(a.std.empty());
+  EXPECT_EQ(a.mu, reference.mu);
+  client::connect("grpc://" + server.address() + "/coulomb")->evaluate(pts.block(), {});
+  EXPECT_FALSE(fs::exists(dir_ / "uncertain" / "coulomb.csv"));
+
+  const CsvTable table = read_csv_table((dir_ / "uncertain" / "gp.csv").string());
+  const auto p = table.si_column("contact_pressure"), v = table.si_column("sliding_velocity"),
+             t = table.si_column("temperature");
+  std::vector<size_t> expected;
+  for (size_t i = 0; i < widths.size(); ++i) {
+    if (widths[i] > threshold) expected.push_back(i);
+  }
+  ASSERT_EQ(p.size(), expected.size());
+  EXPECT_GT(expected.size(), 50u);
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(p[k], pts.p[expected[k]]);
+    EXPECT_EQ(v[k], pts.v[expected[k]]);
+    EXPECT_EQ(t[k], pts.t[expected[k]]);
+  }
+  EXPECT_EQ(log.rows("gp"), static_cast<long long>(expected.size()));
 }
 
 TEST_F(Service, StreamOfIncrementsAnswersLikeUnaryCallsAndSurvivesAnError) {
