@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The main job on a fresh Debian 12 machine: installs dependencies, builds mufric, and runs
 #   1. μ for a few contact states from the empirical laws of seed 001 (Seward et al. 2022);
-#   2. a dataset sampled from the Table 4 law (with measurement-like scatter), a Gaussian-process
-#      surrogate trained on it, its held-out accuracy, and μ with its 95 % interval.
-# Files go to ${MUFRIC_OUT:-mufric-out}/.
+#   2. the whole chain: a Sobol' plan over seed 000's box → the dry micro-model at every point (a
+#      coarse scene that fits a laptop: 32 × 6 elements, 100 ns) → a Gaussian-process surrogate →
+#      `mufric serve` on loopback → a meso-trace client (Python, gRPC) asking μ with its 95 % interval
+#      per contact Gauss point → a short table and a plot of μ over the box with its band.
+# Files go to ${MUFRIC_OUT:-mufric-out}/. MUFRIC_SAMPLES sets the plan size (default 32).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${MUFRIC_JOBS:-2}
@@ -11,7 +13,7 @@ out=${MUFRIC_OUT:-mufric-out}
 
 bash deploy/install-deps.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j "$jobs" --target mufric
+cmake --build build -j "$jobs" --target mufric mufric_python_stubs
 mufric=build/app/mufric
 mkdir -p "$out"
 
@@ -26,13 +28,24 @@ for state in "20MPa 2m/min 0deg" "80MPa 10m/min 45deg" "150MPa 15m/min 90deg" "8
   done
 done
 
-echo; echo "== 2. Gaussian-process surrogate fitted to a dataset file"
-$mufric dataset from-model --model "$out/law-table4.h5" --samples 400 --seed 1 --noise 0.002 --out "$out/dataset.h5"
-$mufric dataset from-model --model "$out/law-table4.h5" --samples 200 --seed 2 --out "$out/test.h5"
-$mufric train --data "$out/dataset.h5" --out "$out/gp.h5" --restarts 4
-$mufric eval --model "$out/gp.h5" --test "$out/test.h5"
-for state in "20MPa 2m/min 0deg" "80MPa 10m/min 45deg" "150MPa 15m/min 90deg" "250MPa 10m/min 90deg"; do
-  read -r p v a <<<"$state"
-  $mufric predict --model "$out/gp.h5" --p "$p" --v "$v" --angle "$a" | paste -sd ' '
-done
+echo; echo "== 2. Micro-model dataset -> GP surrogate -> service -> meso-trace client"
+scene=(--set geometry.chip_surface.fit.control_points=32 --set geometry.tool_surface.fit.control_points=32
+       --set discretisation.elements_x=32 --set discretisation.elements_y=6 --set time.duration=100ns
+       --set time.average_from=50ns)
+rm -f "$out/db.h5"  # a fresh database for this plan (dataset run would resume one of the same plan)
+$mufric dataset plan --out "$out/plan.h5" --samples "${MUFRIC_SAMPLES:-32}" --design sobol "${scene[@]}"
+$mufric dataset run --plan "$out/plan.h5" --db "$out/db.h5" --jobs "$jobs" --threads 1
+mkdir -p "$out/models"
+$mufric train --data "$out/db.h5" --out "$out/models/gp.h5" --restarts 4
+rm -f "$out/address"
+$mufric serve --models "$out/models" --listen 127.0.0.1:0 --ready-file "$out/address" 2>"$out/serve.log" &
+server=$!
+trap 'kill -TERM $server 2>/dev/null || true' EXIT
+for _ in $(seq 1 100); do [[ -s $out/address ]] && break; sleep 0.1; done
+[[ -s $out/address ]] || { echo "the server did not start:"; cat "$out/serve.log"; exit 1; }
+echo "serving $out/models on $(cat "$out/address")"
+PYTHONPATH=build/python /usr/bin/python3 examples/python/meso_trace.py "$(cat "$out/address")" gp \
+  --points 2000 --increments 50 --dataset "$out/db.h5" --plot "$out/mu-over-box.png"
+kill -TERM $server && wait $server || true
+trap - EXIT
 echo; echo "files: $(ls "$out" | tr '\n' ' ')in $out/"

@@ -162,6 +162,14 @@ with tempfile.TemporaryDirectory() as tmp:
             if rows is not None and rows.shape == (len(queries), 5):
                 check_gp_answer(who, rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3], ref_mu, ref_std)
                 check(np.all(rows[:, 4] == 0), f"{who}: every point OK (statuses {rows[:, 4].astype(int).tolist()})")
+        # The meso-trace example of the main job: a trace of Gauss points and the plot of mu over the box.
+        trace = subprocess.run([sys.executable, str(Path(args.examples) / "meso_trace.py"), address, "gp", "--points", "300",
+                                "--increments", "5", "--plot", str(tmp / "mu.png")],
+                               capture_output=True, text=True, timeout=120, env={**os.environ, "PYTHONPATH": args.stubs})
+        plotted = (tmp / "mu.png").exists() and (tmp / "mu.png").stat().st_size > 10000
+        check(trace.returncode == 0 and "5 increments x 300 Gauss points answered" in trace.stdout and plotted,
+              "meso_trace.py: trace answered, table printed, plot written"
+              + ("" if trace.returncode == 0 else "\n" + trace.stdout + trace.stderr))
         example = subprocess.run([c_example, f"grpc://{address}/law"], capture_output=True, text=True, timeout=60)
         check(example.returncode == 0, "C example over gRPC: mu of the law and a NaN point refused alone"
               + ("" if example.returncode == 0 else "\n" + example.stdout + example.stderr))
