@@ -35,19 +35,17 @@ double brute_force_variance(const Eigen::MatrixXd& x, const Eigen::RowVectorXd& 
   return kernel(q, q, h) - kq.dot(k.partialPivLu().solve(kq));
 }
 
-TEST(ActiveLearning, GreedyPicksMatchBruteForcePosteriorVariance) {
-  const TrainingSet data = test::smooth_training_set(15, 5);
-  GpTrainingOptions options;
-  options.restarts = 1;
-  const GaussianProcess gp = train_gaussian_process(data, options);
+// Each pick must be the brute-force argmax of the posterior variance given the training inputs,
+// `tried` and the earlier picks, with the std brute force gives there.
+void expect_brute_force_picks(const GaussianProcess& gp, const Eigen::MatrixXd& candidates,
+                              const std::vector<VariancePick>& picks, const Eigen::MatrixXd& tried) {
   const auto& s = gp.state();
-  const Eigen::MatrixXd candidates = plan_in_box(PlanDesign::sobol, 60, s.inputs, 3);
-  const auto picks = pick_by_posterior_variance(gp, candidates, 5);
-  ASSERT_EQ(picks.size(), 5u);
+  Eigen::MatrixXd x(s.x_train.rows() + tried.rows(), s.x_train.cols());
+  for (Eigen::Index i = 0; i < s.x_train.rows(); ++i) x.row(i) = unit_row(s.inputs, s.x_train.row(i));
+  for (Eigen::Index i = 0; i < tried.rows(); ++i) x.row(s.x_train.rows() + i) = unit_row(s.inputs, tried.row(i));
   const double noise = s.hyper.noise_variance + s.jitter;
-  Eigen::MatrixXd x(s.x_train.rows(), s.x_train.cols());
-  for (Eigen::Index i = 0; i < x.rows(); ++i) x.row(i) = unit_row(s.inputs, s.x_train.row(i));
   for (const auto& pick : picks) {
+    ASSERT_LT(pick.candidate, candidates.rows());
     double best = -1.0;
     Eigen::Index best_index = -1;
     for (Eigen::Index c = 0; c < candidates.rows(); ++c) {
@@ -59,6 +57,21 @@ TEST(ActiveLearning, GreedyPicksMatchBruteForcePosteriorVariance) {
     x.conservativeResize(x.rows() + 1, Eigen::NoChange);
     x.row(x.rows() - 1) = unit_row(s.inputs, candidates.row(pick.candidate));
   }
+}
+
+GaussianProcess trained_gp(Eigen::Index n, unsigned seed) {
+  GpTrainingOptions options;
+  options.restarts = 1;
+  return train_gaussian_process(test::smooth_training_set(n, seed), options);
+}
+
+TEST(ActiveLearning, GreedyPicksMatchBruteForcePosteriorVariance) {
+  const GaussianProcess gp = trained_gp(15, 5);
+  const auto& s = gp.state();
+  const Eigen::MatrixXd candidates = plan_in_box(PlanDesign::sobol, 60, s.inputs, 3);
+  const auto picks = pick_by_posterior_variance(gp, candidates, 5);
+  ASSERT_EQ(picks.size(), 5u);
+  expect_brute_force_picks(gp, candidates, picks, Eigen::MatrixXd(0, 3));
   // The first pick's std is the model's own predictive std there, minus the noise term.
   Evaluation e = gp.evaluate(candidates.row(picks[0].candidate), {.std = true});
   const double noise_mu = s.y_scale * s.y_scale * s.hyper.noise_variance;
@@ -68,30 +81,12 @@ TEST(ActiveLearning, GreedyPicksMatchBruteForcePosteriorVariance) {
 // Failed runs count as observed: with them conditioned on first, the picks are those brute force
 // finds with the failed points added to the training inputs.
 TEST(ActiveLearning, FailedRunsAreConditionedOnAndNeverPicked) {
-  const TrainingSet data = test::smooth_training_set(12, 8);
-  GpTrainingOptions options;
-  options.restarts = 0;
-  const GaussianProcess gp = train_gaussian_process(data, options);
-  const auto& s = gp.state();
-  const Eigen::MatrixXd candidates = plan_in_box(PlanDesign::sobol, 40, s.inputs, 5);
-  const Eigen::MatrixXd tried = plan_in_box(PlanDesign::random, 3, s.inputs, 6);
+  const GaussianProcess gp = trained_gp(12, 8);
+  const Eigen::MatrixXd candidates = plan_in_box(PlanDesign::sobol, 40, gp.state().inputs, 5);
+  const Eigen::MatrixXd tried = plan_in_box(PlanDesign::random, 3, gp.state().inputs, 6);
   const auto picks = pick_by_posterior_variance(gp, candidates, 3, tried);
-  Eigen::MatrixXd x(s.x_train.rows() + 3, 3);
-  for (Eigen::Index i = 0; i < s.x_train.rows(); ++i) x.row(i) = unit_row(s.inputs, s.x_train.row(i));
-  for (Eigen::Index i = 0; i < 3; ++i) x.row(s.x_train.rows() + i) = unit_row(s.inputs, tried.row(i));
-  const double noise = s.hyper.noise_variance + s.jitter;
-  for (const auto& pick : picks) {
-    ASSERT_LT(pick.candidate, candidates.rows());
-    Eigen::Index best_index = -1;
-    double best = -1.0;
-    for (Eigen::Index c = 0; c < candidates.rows(); ++c) {
-      const double var = brute_force_variance(x, unit_row(s.inputs, candidates.row(c)), s.hyper, noise);
-      if (var > best) best = var, best_index = c;
-    }
-    EXPECT_EQ(pick.candidate, best_index);
-    x.conservativeResize(x.rows() + 1, Eigen::NoChange);
-    x.row(x.rows() - 1) = unit_row(s.inputs, candidates.row(pick.candidate));
-  }
+  ASSERT_EQ(picks.size(), 3u);
+  expect_brute_force_picks(gp, candidates, picks, tried);
 }
 
 }  // namespace
