@@ -97,8 +97,8 @@ struct RunOptions {
 
 // A progress bar on a terminal, one line per sample otherwise (logs, Slurm output files).
 void print_progress(const GenerationProgress& p, const InputSpace& inputs, const Eigen::VectorXd& x, bool terminal) {
-  const double rate = p.finished / std::max(p.elapsed_seconds, 1e-9);  // samples per second
-  const double eta = (p.to_run - p.finished) / std::max(rate, 1e-12);
+  const double rate = static_cast<double>(p.finished) / std::max(p.elapsed_seconds, 1e-9);  // samples per second
+  const double eta = static_cast<double>(p.to_run - p.finished) / std::max(rate, 1e-12);
   if (terminal) {
     constexpr int kWidth = 30;
     const int filled = static_cast<int>(kWidth * p.finished / std::max<long long>(p.to_run, 1));

@@ -126,7 +126,10 @@ TEST_F(Service, UncertainQueriesAreLoggedForActiveLearning) {
   std::nth_element(sorted.begin(), sorted.begin() + 300, sorted.end());
   const double threshold = sorted[300];  // about a quarter of the points are wider
   server::UncertainQueryLog log((dir_ / "uncertain").string(), threshold, 1000);
-  LoopbackServer server(dir_, 0, {.evaluation_threads = 2, .uncertain_log = &log});
+  server::ServiceLimits limits;
+  limits.evaluation_threads = 2;
+  limits.uncertain_log = &log;
+  LoopbackServer server(dir_, 0, limits);
   const auto remote = client::connect("grpc://" + server.address() + "/gp");
   const client::Answer a = remote->evaluate(pts.block(), {});
   EXPECT_TRUE(a.std.empty());
