@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <memory>
 #include <string>
 #include <thread>
@@ -255,7 +256,9 @@ void refine_command(const RefineOptions& o) {
       std::printf("  pick %zu: plan row %lld, predicted std %.4f\n", k + 1, static_cast<long long>(first) + static_cast<long long>(k),
                   picks[k].std_at_pick);
     }
-    db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
+    if (db.plan_design.find("active") == std::string::npos) {
+      db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
+    }
     write_dataset(o.db, db);
     GenerationOptions options;
     options.jobs = o.jobs;
@@ -269,6 +272,53 @@ void refine_command(const RefineOptions& o) {
   }
   std::printf("%s: %lld micro-model runs spent of a budget of %lld%s%s\n", o.db.c_str(), spent, o.budget,
               o.model_out.empty() ? "" : "; final model ", o.model_out.c_str());
+}
+
+// What a database holds: provenance, how much of its plan is done, why samples failed.
+void status_command(const std::string& path) {
+  const Dataset d = read_dataset(path);
+  long long converged = 0;
+  std::map<std::string, long long> reasons;
+  std::set<long long> answered;
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    if (d.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged)) {
+      ++converged;
+    } else {
+      ++reasons[d.failure_reason[static_cast<size_t>(i)].substr(0, 120)];
+    }
+    if (!d.plan_index.empty()) answered.insert(d.plan_index[static_cast<size_t>(i)]);
+  }
+  std::printf("%s: %s\n  code %s, created %s, scene sha256 %s\n", path.c_str(), d.source.c_str(), d.code_version.c_str(),
+              d.created_utc.c_str(), d.scene_json.empty() ? "(none)" : sha256_hex(d.scene_json).substr(0, 12).c_str());
+  std::printf("  plan: %lld points%s%s", static_cast<long long>(d.plan.rows()), d.plan_design.empty() ? "" : ", design ",
+              d.plan_design.c_str());
+  if (!d.plan_design.empty()) std::printf(" (seed %lld)", d.plan_seed);
+  std::printf("\n  samples: %lld (%lld converged, %lld failed)", static_cast<long long>(d.size()), converged,
+              static_cast<long long>(d.size()) - converged);
+  if (!d.plan_index.empty() || d.size() == 0) {
+    std::printf("; %lld of %lld plan points not yet run", static_cast<long long>(d.plan.rows()) - static_cast<long long>(answered.size()),
+                static_cast<long long>(d.plan.rows()));
+  }
+  std::printf("\n");
+  for (const auto& input : d.inputs) {
+    std::printf("  %-17s %s .. %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
+                format_human(input.hi, input.kind()).c_str());
+  }
+  if (converged > 0) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (Eigen::Index i = 0; i < d.size(); ++i) {
+      if (d.status[static_cast<size_t>(i)] != 0) continue;
+      lo = std::min(lo, d.mu(i));
+      hi = std::max(hi, d.mu(i));
+    }
+    std::printf("  mu: %.5f .. %.5f\n", lo, hi);
+  }
+  if (const auto it = d.diagnostics.find("wall_seconds"); it != d.diagnostics.end() && d.size() > 0) {
+    const double total = it->second.array().isNaN().select(0.0, it->second.array()).sum();
+    std::printf("  micro-model time: %s in total, %s per sample\n", duration_text(total).c_str(),
+                duration_text(total / static_cast<double>(d.size())).c_str());
+  }
+  for (const auto& [reason, count] : reasons) std::printf("  failed x%lld: %s\n", count, reason.c_str());
 }
 
 struct MergeOptions {
@@ -346,6 +396,11 @@ void add_dataset_commands(CLI::App& app) {
                  "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"
                  "scene, and reports the leave-one-out error (and the held-out error with --test).");
   refine->callback([f] { refine_command(*f); });
+
+  auto s = std::make_shared<std::string>();
+  auto* status = dataset->add_subcommand("status", "What a dataset file holds: provenance, plan progress, failures");
+  status->add_option("db", *s, "Dataset file (HDF5)")->required()->check(CLI::ExistingFile);
+  status->callback([s] { status_command(*s); });
 
   auto m = std::make_shared<MergeOptions>();
   auto* merge = dataset->add_subcommand("merge", "Combine shard databases of one plan");

@@ -220,6 +220,11 @@ TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("9 samples read, 3 duplicates removed -> 6 samples"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("0 of 6 plan rows not yet run"), std::string::npos) << r.output;
+  r = run("dataset status " + path("all.h5"));
+  EXPECT_NE(r.output.find("samples: 6 (6 converged, 0 failed); 0 of 6 plan points not yet run"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("design latin-hypercube (seed 4)"), std::string::npos) << r.output;
+  r = run("dataset status " + path("s1.h5"));  // one shard: the other rows are not run (in this file)
+  EXPECT_NE(r.output.find("3 of 6 plan points not yet run"), std::string::npos) << r.output;
   r = run("train --data " + path("all.h5") + " --out " + path("gp.h5"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
   // A database of this plan refuses another scene.
@@ -257,6 +262,7 @@ TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
   r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
   EXPECT_NE(r.output.find("-> 9 samples"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("0 of 9 plan rows not yet run"), std::string::npos) << r.output;
+  EXPECT_NE(run("dataset status " + path("db.h5")).output.find("design sobol+active (seed 0)"), std::string::npos);
   EXPECT_EQ(run("describe " + path("gp.h5")).exit_code, 0);
 }
 
@@ -278,8 +284,7 @@ TEST_F(Cli, DatasetRunSurvivesKillNine) {
   for (int i = 0; i < 600 && !recorded; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     std::ifstream log(path("run.log"));
-    std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-    recorded = text.find("sample 2/6") != std::string::npos;
+    for (std::string line; std::getline(log, line);) recorded = recorded || line.rfind("sample 2/6", 0) == 0;
   }
   kill(pid, SIGKILL);
   int status = 0;
