@@ -117,6 +117,8 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
 
   Evaluation current = evaluate(u1, true);
   double force_scale = 0.0;
+  bool factorized = false, last_full_step = false;
+  double previous_norm = 0.0;
   for (int it = 0;; ++it) {
     if (!current.assembly.ok) {
       at.reason = current.assembly.reason;
@@ -139,21 +141,29 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
                   std::to_string(current.norm) + " N, tolerance " + std::to_string(tolerance) + " N)";
       return at;
     }
-    SparseMatrix k = std::move(current.assembly.tangent);
-    if (stiffness_factor != 1.0) k *= stiffness_factor;
-    if (dynamic) {
-      // Same pattern as the tangent: add value arrays.
-      Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
-          mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
-    }
-    problem_.constrain(k);
     Eigen::VectorXd rhs = -current.residual;
     problem_.zero_constrained(rhs);
     const auto start = std::chrono::steady_clock::now();
-    if (!solver_.factorize(k)) {
-      at.reason = solver_.reason();
-      return at;
+    // In the quadratic phase the tangent hardly changes between iterations: the last factorisation
+    // serves once more (a chord step), and any sign of trouble brings a fresh one.
+    const bool reuse = options_.reuse_factorization && factorized && last_full_step &&
+                       current.norm < kReuseFactorizationBelow * previous_norm;
+    if (!reuse) {
+      SparseMatrix k = std::move(current.assembly.tangent);
+      if (stiffness_factor != 1.0) k *= stiffness_factor;
+      if (dynamic) {
+        // Same pattern as the tangent: add value arrays.
+        Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
+            mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
+      }
+      problem_.constrain(k);
+      if (!solver_.factorize(k)) {
+        at.reason = solver_.reason();
+        return at;
+      }
+      factorized = true;
     }
+    previous_norm = current.norm;
     const Eigen::VectorXd delta = solver_.solve(rhs);
     report_.seconds_solve += seconds_since(start);
     // Line search on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction.
@@ -178,6 +188,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
                            trial.norm <= 1e3 * tolerance;
     // `trial` was evaluated at the new u1; it lacks a tangent only after a line-search reduction.
     const bool trial_has_tangent = s == 1.0;
+    last_full_step = s == 1.0;
     current = stagnated || trial_has_tangent ? std::move(trial) : evaluate(u1, true);
     if (stagnated && current.assembly.ok) {
       at.record.newton_iterations = it + 1;

@@ -22,6 +22,10 @@ enum class TimeScheme { generalized_alpha, quasi_static };
 inline constexpr double kNewtonStagnationIncrement = 1e-14;
 inline constexpr double kLineSearchSufficientDecrease = 1e-4;  // Armijo constant on ‖G‖²
 inline constexpr int kLineSearchMaxReductions = 8;
+// The factorisation of the previous iteration is reused (a chord step) when that iteration took a
+// full step and cut the residual below this fraction: measured on the default scene (60 ns),
+// 0.05 saved 11 % of the run time for 6 % more iterations; 0.3 doubled the iterations.
+inline constexpr double kReuseFactorizationBelow = 0.05;
 // Step-size control by Newton iteration count (the iteration-count heuristic of e.g. Wriggers,
 // Nonlinear Finite Element Methods 2008, sec. 5.2.3, and Abaqus' automatic incrementation): the next
 // step is the last one × kTargetNewtonIterations / iterations, within [1/2, 2] and at most max_dt.
@@ -43,6 +47,7 @@ struct TimeIntegrationOptions {
   bool line_search = true;
   int max_cutbacks = 8;          // consecutive halvings of a failing step before giving up
   LinearSolverKind linear_solver = LinearSolverKind::lu;
+  bool reuse_factorization = true;  // chord steps in the quadratic phase (kReuseFactorizationBelow)
 };
 
 struct StepRecord {
