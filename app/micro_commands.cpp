@@ -99,9 +99,10 @@ void print_summary(const scene::MicroResult& r, const scene::Scene& sc) {
               r.max_plastic_strain, format_human(r.max_temperature, QuantityKind::temperature).c_str());
   std::printf("%d elements, %d dofs, %zu steps, %d Newton iterations (%d assemblies, %d line-search reductions), "
               "%zu cut-backs, %.2f s (assembly %.2f s of which contact %.2f s, solve %.2f s)\n",
-              r.elements, r.dofs, r.history.size(), r.newton_iterations, r.assemblies, r.line_search_reductions,
-              r.cutbacks.size(), r.wall_seconds, r.seconds_assembly, r.seconds_contact, r.seconds_solve);
-  for (const auto& c : r.cutbacks) std::printf("  cut-back at %.2f ns (dt %.3g s): %s\n", c.time * 1e9, c.dt_failed, c.reason.c_str());
+              r.elements, r.dofs, r.history.size(), r.solver.newton_iterations, r.solver.assemblies,
+              r.solver.line_search_reductions, r.solver.cutbacks.size(), r.wall_seconds, r.solver.seconds_assembly,
+              r.solver.seconds_contact, r.solver.seconds_solve);
+  for (const auto& c : r.solver.cutbacks) std::printf("  cut-back at %.2f ns (dt %.3g s): %s\n", c.time * 1e9, c.dt_failed, c.reason.c_str());
 }
 
 int run_command(const RunCommandOptions& o) {

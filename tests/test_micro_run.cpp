@@ -79,7 +79,7 @@ TEST(MicroRun, ShiftingBothSurfacesAlongTheIntervalLeavesMuUnchanged) {
   const MicroResult shifted = run_micro(parse_scene(j, "shifted"));
   ASSERT_TRUE(shifted.completed) << shifted.reason;
   EXPECT_GT(std::abs(base.mu), 1e-3);
-  ASSERT_TRUE(base.cutbacks.empty() && shifted.cutbacks.empty());  // the same steps, or the comparison says nothing
+  ASSERT_TRUE(base.solver.cutbacks.empty() && shifted.solver.cutbacks.empty());  // the same steps, or the comparison says nothing
   EXPECT_NEAR(shifted.mu, base.mu, 1e-6 * std::abs(base.mu));
   EXPECT_NEAR(shifted.contact_fraction, base.contact_fraction, 1e-6);
 }

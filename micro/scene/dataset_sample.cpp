@@ -44,8 +44,8 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
                      {"max_contact_pressure_pa", r.max_contact_pressure},
                      {"max_plastic_strain", r.max_plastic_strain},
                      {"max_temperature_k", r.max_temperature},
-                     {"newton_iterations", r.newton_iterations},
-                     {"cutbacks", static_cast<double>(r.cutbacks.size())},
+                     {"newton_iterations", r.solver.newton_iterations},
+                     {"cutbacks", static_cast<double>(r.solver.cutbacks.size())},
                      {"dofs", r.dofs},
                      {"micro_wall_seconds", r.wall_seconds}};
     return o;

@@ -103,18 +103,18 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
                       {"max_contact_pressure_pa", max_contact_pressure},
                       {"max_plastic_strain", max_plastic_strain},
                       {"max_temperature_k", max_temperature},
-                      {"newton_iterations", newton_iterations},
-                      {"cutbacks", static_cast<int>(cutbacks.size())},
+                      {"newton_iterations", solver.newton_iterations},
+                      {"cutbacks", static_cast<int>(solver.cutbacks.size())},
                       {"dofs", dofs},
                       {"elements", elements},
                       {"wall_seconds", wall_seconds},
-                      {"assemblies", assemblies},
-                      {"line_search_reductions", line_search_reductions},
-                      {"assembly_seconds", seconds_assembly},
-                      {"contact_seconds", seconds_contact},
-                      {"solve_seconds", seconds_solve}};
+                      {"assemblies", solver.assemblies},
+                      {"line_search_reductions", solver.line_search_reductions},
+                      {"assembly_seconds", solver.seconds_assembly},
+                      {"contact_seconds", solver.seconds_contact},
+                      {"solve_seconds", solver.seconds_solve}};
   auto& cuts = j["cutbacks"] = nlohmann::json::array();
-  for (const auto& c : cutbacks) cuts.push_back({{"time_s", c.time}, {"dt_failed_s", c.dt_failed}, {"reason", c.reason}});
+  for (const auto& c : solver.cutbacks) cuts.push_back({{"time_s", c.time}, {"dt_failed_s", c.dt_failed}, {"reason", c.reason}});
   auto& h = j["history"] = nlohmann::json::array();
   for (const auto& s : history) {
     h.push_back({{"time_s", s.time},
@@ -182,7 +182,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   contact::ContactState last;
   double weighted_mu = 0.0, weight = 0.0, previous_time = 0.0;
-  const solid::IntegrationReport report = integrator.run([&](const solid::StepView& view) {
+  result.solver = integrator.run([&](const solid::StepView& view) {
     last = contact->state(view.u);
     MicroStep step;
     step.time = view.time;
@@ -200,16 +200,10 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     previous_time = view.time;
     if (options.on_step) options.on_step(step, scene);
   });
+  const solid::IntegrationReport& report = result.solver;
   for (size_t k = 0; k < report.steps.size() && k < result.history.size(); ++k) {
     result.history[k].newton_iterations = report.steps[k].newton_iterations;
   }
-  result.newton_iterations = report.newton_iterations;
-  result.cutbacks = report.cutbacks;
-  result.seconds_assembly = report.seconds_assembly;
-  result.seconds_solve = report.seconds_solve;
-  result.seconds_contact = report.seconds_contact;
-  result.assemblies = report.assemblies;
-  result.line_search_reductions = report.line_search_reductions;
   result.contact_fraction = last.surface_length > 0.0 ? last.contact_length / last.surface_length : 0.0;
   result.max_contact_pressure = last.max_pressure;
   for (const auto& s : problem.states()) {

@@ -31,11 +31,9 @@ struct MicroResult {
   std::vector<MicroStep> history;
   double contact_fraction = 0.0, max_contact_pressure = 0.0;  // at the end
   double max_plastic_strain = 0.0, max_temperature = 0.0;     // over the chip, at the end
-  int newton_iterations = 0, dofs = 0, elements = 0;
-  int assemblies = 0, line_search_reductions = 0;
-  std::vector<solid::CutBack> cutbacks;
-  double wall_seconds = 0.0, seconds_assembly = 0.0, seconds_solve = 0.0;
-  double seconds_contact = 0.0;  // part of seconds_assembly
+  int dofs = 0, elements = 0;
+  solid::IntegrationReport solver;  // the time integration's own record: Newton work, cut-backs, seconds
+  double wall_seconds = 0.0;
   nlohmann::json to_json(const Scene& scene) const;
 };
 

@@ -187,9 +187,8 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
                            trial.norm <= 1e3 * tolerance;
     // `trial` was evaluated at the new u1; it lacks a tangent only after a line-search reduction.
-    const bool trial_has_tangent = s == 1.0;
     last_full_step = s == 1.0;
-    current = stagnated || trial_has_tangent ? std::move(trial) : evaluate(u1, true);
+    current = stagnated || last_full_step ? std::move(trial) : evaluate(u1, true);
     if (stagnated && current.assembly.ok) {
       at.record.newton_iterations = it + 1;
       at.record.residual = current.norm;
