@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -50,6 +51,13 @@ std::string duration_text(double seconds) {
   return text;
 }
 
+void print_box(const InputSpace& box) {
+  for (const auto& input : box) {
+    std::printf("  %-17s %s .. %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
+                format_human(input.hi, input.kind()).c_str());
+  }
+}
+
 struct PlanOptions {
   std::string out, design = "sobol", scene_path, p, v, t;
   std::vector<std::string> overrides;
@@ -78,14 +86,10 @@ void plan_command(const PlanOptions& o) {
   plan.plan_seed = static_cast<long long>(o.seed);
   plan.scene_json = sc.effective.dump(2);
   plan.source = "micro-model plan (" + sc.source + ")";
-  plan.plan_index.clear();
   write_dataset(o.out, plan);
   std::printf("wrote %s: %lld points, %s design (seed %llu), scene %s (sha256 %s)\n", o.out.c_str(), o.samples,
               plan.plan_design.c_str(), o.seed, sc.source.c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());
-  for (const auto& input : box) {
-    std::printf("  %-17s %s .. %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
-                format_human(input.hi, input.kind()).c_str());
-  }
+  print_box(box);
 }
 
 struct RunOptions {
@@ -128,21 +132,8 @@ void print_progress(const GenerationProgress& p, const InputSpace& inputs, const
 // The scene of a run: --scene (or the one stored with the plan, or the default), then --set.
 scene::Scene run_scene(const std::string& scene_path, const std::vector<std::string>& overrides, const Dataset& plan,
                        const std::string& plan_path) {
-  nlohmann::json scene_json;
-  std::string scene_source;
-  if (!scene_path.empty()) {
-    scene_json = scene::read_scene_json(scene_path);
-    scene_source = scene_path;
-  } else if (!plan.scene_json.empty()) {
-    scene_json = nlohmann::json::parse(plan.scene_json);
-    scene_source = "the scene of " + plan_path;
-  } else {
-    scene_json = scene::default_scene_json();
-    scene_source = "default dry scene";
-  }
-  for (const auto& assignment : overrides) scene::apply_override(scene_json, assignment);
-  const std::string base = scene_path.empty() ? "." : std::filesystem::path(scene_path).parent_path().string();
-  return scene::parse_scene(scene_json, scene_source, base.empty() ? "." : base);
+  if (!scene_path.empty() || plan.scene_json.empty()) return scene::load_scene(scene_path, overrides);
+  return scene::scene_with_overrides(nlohmann::json::parse(plan.scene_json), overrides, "the scene of " + plan_path);
 }
 
 int threads_per_job(int jobs, int threads) {
@@ -209,14 +200,15 @@ Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box,
   return all;
 }
 
-void report_round(int round, const GaussianProcess& gp, const TrainingSet& data, const RefineOptions& o) {
+// `test` is the held-out set (null without --test).
+void report_round(int round, const GaussianProcess& gp, const TrainingSet& data, const TrainingSet* test) {
   const auto& sum = gp.state().summary;
   std::printf("round %d: %lld training samples, LOO mean relative error %.3f %%, max %.3f %%", round,
               static_cast<long long>(data.x.rows()), 100.0 * sum.loo_mean_relative_error, 100.0 * sum.loo_max_relative_error);
-  if (!o.test.empty()) {
-    const AccuracyReport r = held_out_accuracy(gp, training_set(read_dataset(o.test), o.test), 0.95);
-    std::printf("; held-out (%s, %lld points) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", o.test.c_str(), r.points,
-                100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, 100.0 * r.coverage);
+  if (test != nullptr) {
+    const AccuracyReport r = held_out_accuracy(gp, *test, 0.95);
+    std::printf("; held-out (%s, %lld points) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", test->source_path.c_str(),
+                r.points, 100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, 100.0 * r.coverage);
   }
   std::printf("\n");
   std::fflush(stdout);
@@ -229,6 +221,8 @@ void refine_command(const RefineOptions& o) {
   }
   const scene::Scene sc = run_scene("", {}, db, o.db);
   const SampleEvaluator evaluate = scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads));
+  std::optional<TrainingSet> test;
+  if (!o.test.empty()) test = training_set(read_dataset(o.test), o.test);
   GpTrainingOptions training;
   training.restarts = o.restarts;
   training.seed = o.seed;
@@ -236,7 +230,7 @@ void refine_command(const RefineOptions& o) {
   for (int round = 1;; ++round) {
     const TrainingSet data = training_set(db, o.db);
     const GaussianProcess gp = train_gaussian_process(data, training);
-    report_round(round, gp, data, o);
+    report_round(round, gp, data, test ? &*test : nullptr);
     if (!o.model_out.empty()) save_model(o.model_out, gp);
     if (spent >= o.budget) break;
     const int batch = static_cast<int>(std::min<long long>(o.batch, o.budget - spent));
@@ -300,10 +294,7 @@ void status_command(const std::string& path) {
                 static_cast<long long>(d.plan.rows()));
   }
   std::printf("\n");
-  for (const auto& input : d.inputs) {
-    std::printf("  %-17s %s .. %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
-                format_human(input.hi, input.kind()).c_str());
-  }
+  print_box(d.inputs);
   if (converged > 0) {
     double lo = INFINITY, hi = -INFINITY;
     for (Eigen::Index i = 0; i < d.size(); ++i) {

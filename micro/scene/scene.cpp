@@ -263,11 +263,16 @@ nlohmann::json default_scene_json() {
   return json::parse(kText);
 }
 
+Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& overrides, const std::string& source,
+                           const std::string& base_directory) {
+  for (const auto& assignment : overrides) apply_override(json, assignment);
+  return parse_scene(json, source, base_directory);
+}
+
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  nlohmann::json j = path.empty() ? default_scene_json() : read_scene_json(path);
-  for (const auto& assignment : overrides) apply_override(j, assignment);
-  const std::string base = path.empty() ? "." : std::filesystem::path(path).parent_path().string();
-  return parse_scene(j, path.empty() ? "default dry scene" : path, base.empty() ? "." : base);
+  if (path.empty()) return scene_with_overrides(default_scene_json(), overrides, "default dry scene");
+  const std::string base = std::filesystem::path(path).parent_path().string();
+  return scene_with_overrides(read_scene_json(path), overrides, path, base.empty() ? "." : base);
 }
 
 }  // namespace mufric::scene

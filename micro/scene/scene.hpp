@@ -75,6 +75,9 @@ Scene parse_scene(const nlohmann::json& json, const std::string& source, const s
 // The default dry scene shipped with mufric (micro/scene/dry_default.json, compiled in).
 nlohmann::json default_scene_json();
 
+// A scene's JSON with "key=value" overrides applied, parsed.
+Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& overrides, const std::string& source,
+                           const std::string& base_directory = ".");
 // A scene file (or, for an empty path, the default scene) with "key=value" overrides applied.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides);
 
