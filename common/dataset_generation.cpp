@@ -44,6 +44,11 @@ bool same_inputs(const InputSpace& a, const InputSpace& b) {
   return true;
 }
 
+// Equal plans (a shape check first: Eigen compares matrices of equal shape only).
+bool same_plan(const h5::RowMatrix& a, const h5::RowMatrix& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+}
+
 Dataset empty_database(const Dataset& plan) {
   Dataset d;
   d.inputs = plan.inputs;
@@ -65,7 +70,7 @@ Dataset open_database(const std::string& db_path, const Dataset& plan) {
   if (!std::filesystem::exists(db_path)) return empty_database(plan);
   Dataset d = read_dataset(db_path);
   if (!same_inputs(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
-  if (d.plan.rows() != plan.plan.rows() || d.plan.cols() != plan.plan.cols() || d.plan != plan.plan) {
+  if (!same_plan(d.plan, plan.plan)) {
     throw Error(db_path + ": was made from a different plan (" + std::to_string(d.plan.rows()) + " rows, the plan has " +
                 std::to_string(plan.plan.rows()) + " or different points); use another --db");
   }
@@ -220,57 +225,53 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
 Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, MergeReport& report) {
   if (paths.empty()) throw Error("merge: no input files");
   report = MergeReport{};
-  Dataset merged;
-  std::map<long long, Eigen::Index> row_of_plan;  // plan row -> merged sample
-  for (size_t f = 0; f < paths.size(); ++f) {
-    const Dataset d = read_dataset(paths[f]);
-    ++report.files;
-    if (f == 0) {
-      merged = d;
-      merged.x.resize(0, d.x.cols());
-      merged.mu.resize(0);
-      merged.status.clear();
-      merged.failure_reason.clear();
-      merged.plan_index.clear();
-      merged.diagnostics.clear();
-    } else {
-      if (!same_inputs(d.inputs, merged.inputs)) throw Error("merge: " + paths[f] + ": inputs or box differ from " + paths[0]);
-      if (d.plan != merged.plan) throw Error("merge: " + paths[f] + ": comes from a different plan than " + paths[0]);
-      if (!allow_mixed && d.scene_json != merged.scene_json) {
-        throw Error("merge: " + paths[f] + ": made with a different scene than " + paths[0] + " (--allow-mixed to merge anyway)");
-      }
-      if (!allow_mixed && d.code_version != merged.code_version) {
-        throw Error("merge: " + paths[f] + ": made by code version " + d.code_version + ", " + paths[0] + " by " +
-                    merged.code_version + " (--allow-mixed to merge anyway)");
-      }
+  std::vector<Dataset> files;
+  for (const auto& path : paths) {
+    files.push_back(read_dataset(path));
+    const Dataset& d = files.back();
+    const Dataset& first = files.front();
+    if (!same_inputs(d.inputs, first.inputs)) throw Error("merge: " + path + ": inputs or box differ from " + paths[0]);
+    if (!same_plan(d.plan, first.plan)) throw Error("merge: " + path + ": comes from a different plan than " + paths[0]);
+    if (!allow_mixed && d.scene_json != first.scene_json) {
+      throw Error("merge: " + path + ": made with a different scene than " + paths[0] + " (--allow-mixed to merge anyway)");
     }
-    if (d.plan_index.size() != static_cast<size_t>(d.size())) throw Error("merge: " + paths[f] + ": samples without plan rows");
-    for (Eigen::Index i = 0; i < d.size(); ++i) {
+    if (!allow_mixed && d.code_version != first.code_version) {
+      throw Error("merge: " + path + ": made by code version " + d.code_version + ", " + paths[0] + " by " +
+                  first.code_version + " (--allow-mixed to merge anyway)");
+    }
+    if (d.plan_index.size() != static_cast<size_t>(d.size())) throw Error("merge: " + path + ": samples without plan rows");
+  }
+  report.files = static_cast<long long>(files.size());
+  // One sample per plan row: the first one read, unless a later one converged where it failed.
+  const auto converged = [&](std::pair<size_t, Eigen::Index> at) {
+    return files[at.first].status[static_cast<size_t>(at.second)] == static_cast<long long>(SampleStatus::converged);
+  };
+  std::map<long long, std::pair<size_t, Eigen::Index>> chosen;  // plan row -> (file, sample)
+  for (size_t f = 0; f < files.size(); ++f) {
+    for (Eigen::Index i = 0; i < files[f].size(); ++i) {
       ++report.samples_read;
-      const long long row = d.plan_index[static_cast<size_t>(i)];
-      SampleOutcome o;
-      o.converged = d.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged);
-      o.mu = d.mu(i);
-      o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
-      for (const auto& [name, values] : d.diagnostics) o.diagnostics[name] = values(i);
-      const auto it = row_of_plan.find(row);
-      if (it != row_of_plan.end()) {
-        ++report.duplicates_removed;
-        const bool kept_converged = merged.status[static_cast<size_t>(it->second)] == static_cast<long long>(SampleStatus::converged);
-        if (kept_converged || !o.converged) continue;
-        remove_rows(merged, {row});  // a converged answer replaces a failed one
-        row_of_plan.clear();
-        for (Eigen::Index k = 0; k < merged.size(); ++k) row_of_plan[merged.plan_index[static_cast<size_t>(k)]] = k;
-      }
-      append_sample(merged, d.x.row(i).transpose(), row, o);
-      row_of_plan[row] = merged.size() - 1;
+      const auto [it, inserted] = chosen.try_emplace(files[f].plan_index[static_cast<size_t>(i)], f, i);
+      if (inserted) continue;
+      ++report.duplicates_removed;
+      if (!converged(it->second) && converged({f, i})) it->second = {f, i};
     }
   }
-  for (Eigen::Index i = 0; i < merged.size(); ++i) {
-    (merged.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged) ? report.converged : report.failed) += 1;
+  Dataset merged = empty_database(files.front());
+  merged.code_version = files.front().code_version;
+  merged.created_utc = files.front().created_utc;
+  for (const auto& [row, at] : chosen) {
+    const Dataset& d = files[at.first];
+    const Eigen::Index i = at.second;
+    SampleOutcome o;
+    o.converged = converged(at);
+    o.mu = d.mu(i);
+    o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
+    for (const auto& [name, values] : d.diagnostics) o.diagnostics[name] = values(i);
+    append_sample(merged, d.x.row(i).transpose(), row, o);
+    (o.converged ? report.converged : report.failed) += 1;
   }
   report.plan_rows = merged.plan.rows();
-  report.plan_rows_missing = report.plan_rows - static_cast<long long>(row_of_plan.size());
+  report.plan_rows_missing = report.plan_rows - static_cast<long long>(chosen.size());
   if (allow_mixed) merged.source += " (merged with --allow-mixed)";
   return merged;
 }
