@@ -7,15 +7,6 @@
 namespace mufric {
 namespace {
 
-Eigen::MatrixXd unit_box(const InputSpace& inputs, const Eigen::MatrixXd& x) {
-  Eigen::MatrixXd u(x.rows(), x.cols());
-  for (Eigen::Index j = 0; j < x.cols(); ++j) {
-    const auto& in = inputs[static_cast<size_t>(j)];
-    u.col(j) = ((x.col(j).array() - in.lo) / (in.hi - in.lo)).matrix();
-  }
-  return u;
-}
-
 // σ² exp(−½ Σ ((aᵢ − bᵢ)/lᵢ)²) between the rows of a and b (unit-box coordinates).
 Eigen::MatrixXd rbf(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const GpHyperParameters& h) {
   const Eigen::RowVectorXd inverse_length = h.length_scales.cwiseInverse().transpose();
@@ -25,7 +16,10 @@ Eigen::MatrixXd rbf(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const Gp
   Eigen::MatrixXd d2 = -2.0 * as * bs.transpose();
   d2.colwise() += a2;
   d2.rowwise() += b2.transpose();
-  return h.signal_variance * (-0.5 * d2.cwiseMax(0.0)).array().exp().matrix();
+  Eigen::Map<Eigen::ArrayXd> correlation(d2.data(), d2.size());
+  correlation = correlation.max(0.0);  // round-off in the expanded square
+  rbf_correlation_in_place(correlation);  // the model's own kernel values (same floor)
+  return h.signal_variance * d2;
 }
 
 }  // namespace
@@ -41,7 +35,7 @@ std::vector<VariancePick> pick_by_posterior_variance(const GaussianProcess& gp, 
   Eigen::MatrixXd candidates(given.rows() + tried.rows(), given.cols());
   candidates.topRows(given.rows()) = given;
   if (tried.rows() > 0) candidates.bottomRows(tried.rows()) = tried;
-  const Eigen::MatrixXd xc = unit_box(s.inputs, candidates), xt = unit_box(s.inputs, s.x_train);
+  const Eigen::MatrixXd xc = to_unit_box(candidates, s.inputs), xt = to_unit_box(s.x_train, s.inputs);
   // Posterior covariance among the candidates: K_cc − K_cx K⁻¹ K_xc with K = L Lᵀ.
   const Eigen::MatrixXd v = s.cholesky.triangularView<Eigen::Lower>().solve(rbf(xt, xc, s.hyper));
   Eigen::MatrixXd sigma = rbf(xc, xc, s.hyper);
