@@ -13,9 +13,9 @@ struct LinearSolver::Impl {
 };
 
 LinearSolver::LinearSolver(LinearSolverKind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {
-  // The tangents are structurally symmetric and nearly symmetric in value (the contact and the
-  // plastic flow make them unsymmetric): UMFPACK's symmetric strategy (AMD on A + Aᵀ, diagonal
-  // pivots preferred; Davis, ACM TOMS 30(2) 2004, sec. 2) fills in far less than its column ordering.
+  // The tangents are structurally symmetric (and, in the default scene, symmetric in value to
+  // round-off; LU keeps the solver general): UMFPACK's symmetric strategy (AMD on A + Aᵀ, diagonal
+  // pivots preferred; Davis, ACM TOMS 30(2) 2004, sec. 2) suits them better than its column ordering.
   impl_->lu.umfpackControl()(UMFPACK_STRATEGY) = UMFPACK_STRATEGY_SYMMETRIC;
   // No iterative refinement inside the solve: each Newton iteration already refines the solution,
   // and every refinement step is another solve plus a matrix-vector product.
