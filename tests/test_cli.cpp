@@ -191,18 +191,37 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   EXPECT_NE(r.output.find("physics"), std::string::npos) << r.output;
 }
 
+// A scene small enough that a sample takes a fraction of a second.
+const std::string kTinyScene =
+    " --set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16"
+    " --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set time.duration=6ns"
+    " --set time.average_from=3ns --set load.ramp=3ns";
+
+TEST_F(Cli, MicroConvergeDoublesTheRequestedDirection) {
+  const std::string& tiny = kTinyScene;
+  // Tolerance 1: the first refinement converges, so the table has two levels.
+  CommandResult r = run("micro converge --direction y --max-levels 1 --tolerance 1" + tiny);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // 16 × 4 elements, then 16 × 8 (degree 2: (16) × (4 + 2) and (16) × (8 + 2) control points, 2 dofs each).
+  EXPECT_NE(r.output.find("| 0 | 64 | 192 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 1 | 128 | 320 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("converged at level 1"), std::string::npos) << r.output;
+  // A tolerance no change can meet: not converged, exit code 3.
+  r = run("micro converge --direction x --max-levels 1 --tolerance 1e-6" + tiny);
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("| 1 | 128 | 384 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not converged within 1 refinements"), std::string::npos) << r.output;
+  r = run("micro converge --direction z" + tiny);
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--direction"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, CorruptModelIsRefused) {
   std::ofstream(path("bad.h5")) << "not a model";
   const CommandResult r = run("predict --model " + path("bad.h5") + " --p 800MPa --v 100m/min --T 500C");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("not an HDF5 file"), std::string::npos) << r.output;
 }
-
-// A scene small enough that a sample takes a fraction of a second.
-const std::string kTinyScene =
-    " --set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16"
-    " --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set time.duration=6ns"
-    " --set time.average_from=3ns --set load.ramp=3ns";
 
 TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
   CommandResult r = run("dataset plan --out " + path("plan.h5") + " --samples 6 --design lhs --seed 4 --p 500MPa:900MPa" + kTinyScene);
