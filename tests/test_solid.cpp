@@ -291,6 +291,34 @@ Eigen::Matrix3d amplification(double omega, double dt, double rho_inf) {
   return m;
 }
 
+// A Cholesky solver given a symmetric indefinite matrix factorises it by LU instead: the solution
+// matches a dense solve, and the fallback is counted; an SPD matrix stays with Cholesky.
+TEST(LinearSolverTest, CholeskyHandsAnIndefiniteMatrixToLu) {
+  constexpr int n = 40;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> entry(-1.0, 1.0);
+  Eigen::MatrixXd spd = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = std::max(0, i - 3); j <= i; ++j) spd(i, j) = spd(j, i) = entry(rng);
+    spd(i, i) = 8.0;  // diagonally dominant: positive definite
+  }
+  Eigen::MatrixXd indefinite = spd;
+  indefinite(n / 2, n / 2) = -8.0;
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  LinearSolver solver(LinearSolverKind::cholesky);
+  ASSERT_TRUE(solver.factorize(spd.sparseView()));
+  EXPECT_LT((solver.solve(b) - spd.lu().solve(b)).norm(), 1e-12 * b.norm());
+  EXPECT_EQ(solver.lu_fallbacks(), 0);
+  ASSERT_TRUE(solver.factorize(indefinite.sparseView())) << solver.reason();
+  EXPECT_LT((solver.solve(b) - indefinite.lu().solve(b)).norm(), 1e-12 * b.norm());
+  EXPECT_EQ(solver.lu_fallbacks(), 1);
+  EXPECT_EQ(solver.analyses(), 1);  // same pattern: one symbolic analysis for both
+  // Back to an SPD matrix: Cholesky again, not the stale LU.
+  ASSERT_TRUE(solver.factorize((2.0 * spd).sparseView()));
+  EXPECT_LT((solver.solve(b) - (2.0 * spd).lu().solve(b)).norm(), 1e-12 * b.norm());
+  EXPECT_EQ(solver.lu_fallbacks(), 1);
+}
+
 TEST(GeneralizedAlpha, VibratingBarFollowsTheAmplificationMatrixAndKeepsItsPeriod) {
   const double length = 1.0, youngs = 1.0, density = 1.0;
   const auto material = std::make_shared<LinearElastic>(youngs, 0.0, density);

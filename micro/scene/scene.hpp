@@ -60,7 +60,7 @@ struct Scene {
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
   int max_cutbacks = 8;
-  solid::LinearSolverKind linear_solver = solid::LinearSolverKind::lu;
+  solid::LinearSolverKind linear_solver = solid::LinearSolverKind::cholesky;  // falls back to LU per matrix
 
   nlohmann::json effective;  // the scene as read, with overrides applied (for the result's provenance)
 };

@@ -32,30 +32,44 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
       std::equal(impl_->outer.begin(), impl_->outer.end(), a.outerIndexPtr()) &&
       std::equal(impl_->inner.begin(), impl_->inner.end(), a.innerIndexPtr());
   if (!same_pattern) {
-    if (kind_ == LinearSolverKind::lu) impl_->lu.analyzePattern(a); else impl_->cholesky.analyzePattern(a);
     impl_->outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1);
     impl_->inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
+    lu_analysed_ = cholesky_analysed_ = false;
     ++analyses_;
   }
-  if (kind_ == LinearSolverKind::lu) {
-    impl_->lu.factorize(a);
-    if (impl_->lu.info() != Eigen::Success) {
-      reason_ = "UMFPACK: the tangent is singular";
-      return false;
-    }
-  } else {
-    impl_->cholesky.factorize(a);
-    if (impl_->cholesky.info() != Eigen::Success) {
-      reason_ = "CHOLMOD: the tangent is not positive definite";
-      return false;
-    }
-  }
   reason_.clear();
+  if (kind_ == LinearSolverKind::lu) return factorize_lu(a);
+  if (!cholesky_analysed_) {
+    impl_->cholesky.analyzePattern(a);
+    cholesky_analysed_ = true;
+  }
+  impl_->cholesky.factorize(a);
+  if (impl_->cholesky.info() == Eigen::Success) {
+    last_by_lu_ = false;
+    return true;
+  }
+  ++lu_fallbacks_;
+  if (factorize_lu(a)) return true;
+  reason_ = "CHOLMOD: the tangent is not positive definite, and " + reason_;
+  return false;
+}
+
+bool LinearSolver::factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a) {
+  if (!lu_analysed_) {
+    impl_->lu.analyzePattern(a);
+    lu_analysed_ = true;
+  }
+  impl_->lu.factorize(a);
+  if (impl_->lu.info() != Eigen::Success) {
+    reason_ = "UMFPACK: the tangent is singular";
+    return false;
+  }
+  last_by_lu_ = true;
   return true;
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {
-  return kind_ == LinearSolverKind::lu ? Eigen::VectorXd(impl_->lu.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
+  return last_by_lu_ ? Eigen::VectorXd(impl_->lu.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
 }
 
 }  // namespace mufric::solid

@@ -1,6 +1,8 @@
 #pragma once
-// Sparse direct solves through Eigen's SuiteSparse modules: UMFPACK's LU for general (e.g.
-// plastic, contact) tangents, CHOLMOD's supernodal Cholesky for symmetric positive definite ones.
+// Sparse direct solves through Eigen's SuiteSparse modules: UMFPACK's LU for general tangents,
+// CHOLMOD's supernodal Cholesky for symmetric positive definite ones. A Cholesky solver that meets a
+// matrix CHOLMOD finds not positive definite factorises that one by LU instead (and counts it), so
+// choosing Cholesky for a tangent that is SPD in practice never costs a failed step.
 // The symbolic analysis is done once for a sparsity pattern and reused by every factorisation.
 #include <memory>
 #include <string>
@@ -23,6 +25,7 @@ class LinearSolver {
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   const std::string& reason() const { return reason_; }
   int analyses() const { return analyses_; }  // symbolic analyses done so far
+  int lu_fallbacks() const { return lu_fallbacks_; }  // Cholesky solver: matrices factorised by LU instead
 
  private:
   struct Impl;
@@ -30,6 +33,10 @@ class LinearSolver {
   LinearSolverKind kind_;
   std::string reason_;
   int analyses_ = 0;
+  int lu_fallbacks_ = 0;
+  bool last_by_lu_ = false;  // which factorisation `solve` uses
+  bool lu_analysed_ = false, cholesky_analysed_ = false;  // for the current pattern
+  bool factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
 };
 
 }  // namespace mufric::solid

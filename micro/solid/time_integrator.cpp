@@ -238,6 +238,7 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
       report_.cutbacks.push_back({t, this_dt, at.reason});
       if (++consecutive_cuts > options_.max_cutbacks) {
         report_.symbolic_analyses = solver_.analyses();
+        report_.lu_fallbacks = solver_.lu_fallbacks();
         report_.reason = "step at t = " + std::to_string(t) + " s failed after " + std::to_string(options_.max_cutbacks) +
                          " cut-backs: " + at.reason;
         return report_;
@@ -255,6 +256,7 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
   }
   report_.completed = true;
   report_.symbolic_analyses = solver_.analyses();
+  report_.lu_fallbacks = solver_.lu_fallbacks();
   return report_;
 }
 

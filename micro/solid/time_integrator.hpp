@@ -68,6 +68,7 @@ struct IntegrationReport {
   std::vector<CutBack> cutbacks;
   int newton_iterations = 0;
   int symbolic_analyses = 0;  // sparse symbolic factorisations (1 per run: the pattern is fixed)
+  int lu_fallbacks = 0;       // Cholesky runs: tangents CHOLMOD found not positive definite (solved by LU)
   int assemblies = 0;              // residual evaluations (with or without tangent)
   int line_search_reductions = 0;
   double seconds_assembly = 0.0, seconds_solve = 0.0;
