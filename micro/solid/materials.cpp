@@ -16,6 +16,8 @@ constexpr double kIsotropicSeriesBelow = 1e-4;
 // The return map's scalar equation is solved to this fraction of the trial stress norm.
 constexpr double kReturnMapRelativeTolerance = 1e-13;
 constexpr int kReturnMapMaxIterations = 200;
+// A Newton update this small relative to Δγ is round-off: the root is found.
+constexpr double kReturnMapStagnation = 1e-15;
 
 template <class T>
 struct Sym2 {
@@ -203,7 +205,12 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   double dgamma = 0.0, slope = 0.0;
   YieldWithSlope yield_end{yield_start, 0.0};
   if (q_trial - kSqrtTwoThirds * yield_start > kReturnMapRelativeTolerance * q_trial) {
-    // r(Δγ) = q − 2μΔγ − √(2/3) σy(Δγ), decreasing; r(0) > 0 ≥ r(q/2μ): bracketed Newton (rtsafe).
+    // r(Δγ) = q − 2μΔγ − √(2/3) σy(Δγ), decreasing; r(0) > 0 ≥ r(q/2μ). Newton in x = ln Δγ, kept
+    // in the bracket (rtsafe, Press et al., Numerical Recipes 3rd ed., sec. 9.4): in x, r is concave
+    // (2μe^x is convex, and σy is a product of positive, increasing, convex factors — (ε̄n + ce^x)^n
+    // and 1 + C max(x − x0, 0)), so from a start right of the root the iterates fall monotonically
+    // onto it. Newton in Δγ itself overshot into the power and log singularities of σy at Δγ → 0 and
+    // bisected: 11.4 iterations per plastic update on average, a third of them over 8 (default scene).
     double lo = 0.0, hi = q_trial / (2.0 * mu_);
     // Start from the perfectly plastic answer (yield stress frozen at its start value): hardening
     // and rate only raise σy, so the root lies below it, and it is close because 2μ ≫ dσy/dΔγ.
@@ -219,9 +226,9 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
         break;
       }
       (r > 0.0 ? lo : hi) = dgamma;
-      double next = dgamma - r / slope;
+      double next = dgamma * std::exp(-r / (slope * dgamma));  // x − r/(dr/dx), dr/dx = Δγ dr/dΔγ
       if (!std::isfinite(next) || next <= lo || next >= hi) next = 0.5 * (lo + hi);
-      if (hi - lo <= 1e-16 * q_trial / mu_) {
+      if (hi - lo <= 1e-16 * q_trial / mu_ || std::abs(next - dgamma) <= kReturnMapStagnation * dgamma) {
         converged = true;
         break;
       }
