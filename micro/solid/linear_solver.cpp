@@ -48,6 +48,8 @@ LinearSolver::LinearSolver(LinearSolverKind kind) : impl_(std::make_unique<Impl>
   // No iterative refinement inside the solve: each Newton iteration already refines the solution,
   // and every refinement step is another solve plus a matrix-vector product.
   impl_->lu.umfpackControl()(UMFPACK_IRSTEP) = 0;
+  // A matrix that is not positive definite is an answer here (LU takes it), not a warning for stderr.
+  impl_->cholesky.cholmod().print = 0;
 }
 LinearSolver::~LinearSolver() = default;
 LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;

@@ -212,9 +212,13 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
     // onto it. Newton in Δγ itself overshot into the power and log singularities of σy at Δγ → 0 and
     // bisected: 11.4 iterations per plastic update on average, a third of them over 8 (default scene).
     double lo = 0.0, hi = q_trial / (2.0 * mu_);
-    // Start from the perfectly plastic answer (yield stress frozen at its start value): hardening
-    // and rate only raise σy, so the root lies below it, and it is close because 2μ ≫ dσy/dΔγ.
-    dgamma = std::clamp((q_trial - kSqrtTwoThirds * yield_start) / (2.0 * mu_), 0.01 * hi, 0.99 * hi);
+    // The perfectly plastic answer (yield stress frozen at its start value) bounds the root from
+    // above: hardening and rate only raise σy. In steady flow the last step's plastic strain rate
+    // is a closer start (5.2 instead of 6.2 iterations, default scene); from a start left of the
+    // root, concavity costs one overshoot to the right, then the same monotone descent.
+    const double perfectly_plastic = std::clamp((q_trial - kSqrtTwoThirds * yield_start) / (2.0 * mu_), 0.01 * hi, 0.99 * hi);
+    const double at_last_rate = start.plastic_strain_rate * dt / kSqrtTwoThirds;
+    dgamma = at_last_rate > 0.0 ? std::min(at_last_rate, perfectly_plastic) : perfectly_plastic;
     bool converged = false;
     for (int it = 0; it < kReturnMapMaxIterations; ++it) {
       const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, thermal);
@@ -292,6 +296,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
                                       std::exp(2.0 * (trial.dev_zz * keep + third))};
   const double d_eps = kSqrtTwoThirds * dgamma;
   out.state.equivalent_plastic_strain = eps_n + d_eps;
+  out.state.plastic_strain_rate = d_eps / dt;
   out.state.yield_stress = yield_end.stress;
   out.state.temperature = theta + p_.heat_fraction * yield_end.stress * d_eps / (p_.density * p_.specific_heat);
   return out;

@@ -18,6 +18,7 @@ struct MaterialState {
   double equivalent_plastic_strain = 0.0;
   double temperature = 293.15;  // K
   double yield_stress = 0.0;    // Pa, at the end of the last step (diagnostic)
+  double plastic_strain_rate = 0.0;  // 1/s, over the last step: the next return map's first guess
 };
 
 struct StressResponse {
