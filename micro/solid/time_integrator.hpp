@@ -48,6 +48,10 @@ struct TimeIntegrationOptions {
   int max_cutbacks = 8;          // consecutive halvings of a failing step before giving up
   LinearSolverKind linear_solver = LinearSolverKind::lu;
   bool reuse_factorization = true;  // chord steps in the quadratic phase (kReuseFactorizationBelow)
+  // Predictor: the last accepted increment scaled to the new step (linear extrapolation, as
+  // Abaqus/Standard's default EXTRAPOLATION=LINEAR); false, or on the first step: constant velocity
+  // (dynamic) or the last state (quasi-static).
+  bool extrapolate_predictor = true;
 };
 
 struct StepRecord {
@@ -110,6 +114,8 @@ class TimeIntegrator {
   SolidProblem& problem_;
   TimeIntegrationOptions options_;
   Eigen::VectorXd u_, v_, a_, f_int_, reactions_;
+  Eigen::VectorXd last_increment_;  // u of the last accepted step minus u before it
+  double last_dt_ = 0.0;            // its length; 0 before the first accepted step
   std::vector<Eigen::Matrix2d> stresses_;
   LinearSolver solver_;
   IntegrationReport report_;
