@@ -237,7 +237,7 @@ void refine_command(const RefineOptions& o) {
     const Eigen::MatrixXd candidates = refine_candidates(o, db.inputs, round);
     std::vector<Eigen::Index> failed_rows;
     for (Eigen::Index i = 0; i < db.size(); ++i) {
-      if (db.status[static_cast<size_t>(i)] != static_cast<long long>(SampleStatus::converged)) failed_rows.push_back(i);
+      if (!db.converged(i)) failed_rows.push_back(i);
     }
     Eigen::MatrixXd failed(static_cast<Eigen::Index>(failed_rows.size()), db.x.cols());
     for (size_t k = 0; k < failed_rows.size(); ++k) failed.row(static_cast<Eigen::Index>(k)) = db.x.row(failed_rows[k]);
@@ -275,7 +275,7 @@ void status_command(const std::string& path) {
   std::map<std::string, long long> reasons;
   std::set<long long> answered;
   for (Eigen::Index i = 0; i < d.size(); ++i) {
-    if (d.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged)) {
+    if (d.converged(i)) {
       ++converged;
     } else {
       ++reasons[d.failure_reason[static_cast<size_t>(i)].substr(0, 120)];
@@ -298,7 +298,7 @@ void status_command(const std::string& path) {
   if (converged > 0) {
     double lo = INFINITY, hi = -INFINITY;
     for (Eigen::Index i = 0; i < d.size(); ++i) {
-      if (d.status[static_cast<size_t>(i)] != 0) continue;
+      if (!d.converged(i)) continue;
       lo = std::min(lo, d.mu(i));
       hi = std::max(hi, d.mu(i));
     }

@@ -147,7 +147,7 @@ TrainingSet training_set(const Dataset& d, const std::string& path) {
   t.source_hash = sha256_file(path);
   std::vector<Eigen::Index> rows;
   for (Eigen::Index i = 0; i < d.size(); ++i) {
-    if (d.status[static_cast<size_t>(i)] != static_cast<long long>(SampleStatus::converged)) continue;
+    if (!d.converged(i)) continue;
     for (Eigen::Index j = 0; j < d.x.cols(); ++j) {
       if (!std::isfinite(d.x(i, j))) {
         throw Error(path + ": sample row " + std::to_string(i) + ", input '" + d.inputs[static_cast<size_t>(j)].name +

@@ -39,6 +39,7 @@ struct Dataset {
   std::string created_utc;
 
   Eigen::Index size() const { return x.rows(); }
+  bool converged(Eigen::Index i) const { return status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged); }
 };
 
 // Samples that converged, validated: finite inputs and μ. Errors name file, row and input.

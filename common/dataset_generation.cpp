@@ -143,7 +143,7 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
   std::set<long long> done, failed_rows;
   for (Eigen::Index i = 0; i < db.size(); ++i) {
     const long long row = db.plan_index[static_cast<size_t>(i)];
-    const bool failed = db.status[static_cast<size_t>(i)] != static_cast<long long>(SampleStatus::converged);
+    const bool failed = !db.converged(i);
     if (failed && options.retry_failed) {
       failed_rows.insert(row);
     } else {
@@ -244,7 +244,7 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
   report.files = static_cast<long long>(files.size());
   // One sample per plan row: the first one read, unless a later one converged where it failed.
   const auto converged = [&](std::pair<size_t, Eigen::Index> at) {
-    return files[at.first].status[static_cast<size_t>(at.second)] == static_cast<long long>(SampleStatus::converged);
+    return files[at.first].converged(at.second);
   };
   std::map<long long, std::pair<size_t, Eigen::Index>> chosen;  // plan row -> (file, sample)
   for (size_t f = 0; f < files.size(); ++f) {

@@ -55,7 +55,7 @@ void expect_each_row_once(const Dataset& d, long long rows) {
     const long long row = d.plan_index[static_cast<size_t>(i)];
     EXPECT_TRUE(seen.insert(row).second) << "plan row " << row << " twice";
     EXPECT_EQ(d.x.row(i), d.plan.row(row));
-    if (d.status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged)) {
+    if (d.converged(i)) {
       EXPECT_DOUBLE_EQ(d.mu(i), exact_mu(d.x.row(i).transpose()));
     } else {
       EXPECT_NE(d.failure_reason[static_cast<size_t>(i)].find("did not converge"), std::string::npos);
