@@ -174,9 +174,6 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   o.max_newton_iterations = scene.max_newton_iterations;
   o.max_cutbacks = scene.max_cutbacks;
   o.linear_solver = scene.linear_solver;
-  // Chord steps pay when a factorisation costs as much as an assembly (UMFPACK); with CHOLMOD the
-  // factorisation is a fifth of an iteration and a chord step's slower convergence costs more.
-  o.reuse_factorization = scene.linear_solver == solid::LinearSolverKind::lu;
   solid::TimeIntegrator integrator(problem, o);
   if (scene.scheme == solid::TimeScheme::generalized_alpha) {
     // The chip starts moving with Γ_B: a rigid translation at the sliding velocity.
