@@ -198,20 +198,19 @@ const std::string kTinyScene =
     " --set time.average_from=3ns --set load.ramp=3ns";
 
 TEST_F(Cli, MicroConvergeDoublesTheRequestedDirection) {
-  const std::string& tiny = kTinyScene;
   // Tolerance 1: the first refinement converges, so the table has two levels.
-  CommandResult r = run("micro converge --direction y --max-levels 1 --tolerance 1" + tiny);
+  CommandResult r = run("micro converge --direction y --max-levels 1 --tolerance 1" + kTinyScene);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // 16 × 4 elements, then 16 × 8 (degree 2: (16) × (4 + 2) and (16) × (8 + 2) control points, 2 dofs each).
   EXPECT_NE(r.output.find("| 0 | 64 | 192 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("| 1 | 128 | 320 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("converged at level 1"), std::string::npos) << r.output;
   // A tolerance no change can meet: not converged, exit code 3.
-  r = run("micro converge --direction x --max-levels 1 --tolerance 1e-6" + tiny);
+  r = run("micro converge --direction x --max-levels 1 --tolerance 1e-6" + kTinyScene);
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("| 1 | 128 | 384 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("not converged within 1 refinements"), std::string::npos) << r.output;
-  r = run("micro converge --direction z" + tiny);
+  r = run("micro converge --direction z" + kTinyScene);
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--direction"), std::string::npos) << r.output;
 }
