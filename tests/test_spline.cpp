@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <numbers>
+#include <limits>
 #include <random>
 
 #include "common/error.hpp"
@@ -322,6 +323,30 @@ TEST(ClosestPoint, AgreesWithBruteForceOnRoughProfilesOfEveryDegree) {
       EXPECT_NEAR(project(c, x, window).distance, global.distance, 1e-14);
     }
   }
+}
+
+TEST(ClosestPoint, DivergedPointsFailWithAReasonInsteadOfExhaustingMemory) {
+  RoughnessSpec spec;
+  spec.length = 1.0;
+  spec.ra = 0.05;
+  spec.correlation_length = 0.05;
+  spec.samples = 128;
+  const SplineCurve c = fit_periodic_profile(synthetic_rough_profile(spec), 3, 30).curve;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const Eigen::Vector2d& x : {Eigen::Vector2d(nan, 0.0), Eigen::Vector2d(0.5, 1e300), Eigen::Vector2d(1e200, 0.0)}) {
+    const Projection p = project(c, x);
+    EXPECT_FALSE(p.converged);
+    EXPECT_FALSE(p.reason.empty());
+  }
+  EXPECT_NE(project(c, Eigen::Vector2d(nan, 0.0)).reason.find("diverged"), std::string::npos);
+  EXPECT_NE(project(c, Eigen::Vector2d(1e200, 0.0)).reason.find("diverged"), std::string::npos);
+  // A window spanning a million periods (what a contact search computes for a far-away point).
+  ProjectionOptions window;
+  window.window_lo = -1e6;
+  window.window_hi = 1e6;
+  const Projection p = project(c, Eigen::Vector2d(0.5, 0.0), window);
+  EXPECT_FALSE(p.converged);
+  EXPECT_NE(p.reason.find("periods"), std::string::npos) << p.reason;
 }
 
 TEST(ClosestPoint, AdversarialProfiles) {

@@ -111,6 +111,20 @@ LocalResult refine(const SplineCurve& curve, const Eigen::Vector2d& x, double a,
 
 Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const ProjectionOptions& options) {
   const SplineBasis& basis = curve.basis();
+  if (!x.allFinite() || !(options.window_lo <= options.window_hi)) {
+    Projection failed;
+    failed.reason = "the point or its search window is not finite (a diverged iterate)";
+    return failed;
+  }
+  // A window of more periods than this is a point absurdly far from the tool (a diverged iterate),
+  // not a search to sample span by span.
+  constexpr double kMaxWindowPeriods = 64.0;
+  if (basis.is_periodic() && options.window_hi - options.window_lo > kMaxWindowPeriods * basis.period()) {
+    Projection failed;
+    failed.reason = "the point is more than " + std::to_string(static_cast<int>(kMaxWindowPeriods)) +
+                    " periods from the curve (a diverged iterate)";
+    return failed;
+  }
   const int per_span = options.samples_per_span > 0 ? options.samples_per_span : 2 * basis.degree() + 4;
   // Parameter range: open curves their domain; periodic curves with a shift a few periods around
   // the period the point's position along the shift falls into.
@@ -140,6 +154,11 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
   } else if (basis.is_periodic() && !curve.shift().isZero() && options.periods > 1) {
     const Eigen::Vector2d s = curve.shift();
     const double along = (x - curve.point(lo)).dot(s) / s.squaredNorm();
+    if (!(std::abs(along) < 1e9)) {
+      Projection failed;
+      failed.reason = "the point is too many periods from the curve (a diverged iterate)";
+      return failed;
+    }
     const int centre = static_cast<int>(std::floor(along));
     const int first = centre - (options.periods - 1) / 2;
     std::vector<double> extended;
