@@ -116,7 +116,7 @@ LinearElastic::LinearElastic(double youngs_modulus, double poisson_ratio, double
   if (kind == PlaneKind::stress) lambda_ = 2.0 * lambda_ * mu_ / (lambda_ + 2.0 * mu_);
 }
 
-StressResponse LinearElastic::update(const Eigen::Matrix2d& h, const MaterialState& start, double) const {
+StressResponse LinearElastic::update(const Eigen::Matrix2d& h, const MaterialState& start, double, bool) const {
   StressResponse r;
   const Eigen::Matrix2d strain = 0.5 * (h + h.transpose());
   r.stress = lambda_ * strain.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * strain;
@@ -183,7 +183,8 @@ KirchhoffTrial<T> trial_strain(const Eigen::Matrix<T, 2, 2>& f, const MaterialSt
 
 }  // namespace
 
-StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialState& start, double dt) const {
+StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialState& start, double dt,
+                                     bool with_tangent) const {
   StressResponse out;
   out.state = start;
   const Eigen::Matrix2d f = Eigen::Matrix2d::Identity() + h;
@@ -248,8 +249,47 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   }
   if (!std::isfinite(slope) || slope == 0.0) slope = -2.0 * mu_;  // elastic, or hardening slope unbounded
 
-  // Stress and tangent: the same formulas in dual numbers with F's four entries as variables; Δγ
-  // enters as Δγ − r/r′ so that its derivative is −(∂r/∂F)/r′ (implicit-function theorem).
+  if (with_tangent) {
+    stress_and_tangent(f, start, dgamma, yield_end.stress, slope, out);
+  } else {
+    // The same stress in doubles: τ = 2μ dev ε (1 − 2μΔγ/q) + κ tr ε I, P = τ F⁻ᵀ.
+    const double scale = dgamma > 0.0 ? 1.0 - 2.0 * mu_ * dgamma / q_trial : 1.0;
+    const double pressure = kappa_ * trial.volumetric;
+    Eigen::Matrix2d tau;
+    tau << 2.0 * mu_ * trial.dev.xx * scale + pressure, 2.0 * mu_ * trial.dev.xy * scale,
+        2.0 * mu_ * trial.dev.xy * scale, 2.0 * mu_ * trial.dev.yy * scale + pressure;
+    out.stress = tau * f.inverse().transpose();
+  }
+
+  if (dgamma == 0.0) {
+    // Elastic: Cp⁻¹ and ε̄p stay as they were (the formulas below would return them up to round-off).
+    out.state.plastic_strain_rate = 0.0;
+    out.state.yield_stress = yield_start;
+    return out;
+  }
+  // New state: εe = dev εtrial (1 − 2μΔγ/q) + tr/3 I; be = exp(2εe); Cp⁻¹ = F⁻¹ be F⁻ᵀ.
+  const double keep = 1.0 - 2.0 * mu_ * dgamma / q_trial;
+  const double third = trial.volumetric / 3.0;
+  const Sym2<double> be = sym_exp(Sym2<double>{2.0 * (trial.dev.xx * keep + third), 2.0 * trial.dev.xy * keep,
+                                               2.0 * (trial.dev.yy * keep + third)});
+  Eigen::Matrix2d be_matrix;
+  be_matrix << be.xx, be.xy, be.xy, be.yy;
+  const Eigen::Matrix2d f_inv = f.inverse();
+  const Eigen::Matrix2d cp_inv = f_inv * be_matrix * f_inv.transpose();
+  out.state.plastic_metric_inverse = {cp_inv(0, 0), 0.5 * (cp_inv(0, 1) + cp_inv(1, 0)), cp_inv(1, 1),
+                                      std::exp(2.0 * (trial.dev_zz * keep + third))};
+  const double d_eps = kSqrtTwoThirds * dgamma;
+  out.state.equivalent_plastic_strain = eps_n + d_eps;
+  out.state.plastic_strain_rate = d_eps / dt;
+  out.state.yield_stress = yield_end.stress;
+  out.state.temperature = theta + p_.heat_fraction * yield_end.stress * d_eps / (p_.density * p_.specific_heat);
+  return out;
+}
+
+void J2JohnsonCook::stress_and_tangent(const Eigen::Matrix2d& f, const MaterialState& start, double dgamma,
+                                       double yield_stress, double slope, StressResponse& out) const {
+  // The update's stress formulas in dual numbers with F's four entries as variables; Δγ enters as
+  // Δγ − r/r′ so that its derivative is −(∂r/∂F)/r′ (implicit-function theorem).
   using D = Dual<4>;
   Eigen::Matrix<D, 2, 2> fd;
   for (int i = 0; i < 2; ++i) {
@@ -259,7 +299,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
   const D q = 2.0 * mu_ * t.norm;
   D scale = D(1.0);
   if (dgamma > 0.0) {
-    const D r = q - 2.0 * mu_ * dgamma - kSqrtTwoThirds * yield_end.stress;
+    const D r = q - 2.0 * mu_ * dgamma - kSqrtTwoThirds * yield_stress;
     const D dg = dgamma - r / slope;
     scale = 1.0 - 2.0 * mu_ * dg / q;
   }
@@ -282,24 +322,6 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
       out.tangent.row(2 * i + j) = p(i, j).d.transpose();
     }
   }
-
-  // New state: εe = dev εtrial (1 − 2μΔγ/q) + tr/3 I; be = exp(2εe); Cp⁻¹ = F⁻¹ be F⁻ᵀ.
-  const double keep = dgamma > 0.0 ? 1.0 - 2.0 * mu_ * dgamma / q_trial : 1.0;
-  const double third = trial.volumetric / 3.0;
-  const Sym2<double> be = sym_exp(Sym2<double>{2.0 * (trial.dev.xx * keep + third), 2.0 * trial.dev.xy * keep,
-                                               2.0 * (trial.dev.yy * keep + third)});
-  Eigen::Matrix2d be_matrix;
-  be_matrix << be.xx, be.xy, be.xy, be.yy;
-  const Eigen::Matrix2d f_inv = f.inverse();
-  const Eigen::Matrix2d cp_inv = f_inv * be_matrix * f_inv.transpose();
-  out.state.plastic_metric_inverse = {cp_inv(0, 0), 0.5 * (cp_inv(0, 1) + cp_inv(1, 0)), cp_inv(1, 1),
-                                      std::exp(2.0 * (trial.dev_zz * keep + third))};
-  const double d_eps = kSqrtTwoThirds * dgamma;
-  out.state.equivalent_plastic_strain = eps_n + d_eps;
-  out.state.plastic_strain_rate = d_eps / dt;
-  out.state.yield_stress = yield_end.stress;
-  out.state.temperature = theta + p_.heat_fraction * yield_end.stress * d_eps / (p_.density * p_.specific_heat);
-  return out;
 }
 
 }  // namespace mufric::solid

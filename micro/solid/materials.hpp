@@ -23,7 +23,7 @@ struct MaterialState {
 
 struct StressResponse {
   Eigen::Matrix2d stress;   // S_ij
-  Eigen::Matrix4d tangent;  // ∂S_ij/∂H_kl at row 2i+j, column 2k+l
+  Eigen::Matrix4d tangent;  // ∂S_ij/∂H_kl at row 2i+j, column 2k+l (when requested)
   MaterialState state;      // at the end of the step
   bool ok = true;           // false: the update failed (reason says why); never NaN
   std::string reason;
@@ -32,9 +32,12 @@ struct StressResponse {
 class Material {
  public:
   virtual ~Material() = default;
-  // dt: the step's length (s), for rates; quasi-static runs pass their pseudo-time step.
-  virtual StressResponse update(const Eigen::Matrix2d& displacement_gradient, const MaterialState& start,
-                                double dt) const = 0;
+  // dt: the step's length (s), for rates; quasi-static runs pass their pseudo-time step. Without
+  // `with_tangent` the response's tangent is left unset (a residual evaluation needs only S). The
+  // tangent has major symmetry (∂S_ij/∂H_kl = ∂S_kl/∂H_ij: hyperelastic and associative models),
+  // which the assembly relies on.
+  virtual StressResponse update(const Eigen::Matrix2d& displacement_gradient, const MaterialState& start, double dt,
+                                bool with_tangent) const = 0;
   virtual double density() const = 0;  // kg/m³ (reference configuration)
   virtual bool finite_strain() const = 0;
 };
@@ -45,7 +48,7 @@ enum class PlaneKind { strain, stress };
 class LinearElastic final : public Material {
  public:
   LinearElastic(double youngs_modulus, double poisson_ratio, double density, PlaneKind kind = PlaneKind::strain);
-  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt) const override;
+  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt, bool with_tangent) const override;
   double density() const override { return density_; }
   bool finite_strain() const override { return false; }
   // Strain energy density ½ σ:ε (for energy checks).
@@ -89,7 +92,7 @@ double johnson_cook_yield_stress(const JohnsonCookParameters& p, double plastic_
 class J2JohnsonCook final : public Material {
  public:
   explicit J2JohnsonCook(JohnsonCookParameters parameters);
-  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt) const override;
+  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt, bool with_tangent) const override;
   double density() const override { return p_.density; }
   bool finite_strain() const override { return true; }
   const JohnsonCookParameters& parameters() const { return p_; }
@@ -97,6 +100,9 @@ class J2JohnsonCook final : public Material {
   double bulk_modulus() const { return kappa_; }
 
  private:
+  // P and ∂P/∂F at F for the return map's converged Δγ (its σy and residual slope dr/dΔγ).
+  void stress_and_tangent(const Eigen::Matrix2d& f, const MaterialState& start, double dgamma, double yield_stress,
+                          double slope, StressResponse& out) const;
   JohnsonCookParameters p_;
   double mu_, kappa_;
 };

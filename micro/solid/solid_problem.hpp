@@ -102,6 +102,12 @@ class SolidProblem {
 
  private:
   void build_pattern();
+  // One element's forces and tangent, added straight into `out` (elements of one colour share no
+  // dof, so a colour's elements may run in parallel). Nen: functions per element, fixed at compile
+  // time for the common degrees so that the small products vectorise.
+  template <int Nen>
+  void assemble_element(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent, Assembly& out,
+                        std::string& failure) const;
   IgaSpace space_;
   std::shared_ptr<const Material> material_;
   std::vector<MaterialState> states_;  // one per quadrature point, committed
@@ -111,9 +117,14 @@ class SolidProblem {
   std::vector<std::vector<BoundaryPoint>> load_points_;  // quadrature of each load's side, computed once
   std::vector<std::shared_ptr<const BoundaryInteraction>> interactions_;
   SparseMatrix pattern_;                       // structure of the tangent, values zero
+  // Per element, local dofs are numbered component-major: x of each of its nodes, then y.
   std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col)
   std::vector<std::vector<int>> element_dofs_;
   std::vector<int> element_first_point_;       // quadrature points of element e: [first[e], first[e+1])
+  int element_nodes_count_ = 0;                // functions per element (the same for every element)
+  std::vector<int> element_nodes_;             // element e's nodes at [e·count, (e+1)·count)
+  std::vector<double> point_gradients_;        // per quadrature point, ∂R/∂X as a 2 × count column-major block
+  std::vector<std::vector<int>> colours_;      // elements grouped so that no two in a group share a node
   mutable SparseMatrix mass_;
 };
 
