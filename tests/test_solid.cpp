@@ -147,6 +147,25 @@ TEST(JohnsonCook, RateTermNeverLowersTheYieldStressBelowItsReferenceValue) {
   EXPECT_DOUBLE_EQ(johnson_cook_yield_stress(jc, 0.1, 1.0, 1800.0), 0.0);
 }
 
+TEST(JohnsonCook, ResidualOnlyUpdateGivesTheSameStressAndState) {
+  const J2JohnsonCook material{JohnsonCookParameters()};
+  MaterialState start;
+  start.temperature = 773.15;
+  Eigen::Matrix2d elastic, plastic;
+  elastic << 4e-4, 1e-4, -2e-4, -3e-4;
+  plastic << 0.05, 0.08, -0.02, -0.04;
+  for (const Eigen::Matrix2d& h : {elastic, plastic, Eigen::Matrix2d(1.3 * plastic)}) {
+    const StressResponse full = material.update(h, start, 1e-9, true), bare = material.update(h, start, 1e-9, false);
+    ASSERT_TRUE(full.ok && bare.ok);
+    EXPECT_LT((full.stress - bare.stress).norm(), 1e-12 * full.stress.norm());
+    EXPECT_EQ(full.state.equivalent_plastic_strain, bare.state.equivalent_plastic_strain);
+    EXPECT_EQ(full.state.plastic_metric_inverse, bare.state.plastic_metric_inverse);
+    EXPECT_EQ(full.state.temperature, bare.state.temperature);
+    start = full.state;  // the next, larger stretch loads on from this one's history
+  }
+  EXPECT_GT(start.equivalent_plastic_strain, 0.0);
+}
+
 // ---- Consistent tangent: K w against central differences of f_int, elastic and plastic states.
 TEST(SolidTangent, ConsistentTangentMatchesFiniteDifferencesElasticAndPlastic) {
   const auto material = std::make_shared<J2JohnsonCook>(JohnsonCookParameters());
