@@ -49,7 +49,9 @@ struct Scene {
   double ramp = 2.5e-8;               // s, the vertical load rises linearly over this time
   // time
   solid::TimeScheme scheme = solid::TimeScheme::generalized_alpha;
-  double spectral_radius = 0.8;
+  // ρ∞ 0.5: damps the chip's thickness vibration that the pressure ramp excites, which with 0.8 still
+  // rang through the averaging window, and gave μ closest to the small-step runs (bench/RESULTS.md).
+  double spectral_radius = 0.5;
   double dt = 1e-9;                   // s, the first step
   double max_dt = 1e-9;               // s, the longest step the step-size control may take
   double duration = 2.5e-7;           // s (seed 000 Figs. 3–5)
