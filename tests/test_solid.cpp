@@ -155,7 +155,7 @@ TEST(JohnsonCook, ResidualOnlyUpdateGivesTheSameStressAndState) {
   elastic << 4e-4, 1e-4, -2e-4, -3e-4;
   plastic << 0.05, 0.08, -0.02, -0.04;
   for (const Eigen::Matrix2d& h : {elastic, plastic, Eigen::Matrix2d(1.3 * plastic)}) {
-    const StressResponse full = material.update(h, start, 1e-9, true), bare = material.update(h, start, 1e-9, false);
+    const StressResponse full = material.update(h, start, 1e-9, true, nullptr), bare = material.update(h, start, 1e-9, false, nullptr);
     ASSERT_TRUE(full.ok && bare.ok);
     EXPECT_LT((full.stress - bare.stress).norm(), 1e-12 * full.stress.norm());
     EXPECT_EQ(full.state.equivalent_plastic_strain, bare.state.equivalent_plastic_strain);

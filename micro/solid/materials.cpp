@@ -116,7 +116,8 @@ LinearElastic::LinearElastic(double youngs_modulus, double poisson_ratio, double
   if (kind == PlaneKind::stress) lambda_ = 2.0 * lambda_ * mu_ / (lambda_ + 2.0 * mu_);
 }
 
-StressResponse LinearElastic::update(const Eigen::Matrix2d& h, const MaterialState& start, double, bool) const {
+StressResponse LinearElastic::update(const Eigen::Matrix2d& h, const MaterialState& start, double, bool,
+                                     const MaterialState*) const {
   StressResponse r;
   const Eigen::Matrix2d strain = 0.5 * (h + h.transpose());
   r.stress = lambda_ * strain.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * strain;
@@ -184,7 +185,7 @@ KirchhoffTrial<T> trial_strain(const Eigen::Matrix<T, 2, 2>& f, const MaterialSt
 }  // namespace
 
 StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialState& start, double dt,
-                                     bool with_tangent) const {
+                                     bool with_tangent, const MaterialState* iterate) const {
   StressResponse out;
   out.state = start;
   const Eigen::Matrix2d f = Eigen::Matrix2d::Identity() + h;
@@ -218,8 +219,11 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
     // is a closer start (5.2 instead of 6.2 iterations, default scene); from a start left of the
     // root, concavity costs one overshoot to the right, then the same monotone descent.
     const double perfectly_plastic = std::clamp((q_trial - kSqrtTwoThirds * yield_start) / (2.0 * mu_), 0.01 * hi, 0.99 * hi);
-    const double at_last_rate = start.plastic_strain_rate * dt / kSqrtTwoThirds;
-    dgamma = at_last_rate > 0.0 ? std::min(at_last_rate, perfectly_plastic) : perfectly_plastic;
+    // Within a step's Newton iteration, the Δγ of the previous iterate is closer still.
+    const double guess_rate = iterate != nullptr && iterate->plastic_strain_rate > 0.0 ? iterate->plastic_strain_rate
+                                                                                       : start.plastic_strain_rate;
+    const double at_guess = guess_rate * dt / kSqrtTwoThirds;
+    dgamma = at_guess > 0.0 ? std::min(at_guess, perfectly_plastic) : perfectly_plastic;
     bool converged = false;
     for (int it = 0; it < kReturnMapMaxIterations; ++it) {
       const YieldWithSlope y = yield_along_return(p_, eps_n, dgamma, dt, thermal);

@@ -35,9 +35,10 @@ class Material {
   // dt: the step's length (s), for rates; quasi-static runs pass their pseudo-time step. Without
   // `with_tangent` the response's tangent is left unset (a residual evaluation needs only S). The
   // tangent has major symmetry (∂S_ij/∂H_kl = ∂S_kl/∂H_ij: hyperelastic and associative models),
-  // which the assembly relies on.
+  // which the assembly relies on. `iterate`, when not null, is the state this point reached at the
+  // previous Newton iterate of the same step: a first guess for the update's own iteration.
   virtual StressResponse update(const Eigen::Matrix2d& displacement_gradient, const MaterialState& start, double dt,
-                                bool with_tangent) const = 0;
+                                bool with_tangent, const MaterialState* iterate) const = 0;
   virtual double density() const = 0;  // kg/m³ (reference configuration)
   virtual bool finite_strain() const = 0;
 };
@@ -48,7 +49,8 @@ enum class PlaneKind { strain, stress };
 class LinearElastic final : public Material {
  public:
   LinearElastic(double youngs_modulus, double poisson_ratio, double density, PlaneKind kind = PlaneKind::strain);
-  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt, bool with_tangent) const override;
+  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt, bool with_tangent,
+                        const MaterialState* iterate) const override;
   double density() const override { return density_; }
   bool finite_strain() const override { return false; }
   // Strain energy density ½ σ:ε (for energy checks).
@@ -92,7 +94,8 @@ double johnson_cook_yield_stress(const JohnsonCookParameters& p, double plastic_
 class J2JohnsonCook final : public Material {
  public:
   explicit J2JohnsonCook(JohnsonCookParameters parameters);
-  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt, bool with_tangent) const override;
+  StressResponse update(const Eigen::Matrix2d& h, const MaterialState& start, double dt, bool with_tangent,
+                        const MaterialState* iterate) const override;
   double density() const override { return p_.density; }
   bool finite_strain() const override { return true; }
   const JohnsonCookParameters& parameters() const { return p_; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <tuple>
 
 #include "common/error.hpp"
 
@@ -41,11 +42,15 @@ void SolidProblem::build_pattern() {
   element_first_point_.push_back(static_cast<int>(qps.size()));
   element_nodes_count_ = qps.empty() ? 0 : static_cast<int>(qps.front().nodes.size());
   point_gradients_.resize(qps.size() * 2 * static_cast<size_t>(element_nodes_count_));
+  point_weights_.resize(qps.size());
   for (size_t k = 0; k < qps.size(); ++k) {
     if (static_cast<int>(qps[k].nodes.size()) != element_nodes_count_) {
       throw Error("solid problem: quadrature points with different numbers of basis functions");
     }
-    std::copy_n(qps[k].gradients.data(), 2 * element_nodes_count_, point_gradients_.begin() + static_cast<long>(k * 2 * element_nodes_count_));
+    // Row-major: the x-derivatives of all functions, then the y-derivatives.
+    const Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> rows = qps[k].gradients;
+    std::copy_n(rows.data(), 2 * element_nodes_count_, point_gradients_.begin() + static_cast<long>(k * 2 * element_nodes_count_));
+    point_weights_[k] = qps[k].weight;
   }
   std::vector<Eigen::Triplet<double>> triplets;
   const size_t elements = element_first_point_.size() - 1;
@@ -163,44 +168,78 @@ void SolidProblem::apply_dirichlet(double t, Eigen::VectorXd& u) const {
 
 template <int Nen>
 void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent,
-                                    Assembly& out, std::string& failure) const {
-  using Gradients = Eigen::Matrix<double, 2, Nen>;
+                                    const std::vector<MaterialState>* iterate, Assembly& out,
+                                    std::string& failure) const {
+  // Arrays indexed [node] (or [column · nen + row]) and written as plain loops over nodes: with the
+  // count fixed at compile time they vectorise, where Eigen's fixed 9-row products stayed scalar.
+  using Row = Eigen::Matrix<double, Nen, 1>;
   using Block = Eigen::Matrix<double, Nen, Nen>;
-  const int nen = element_nodes_count_;
+  const int nen = Nen == Eigen::Dynamic ? element_nodes_count_ : Nen;  // a compile-time trip count where possible
   const int* nodes = element_nodes_.data() + element * static_cast<size_t>(nen);
-  Gradients ue(2, nen);  // the element's nodal displacements, column a: node a
-  for (int a = 0; a < nen; ++a) ue.col(a) = u.segment<2>(2 * nodes[a]);
-  Gradients fe = Gradients::Zero(2, nen);  // f_int[a, i] at (i, a)
+  Row ux(nen), uy(nen);  // the element's nodal displacements
+  for (int a = 0; a < nen; ++a) {
+    ux(a) = u(2 * nodes[a]);
+    uy(a) = u(2 * nodes[a] + 1);
+  }
+  Row fx = Row::Zero(nen), fy = Row::Zero(nen);
   // The tangent in 2 × 2 blocks of nen × nen, block (i, k) = Σ w gᵀ A_ik g with A_ik(j, l) = ∂S_ij/∂H_kl
   // (δH_kl = δu_k ∂R/∂X_l). Block (y, x) is the transpose of (x, y): the material tangent has major
   // symmetry, so three blocks are computed.
   Block kxx, kxy, kyy;
   if (with_tangent) kxx = kxy = kyy = Block::Zero(nen, nen);
-  const auto& qps = space_.quadrature();
+  Row c0(nen), c1(nen);
+  // K_block(a, b) += g0(a) c0(b) + g1(a) c1(b), c = w A_ik g.
+  const auto rank_two_update = [&](Block& k, const double* g0, const double* g1) {
+    for (int b = 0; b < nen; ++b) {
+      double* column = k.data() + static_cast<Eigen::Index>(b) * nen;
+      const double p = c0(b), q = c1(b);
+      for (int a = 0; a < nen; ++a) column[a] += g0[a] * p + g1[a] * q;
+    }
+  };
   for (int k = element_first_point_[element]; k < element_first_point_[element + 1]; ++k) {
     const auto uk = static_cast<size_t>(k);
-    const Eigen::Map<const Gradients> g(point_gradients_.data() + uk * 2 * static_cast<size_t>(nen), 2, nen);
-    const Eigen::Matrix2d h = ue * g.transpose();
-    StressResponse r = material_->update(h, states_[uk], dt, with_tangent);
+    // Local copies of ∂R_a/∂X and ∂R_a/∂Y: the compiler then knows they alias nothing it writes.
+    const double* gradients = point_gradients_.data() + uk * 2 * static_cast<size_t>(nen);
+    Row g0_row(nen), g1_row(nen);
+    std::copy_n(gradients, nen, g0_row.data());
+    std::copy_n(gradients + nen, nen, g1_row.data());
+    const double* g0 = g0_row.data();
+    const double* g1 = g1_row.data();
+    Eigen::Matrix2d h = Eigen::Matrix2d::Zero();
+    for (int a = 0; a < nen; ++a) {
+      h(0, 0) += ux(a) * g0[a];
+      h(0, 1) += ux(a) * g1[a];
+      h(1, 0) += uy(a) * g0[a];
+      h(1, 1) += uy(a) * g1[a];
+    }
+    StressResponse r = material_->update(h, states_[uk], dt, with_tangent, iterate != nullptr ? &(*iterate)[uk] : nullptr);
     if (!r.ok) {
-      failure = r.reason + " at X = (" + std::to_string(qps[uk].position.x()) + ", " + std::to_string(qps[uk].position.y()) + ")";
+      const auto& q = space_.quadrature()[uk];
+      failure = r.reason + " at X = (" + std::to_string(q.position.x()) + ", " + std::to_string(q.position.y()) + ")";
       return;
     }
-    const double w = qps[uk].weight;
-    fe.noalias() += (w * r.stress) * g;  // f_int[a, i] += S_ij ∂R_a/∂X_j w
+    const double w = point_weights_[uk];
+    const Eigen::Matrix2d ws = w * r.stress;
+    for (int a = 0; a < nen; ++a) {  // f_int[a, i] += S_ij ∂R_a/∂X_j w
+      fx(a) += ws(0, 0) * g0[a] + ws(0, 1) * g1[a];
+      fy(a) += ws(1, 0) * g0[a] + ws(1, 1) * g1[a];
+    }
     out.states[uk] = std::move(r.state);
     out.stresses[uk] = r.stress;
     if (!with_tangent) continue;
-    const Gradients cxx = (w * r.tangent.block<2, 2>(0, 0)) * g;
-    const Gradients cxy = (w * r.tangent.block<2, 2>(0, 2)) * g;
-    const Gradients cyy = (w * r.tangent.block<2, 2>(2, 2)) * g;
-    // Rank-2 updates: lazy (coefficient-wise) products, which Eigen's size heuristics would otherwise
-    // send through its GEMM packing (9 × 2 × 9 counts as large; 14 % of a run went there).
-    kxx.noalias() += g.transpose().lazyProduct(cxx);
-    kxy.noalias() += g.transpose().lazyProduct(cxy);
-    kyy.noalias() += g.transpose().lazyProduct(cyy);
+    for (const auto& [block, row, col] : {std::tuple{&kxx, 0, 0}, std::tuple{&kxy, 0, 2}, std::tuple{&kyy, 2, 2}}) {
+      const Eigen::Matrix2d a_ik = w * r.tangent.block<2, 2>(row, col);
+      for (int b = 0; b < nen; ++b) {
+        c0(b) = a_ik(0, 0) * g0[b] + a_ik(0, 1) * g1[b];
+        c1(b) = a_ik(1, 0) * g0[b] + a_ik(1, 1) * g1[b];
+      }
+      rank_two_update(*block, g0, g1);
+    }
   }
-  for (int a = 0; a < nen; ++a) out.internal.segment<2>(2 * nodes[a]) += fe.col(a);
+  for (int a = 0; a < nen; ++a) {
+    out.internal(2 * nodes[a]) += fx(a);
+    out.internal(2 * nodes[a] + 1) += fy(a);
+  }
   if (!with_tangent) return;
   double* values = out.tangent.valuePtr();
   const int* slots = element_slots_[element].data();
@@ -215,7 +254,9 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
   }
 }
 
-SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double dt, bool with_tangent) const {
+SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double dt, bool with_tangent,
+                                              const std::vector<MaterialState>* iterate) const {
+  if (iterate != nullptr && iterate->size() != states_.size()) iterate = nullptr;  // not this problem's
   Assembly out;
   out.internal = Eigen::VectorXd::Zero(dof_count());
   out.states.resize(states_.size());
@@ -225,10 +266,10 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
   std::vector<std::string> failure(elements);
   const auto kernel = [&](size_t e) {
     switch (element_nodes_count_) {
-      case 4: return assemble_element<4>(e, u, dt, with_tangent, out, failure[e]);
-      case 9: return assemble_element<9>(e, u, dt, with_tangent, out, failure[e]);
-      case 16: return assemble_element<16>(e, u, dt, with_tangent, out, failure[e]);
-      default: return assemble_element<Eigen::Dynamic>(e, u, dt, with_tangent, out, failure[e]);
+      case 4: return assemble_element<4>(e, u, dt, with_tangent, iterate, out, failure[e]);
+      case 9: return assemble_element<9>(e, u, dt, with_tangent, iterate, out, failure[e]);
+      case 16: return assemble_element<16>(e, u, dt, with_tangent, iterate, out, failure[e]);
+      default: return assemble_element<Eigen::Dynamic>(e, u, dt, with_tangent, iterate, out, failure[e]);
     }
   };
   for (const auto& colour : colours_) {

@@ -91,7 +91,10 @@ class SolidProblem {
     double seconds_interactions = 0.0;  // of which contact and other boundary interactions
   };
   // Internal forces at u from the committed states (step length dt for rates); never commits.
-  Assembly assemble(const Eigen::VectorXd& u, double dt, bool with_tangent) const;
+  // `iterate`: the states of the previous Newton iterate of the same step, as first guesses for the
+  // material updates (null: none).
+  Assembly assemble(const Eigen::VectorXd& u, double dt, bool with_tangent,
+                    const std::vector<MaterialState>* iterate = nullptr) const;
   Eigen::VectorXd external(double t) const;
   const SparseMatrix& mass() const;  // consistent, ∫ρ R_a R_b dX, built on first use
 
@@ -106,8 +109,8 @@ class SolidProblem {
   // dof, so a colour's elements may run in parallel). Nen: functions per element, fixed at compile
   // time for the common degrees so that the small products vectorise.
   template <int Nen>
-  void assemble_element(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent, Assembly& out,
-                        std::string& failure) const;
+  void assemble_element(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent,
+                        const std::vector<MaterialState>* iterate, Assembly& out, std::string& failure) const;
   IgaSpace space_;
   std::shared_ptr<const Material> material_;
   std::vector<MaterialState> states_;  // one per quadrature point, committed
@@ -123,7 +126,8 @@ class SolidProblem {
   std::vector<int> element_first_point_;       // quadrature points of element e: [first[e], first[e+1])
   int element_nodes_count_ = 0;                // functions per element (the same for every element)
   std::vector<int> element_nodes_;             // element e's nodes at [e·count, (e+1)·count)
-  std::vector<double> point_gradients_;        // per quadrature point, ∂R/∂X as a 2 × count column-major block
+  std::vector<double> point_gradients_;        // per quadrature point, ∂R/∂X as a 2 × count row-major block
+  std::vector<double> point_weights_;          // per quadrature point, weight × |det J|
   std::vector<std::vector<int>> colours_;      // elements grouped so that no two in a group share a node
   mutable SparseMatrix mass_;
 };

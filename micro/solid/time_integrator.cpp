@@ -102,10 +102,13 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     Eigen::VectorXd residual, a1;
     double norm = 0.0, scale = 0.0;
   };
+  // The material states of the last evaluation in this step: first guesses for the next one's
+  // return maps (a Johnson-Cook update then needs fewer of its own Newton iterations).
+  const std::vector<MaterialState>* last_states = nullptr;
   auto evaluate = [&](const Eigen::VectorXd& u, bool with_tangent) {
     Evaluation e;
     const auto start = std::chrono::steady_clock::now();
-    e.assembly = problem_.assemble(u, dt, with_tangent);
+    e.assembly = problem_.assemble(u, dt, with_tangent, last_states);
     report_.seconds_assembly += seconds_since(start);
     report_.seconds_contact += e.assembly.seconds_interactions;
     ++report_.assemblies;
@@ -124,6 +127,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   };
 
   Evaluation current = evaluate(u1, true);
+  last_states = &current.assembly.states;  // `current` is reassigned in place: the pointer stays valid
   double force_scale = 0.0;
   bool factorized = false, last_full_step = false;
   double previous_norm = 0.0;
