@@ -261,7 +261,7 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
   out.internal = Eigen::VectorXd::Zero(dof_count());
   out.states.resize(states_.size());
   out.stresses.resize(states_.size());
-  if (with_tangent) out.tangent = pattern_;
+  if (with_tangent) out.tangent = MovableSparseMatrix(pattern_);
   const size_t elements = element_first_point_.size() - 1;
   std::vector<std::string> failure(elements);
   const auto kernel = [&](size_t e) {

@@ -161,7 +161,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     const bool reuse = options_.linear_solver == LinearSolverKind::lu && factorized && last_full_step &&
                        current.norm < kReuseFactorizationBelow * previous_norm;
     if (!reuse) {
-      SparseMatrix k = std::move(current.assembly.tangent);
+      MovableSparseMatrix k = std::move(current.assembly.tangent);
       if (stiffness_factor != 1.0) k *= stiffness_factor;
       if (dynamic) {
         // Same pattern as the tangent: add value arrays.
