@@ -130,7 +130,7 @@ std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& 
                std::to_string(x[q].y()) + "): " + p.reason;
       break;
     }
-    const spline::Points2 d = tool_.surface.derivatives(p.u, 2);
+    const spline::CurveDerivatives d = tool_.surface.derivatives(p.u, 2);
     const Eigen::Vector2d t = d.row(1).transpose(), c2 = d.row(2).transpose();
     const double speed2 = t.squaredNorm();
     PointGap& g = out[q];

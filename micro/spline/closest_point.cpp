@@ -27,7 +27,7 @@ struct Stationarity {
 };
 
 Stationarity stationarity(const SplineCurve& curve, const Eigen::Vector2d& x, double u) {
-  const Points2 d = curve.derivatives(u, 2);
+  const CurveDerivatives d = curve.derivatives(u, 2);
   const Eigen::Vector2d r = d.row(0).transpose() - x;
   const Eigen::Vector2d c1 = d.row(1).transpose(), c2 = d.row(2).transpose();
   return {c1.dot(r), c2.dot(r) + c1.squaredNorm(), r.squaredNorm(), c1.norm()};

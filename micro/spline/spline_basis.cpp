@@ -144,10 +144,11 @@ int SplineBasis::function_period(int span, int j) const {
   return periodic_ ? floor_div(span - degree_ + j, count()) : 0;
 }
 
-Eigen::MatrixXd SplineBasis::derivatives(int span, double u, int n) const {
+BasisDerivatives SplineBasis::derivatives(int span, double u, int n) const {
+  if (n < 0 || n > kMaxDegree) throw Error("spline basis: derivative order " + std::to_string(n) + " outside [0, " + std::to_string(kMaxDegree) + "]");
   const int p = degree_;
   const int k = span;
-  Eigen::MatrixXd ders = Eigen::MatrixXd::Zero(n + 1, p + 1);
+  BasisDerivatives ders = BasisDerivatives::Zero(n + 1, p + 1);
   // Fixed-capacity work arrays: no heap allocation per evaluation (assembly calls this per point).
   using Work = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDegree + 1, kMaxDegree + 1>;
   using WorkVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDegree + 1, 1>;

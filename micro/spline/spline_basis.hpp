@@ -17,6 +17,9 @@ namespace mufric::spline {
 inline constexpr double kRelativeKnotTolerance = 1e-12;
 // Highest degree supported (work arrays are sized for it); IGA uses 2–4.
 inline constexpr int kMaxDegree = 10;
+// Basis-function derivatives at a point, rows r = 0..n (n ≤ kMaxDegree), columns j = 0..p: fixed
+// capacity, so an evaluation allocates nothing (contact searches evaluate curves millions of times).
+using BasisDerivatives = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDegree + 1, kMaxDegree + 1>;
 
 class SplineBasis {
  public:
@@ -54,8 +57,8 @@ class SplineBasis {
   // k − p + j for j = 0..p.
   int function_index(int span, int j) const;
   int function_period(int span, int j) const;
-  // d^r N_{k−p+j}/du^r for r = 0..n, j = 0..p, at u in span k (A2.3); rows r, columns j.
-  Eigen::MatrixXd derivatives(int span, double u, int n) const;
+  // d^r N_{k−p+j}/du^r for r = 0..n, j = 0..p, at u in span k (A2.3); rows r, columns j. n ≤ kMaxDegree.
+  BasisDerivatives derivatives(int span, double u, int n) const;
   // The p + 1 non-zero values (A2.2).
   Eigen::VectorXd values(int span, double u) const;
 

@@ -34,10 +34,11 @@ Eigen::Vector2d SplineCurve::extended_point(int index, int period) const {
   return points_.row(index).transpose() + period * shift_;
 }
 
-Eigen::Matrix<double, Eigen::Dynamic, 3> SplineCurve::homogeneous_derivatives(double u, int n) const {
+Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3> SplineCurve::homogeneous_derivatives(double u, int n) const {
+  using Homogeneous = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3>;
   const auto at = basis_.locate(u);
-  const Eigen::MatrixXd ders = basis_.derivatives(at.span, at.u, n);
-  Eigen::Matrix<double, Eigen::Dynamic, 3> h = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(n + 1, 3);
+  const BasisDerivatives ders = basis_.derivatives(at.span, at.u, n);
+  Homogeneous h = Homogeneous::Zero(n + 1, 3);
   for (int j = 0; j <= basis_.degree(); ++j) {
     const int i = basis_.function_index(at.span, j);
     const double weight = extended_weight(i);
@@ -48,10 +49,10 @@ Eigen::Matrix<double, Eigen::Dynamic, 3> SplineCurve::homogeneous_derivatives(do
   return h;
 }
 
-Points2 SplineCurve::derivatives(double u, int n) const {
+CurveDerivatives SplineCurve::derivatives(double u, int n) const {
   const auto h = homogeneous_derivatives(u, n);
   // A4.2: C^(k) = (A^(k) − Σ_{i=1..k} C(k,i) w^(i) C^(k−i)) / w.
-  Points2 c(n + 1, 2);
+  CurveDerivatives c(n + 1, 2);
   for (int k = 0; k <= n; ++k) {
     Eigen::RowVector2d v = h.row(k).head<2>();
     for (int i = 1; i <= k; ++i) v -= binomial(k, i) * h(i, 2) * c.row(k - i);

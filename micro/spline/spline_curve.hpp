@@ -11,6 +11,8 @@
 namespace mufric::spline {
 
 using Points2 = Eigen::Matrix<double, Eigen::Dynamic, 2>;
+// A curve's derivatives at a point, rows r = 0..n: fixed capacity (no allocation per evaluation).
+using CurveDerivatives = Eigen::Matrix<double, Eigen::Dynamic, 2, 0, kMaxDegree + 1, 2>;
 
 class SplineCurve {
  public:
@@ -28,7 +30,7 @@ class SplineCurve {
 
   Eigen::Vector2d point(double u) const;
   // Rows r = 0..n: d^r C/du^r at u (A3.2; for NURBS A4.2). Periodic curves accept any u.
-  Points2 derivatives(double u, int n) const;
+  CurveDerivatives derivatives(double u, int n) const;
 
   // Control point of extended index i of a periodic curve (the point of i mod n moved by the shift
   // times its period); for open curves simply point i.
@@ -50,7 +52,7 @@ class SplineCurve {
  private:
   // Rows r = 0..n: d^r/du^r of the homogeneous curve (w·C, w) at u (A3.2 applied to the weighted
   // control points; A4.2 turns it into the curve's derivatives).
-  Eigen::Matrix<double, Eigen::Dynamic, 3> homogeneous_derivatives(double u, int n) const;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3> homogeneous_derivatives(double u, int n) const;
 
   SplineBasis basis_;
   Points2 points_;

@@ -24,7 +24,7 @@ SplineSurface::SplineSurface(SplineBasis u_basis, SplineBasis v_basis, Points2 p
 
 RationalBasis SplineSurface::basis_at(double u, double v) const {
   const auto au = u_.locate(u), av = v_.locate(v);
-  const Eigen::MatrixXd nu = u_.derivatives(au.span, au.u, 1), nv = v_.derivatives(av.span, av.u, 1);
+  const BasisDerivatives nu = u_.derivatives(au.span, au.u, 1), nv = v_.derivatives(av.span, av.u, 1);
   const int p = u_.degree(), q = v_.degree(), count = (p + 1) * (q + 1);
   RationalBasis b;
   b.nodes.resize(static_cast<size_t>(count));
