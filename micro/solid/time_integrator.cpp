@@ -200,7 +200,14 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
                            trial.norm <= 1e3 * tolerance;
     // `trial` was evaluated at the new u1; it lacks a tangent only after a line-search reduction.
     last_full_step = s == 1.0;
-    current = stagnated || last_full_step ? std::move(trial) : evaluate(u1, true);
+    if (stagnated || last_full_step) {
+      current = std::move(trial);
+    } else {
+      // The accepted point again, with its tangent: the trial's own states are exact first guesses.
+      last_states = &trial.assembly.states;
+      current = evaluate(u1, true);
+      last_states = &current.assembly.states;
+    }
     if (stagnated && current.assembly.ok) {
       at.record.newton_iterations = it + 1;
       at.record.residual = current.norm;
