@@ -181,8 +181,10 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     // Line search on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction.
     const double phi0 = current.norm * current.norm;
     double s = 1.0;
-    // The full step is usually accepted: evaluating it with its tangent makes it the next
-    // iteration's linearisation, one material update per iteration instead of two.
+    // Trials are evaluated with their tangent: the accepted one is the next iteration's
+    // linearisation. Most trials are accepted (the full step usually, and the last of a line search
+    // always); evaluating line-search trials without a tangent and the accepted point again with one
+    // cost more (128 x 24 default scene: 199 reduced trials, 155 of them accepted).
     Evaluation trial = evaluate(u1 + delta, true);
     if (options_.line_search) {
       for (int r = 0; r < kLineSearchMaxReductions; ++r) {
@@ -190,7 +192,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
         if (phi1 <= (1.0 - 2.0 * kLineSearchSufficientDecrease * s) * phi0) break;
         const double minimiser = std::isfinite(phi1) ? phi0 * s * s / (phi1 - phi0 + 2.0 * phi0 * s) : 0.1 * s;
         s = std::clamp(minimiser, 0.1 * s, 0.5 * s);
-        trial = evaluate(u1 + s * delta, false);
+        trial = evaluate(u1 + s * delta, true);
         ++at.record.line_search_reductions;
       }
     }
@@ -198,16 +200,8 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     u1 += s * delta;
     const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
                            trial.norm <= 1e3 * tolerance;
-    // `trial` was evaluated at the new u1; it lacks a tangent only after a line-search reduction.
     last_full_step = s == 1.0;
-    if (stagnated || last_full_step) {
-      current = std::move(trial);
-    } else {
-      // The accepted point again, with its tangent: the trial's own states are exact first guesses.
-      last_states = &trial.assembly.states;
-      current = evaluate(u1, true);
-      last_states = &current.assembly.states;
-    }
+    current = std::move(trial);  // evaluated at the new u1, with its tangent
     if (stagnated && current.assembly.ok) {
       at.record.newton_iterations = it + 1;
       at.record.residual = current.norm;
