@@ -110,6 +110,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
                       {"wall_seconds", wall_seconds},
                       {"assemblies", solver.assemblies},
                       {"line_search_reductions", solver.line_search_reductions},
+                      {"unpredicted_convergence", solver.unpredicted_convergence},
                       {"lu_fallbacks", solver.lu_fallbacks},
                       {"assembly_seconds", solver.seconds_assembly},
                       {"contact_seconds", solver.seconds_contact},

@@ -37,6 +37,9 @@ inline constexpr double kReuseFactorizationBelow = 0.05;
 inline constexpr int kTargetNewtonIterations = 8;
 inline constexpr double kMaxStepGrowth = 2.0, kMaxStepShrink = 0.5;
 inline constexpr double kShortestControlledStep = 0.25;
+// A Newton trial whose quadratic-convergence prediction is below this fraction of the tolerance is
+// evaluated without its tangent (it is expected to end the step).
+inline constexpr double kPredictedConvergenceMargin = 0.1;
 
 struct TimeIntegrationOptions {
   TimeScheme scheme = TimeScheme::generalized_alpha;
@@ -72,6 +75,7 @@ struct IntegrationReport {
   int lu_fallbacks = 0;       // Cholesky runs: tangents CHOLMOD found not positive definite (solved by LU)
   int assemblies = 0;              // residual evaluations (with or without tangent)
   int line_search_reductions = 0;
+  int unpredicted_convergence = 0;  // trials expected to converge that did not (evaluated twice)
   double seconds_assembly = 0.0, seconds_solve = 0.0;
   double seconds_contact = 0.0;    // part of seconds_assembly spent in boundary interactions
 };
