@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     // The tangent at the loaded state, constrained as the integrator does.
-    auto tangent = problem.assemble(integrator.u(), options.dt, true).tangent;
+    solid::SparseMatrix tangent = problem.assemble(integrator.u(), options.dt, true).tangent.selfadjointView<Eigen::Lower>();
     problem.constrain(tangent);
     const Eigen::VectorXd rhs = Eigen::VectorXd::Ones(tangent.rows());
     const int repeats = level < 3 ? 5 : 2;

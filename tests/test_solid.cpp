@@ -346,8 +346,8 @@ TEST(GeneralizedAlpha, VibratingBarFollowsTheAmplificationMatrixAndKeepsItsPerio
     problem.fix_side(Side::left, 0);
     for (int node = 0; node < problem.space().node_count(); ++node) problem.add_dirichlet({node, 1, 0.0, {}});
     // Lowest discrete mode from the free-dof generalized eigenproblem K φ = ω² M φ.
-    const auto k_full = Eigen::MatrixXd(problem.assemble(Eigen::VectorXd::Zero(problem.dof_count()), 1.0, true).tangent);
-    const auto m_full = Eigen::MatrixXd(problem.mass());
+    const auto k_full = Eigen::MatrixXd(SparseMatrix(problem.assemble(Eigen::VectorXd::Zero(problem.dof_count()), 1.0, true).tangent.selfadjointView<Eigen::Lower>()));
+    const auto m_full = Eigen::MatrixXd(SparseMatrix(problem.mass().selfadjointView<Eigen::Lower>()));
     std::vector<int> free;
     for (int i = 0; i < problem.dof_count(); ++i) {
       if (!problem.constrained()[static_cast<size_t>(i)]) free.push_back(i);
@@ -379,16 +379,16 @@ TEST(GeneralizedAlpha, VibratingBarFollowsTheAmplificationMatrixAndKeepsItsPerio
     integrator.set_initial(amplitude * phi, Eigen::VectorXd::Zero(problem.dof_count()));
     const Eigen::Matrix3d amp = amplification(omega, options.dt, rho_inf);
     Eigen::Vector3d sdof(amplitude, 0.0, -omega * omega * amplitude);
-    const double mphi = phi.dot(problem.mass() * phi);
+    const double mphi = phi.dot(problem.mass().selfadjointView<Eigen::Lower>() * phi);
     const auto energy = [&](const Eigen::VectorXd& u, const Eigen::VectorXd& v) {
-      return 0.5 * v.dot(problem.mass() * v) + problem.elastic_energy(u);
+      return 0.5 * v.dot(problem.mass().selfadjointView<Eigen::Lower>() * v) + problem.elastic_energy(u);
     };
     const double e0 = energy(amplitude * phi, Eigen::VectorXd::Zero(problem.dof_count()));
     double worst = 0.0, previous_q = amplitude, first_crossing = -1.0, last_crossing = -1.0, last_energy = e0;
     int crossings = 0;
     const IntegrationReport report = integrator.run([&](const StepView& s) {
       sdof = amp * sdof;
-      const double q = phi.dot(problem.mass() * s.u) / mphi;
+      const double q = phi.dot(problem.mass().selfadjointView<Eigen::Lower>() * s.u) / mphi;
       worst = std::max(worst, std::abs(q - sdof(0)));
       if (previous_q > 0.0 && q <= 0.0) {  // downward zero crossing, interpolated
         const double t = s.time - options.dt * q / (q - previous_q);

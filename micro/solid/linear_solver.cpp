@@ -38,6 +38,7 @@ struct LinearSolver::Impl {
   Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>> lu;
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>> cholesky;
   std::vector<int> outer, inner;  // pattern of the last analysis
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> full;  // LU of a lower-stored matrix: both triangles
 };
 
 LinearSolver::LinearSolver(LinearSolverKind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {
@@ -64,7 +65,7 @@ LinearSolver::~LinearSolver() = default;
 LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
 LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
 
-bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a) {
+bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage) {
   const bool same_pattern =
       analyses_ > 0 && static_cast<Eigen::Index>(impl_->outer.size()) == a.outerSize() + 1 &&
       static_cast<Eigen::Index>(impl_->inner.size()) == a.nonZeros() &&
@@ -77,7 +78,7 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
     ++analyses_;
   }
   reason_.clear();
-  if (kind_ == LinearSolverKind::lu) return factorize_lu(a);
+  if (kind_ == LinearSolverKind::lu) return factorize_lu(a, storage);
   const CholmodThreadsWithinOurs threads;
   if (!cholesky_analysed_) {
     impl_->cholesky.analyzePattern(a);
@@ -89,17 +90,19 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
     return true;
   }
   ++lu_fallbacks_;
-  if (factorize_lu(a)) return true;
+  if (factorize_lu(a, storage)) return true;
   reason_ = "CHOLMOD: the tangent is not positive definite, and " + reason_;
   return false;
 }
 
-bool LinearSolver::factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a) {
+bool LinearSolver::factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage) {
+  if (storage == MatrixStorage::lower_symmetric) impl_->full = a.selfadjointView<Eigen::Lower>();
+  const auto& m = storage == MatrixStorage::lower_symmetric ? impl_->full : a;
   if (!lu_analysed_) {
-    impl_->lu.analyzePattern(a);
+    impl_->lu.analyzePattern(m);
     lu_analysed_ = true;
   }
-  impl_->lu.factorize(a);
+  impl_->lu.factorize(m);
   if (impl_->lu.info() != Eigen::Success) {
     reason_ = "UMFPACK: the tangent is singular";
     return false;

@@ -12,6 +12,9 @@
 namespace mufric::solid {
 
 enum class LinearSolverKind { lu, cholesky };
+// How a matrix given to the solver is stored: every entry, or the lower triangle of a symmetric
+// matrix (SolidProblem's tangents and mass matrices).
+enum class MatrixStorage { full, lower_symmetric };
 
 class LinearSolver {
  public:
@@ -21,7 +24,7 @@ class LinearSolver {
   LinearSolver& operator=(LinearSolver&&) noexcept;
   // Factorises A (re-analysing only when its pattern differs from the last one). false: singular
   // or not positive definite; `reason()` says which.
-  bool factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
+  bool factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage = MatrixStorage::full);
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   const std::string& reason() const { return reason_; }
   int analyses() const { return analyses_; }  // symbolic analyses done so far
@@ -36,7 +39,7 @@ class LinearSolver {
   int lu_fallbacks_ = 0;
   bool last_by_lu_ = false;  // which factorisation `solve` uses
   bool lu_analysed_ = false, cholesky_analysed_ = false;  // for the current pattern
-  bool factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
+  bool factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage);
 };
 
 }  // namespace mufric::solid

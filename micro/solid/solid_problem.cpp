@@ -16,6 +16,7 @@ SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> mater
 }
 
 void TangentAccumulator::add(int row, int col, double value) {
+  if (row < col) return;  // the lower triangle is stored
   const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
   const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
   const int* at = std::lower_bound(begin, end, row);
@@ -63,7 +64,9 @@ void SolidProblem::build_pattern() {
       for (const int n : nodes) dofs.push_back(2 * n + i);
     }
     for (const int r : dofs) {
-      for (const int c : dofs) triplets.emplace_back(r, c, 0.0);
+      for (const int c : dofs) {
+        if (r >= c) triplets.emplace_back(r, c, 0.0);
+      }
     }
   }
   for (const auto& interaction : interactions_) {
@@ -71,7 +74,9 @@ void SolidProblem::build_pattern() {
       for (const int a : group) {
         for (const int b : group) {
           for (int i = 0; i < 2; ++i) {
-            for (int k = 0; k < 2; ++k) triplets.emplace_back(2 * a + i, 2 * b + k, 0.0);
+            for (int k = 0; k < 2; ++k) {
+              if (2 * a + i >= 2 * b + k) triplets.emplace_back(2 * a + i, 2 * b + k, 0.0);
+            }
           }
         }
       }
@@ -91,8 +96,9 @@ void SolidProblem::build_pattern() {
       const int* rows_begin = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col];
       const int* rows_end = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col + 1];
       for (size_t r = 0; r < dofs.size(); ++r) {
-        slots[r + dofs.size() * c] = static_cast<int>(std::lower_bound(rows_begin, rows_end, dofs[r]) -
-                                                      pattern_.innerIndexPtr());
+        slots[r + dofs.size() * c] = dofs[r] < col ? -1
+                                                   : static_cast<int>(std::lower_bound(rows_begin, rows_end, dofs[r]) -
+                                                                      pattern_.innerIndexPtr());
       }
     }
   }
@@ -244,12 +250,16 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
   double* values = out.tangent.valuePtr();
   const int* slots = element_slots_[element].data();
   const int n = 2 * nen;
+  // Entries above the diagonal have slot −1: the lower triangle is stored.
+  const auto add = [values](int slot, double v) {
+    if (slot >= 0) values[slot] += v;
+  };
   for (int b = 0; b < nen; ++b) {
     for (int a = 0; a < nen; ++a) {
-      values[slots[a + n * b]] += kxx(a, b);
-      values[slots[(nen + a) + n * b]] += kxy(b, a);  // block (y, x) = (x, y)ᵀ
-      values[slots[a + n * (nen + b)]] += kxy(a, b);
-      values[slots[(nen + a) + n * (nen + b)]] += kyy(a, b);
+      add(slots[a + n * b], kxx(a, b));
+      add(slots[(nen + a) + n * b], kxy(b, a));  // block (y, x) = (x, y)ᵀ
+      add(slots[a + n * (nen + b)], kxy(a, b));
+      add(slots[(nen + a) + n * (nen + b)], kyy(a, b));
     }
   }
 }
@@ -327,7 +337,10 @@ const SparseMatrix& SolidProblem::mass() const {
       for (Eigen::Index b = 0; b < nen; ++b) {
         for (Eigen::Index a = 0; a < nen; ++a) {
           const double m = rho * q.values(a) * q.values(b) * q.weight;
-          for (int i = 0; i < 2; ++i) values[slots[static_cast<size_t>((i * nen + a) + n * (i * nen + b))]] += m;
+          for (int i = 0; i < 2; ++i) {
+            const int slot = slots[static_cast<size_t>((i * nen + a) + n * (i * nen + b))];
+            if (slot >= 0) values[slot] += m;
+          }
         }
       }
     }

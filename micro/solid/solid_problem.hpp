@@ -2,7 +2,10 @@
 // The chip as a boundary-value problem: one IGA patch, one material, Dirichlet conditions on
 // control-point displacement components and dead tractions on sides, each scaled by a function of
 // time. Assembles internal forces, the tangent (a fixed sparsity pattern, filled element by
-// element), external forces and the consistent mass matrix.
+// element), external forces and the consistent mass matrix. The tangent and the mass matrix are
+// symmetric and stored as their lower triangle (row ≥ column): products go through
+// selfadjointView<Eigen::Lower>(), and CHOLMOD reads that triangle anyway — storing only it halves
+// the scatter, the copies and CHOLMOD's transpose of every factorisation.
 #include <functional>
 #include <memory>
 #include <string>
@@ -62,7 +65,8 @@ class BoundaryInteraction {
                    std::string& reason) const = 0;
 };
 
-// Adds entries to a tangent whose pattern already holds them.
+// Adds entries to a tangent whose pattern already holds them. The tangent keeps its lower triangle:
+// an entry above the diagonal is dropped (symmetric interactions add its mirror image as well).
 class TangentAccumulator {
  public:
   explicit TangentAccumulator(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) : matrix_(matrix) {}
@@ -100,7 +104,7 @@ class SolidProblem {
 
   struct Assembly {
     Eigen::VectorXd internal;           // f_int(u)
-    MovableSparseMatrix tangent;        // ∂f_int/∂u (when requested)
+    MovableSparseMatrix tangent;        // ∂f_int/∂u (when requested), lower triangle
     std::vector<MaterialState> states;  // trial states at u
     std::vector<Eigen::Matrix2d> stresses;  // S at each quadrature point
     bool ok = true;
@@ -113,7 +117,7 @@ class SolidProblem {
   Assembly assemble(const Eigen::VectorXd& u, double dt, bool with_tangent,
                     const std::vector<MaterialState>* iterate = nullptr) const;
   Eigen::VectorXd external(double t) const;
-  const SparseMatrix& mass() const;  // consistent, ∫ρ R_a R_b dX, built on first use
+  const SparseMatrix& mass() const;  // consistent, ∫ρ R_a R_b dX, lower triangle, built on first use
 
   const std::vector<MaterialState>& states() const { return states_; }
   void commit(std::vector<MaterialState> states) { states_ = std::move(states); }
@@ -136,9 +140,9 @@ class SolidProblem {
   std::vector<SideLoad> loads_;
   std::vector<std::vector<BoundaryPoint>> load_points_;  // quadrature of each load's side, computed once
   std::vector<std::shared_ptr<const BoundaryInteraction>> interactions_;
-  SparseMatrix pattern_;                       // structure of the tangent, values zero
+  SparseMatrix pattern_;                       // structure of the tangent's lower triangle, values zero
   // Per element, local dofs are numbered component-major: x of each of its nodes, then y.
-  std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col)
+  std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col); −1 above the diagonal
   std::vector<std::vector<int>> element_dofs_;
   std::vector<int> element_first_point_;       // quadrature points of element e: [first[e], first[e+1])
   int element_nodes_count_ = 0;                // functions per element (the same for every element)

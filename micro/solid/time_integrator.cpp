@@ -71,7 +71,7 @@ void TimeIntegrator::set_initial(const Eigen::VectorXd& u, const Eigen::VectorXd
     Eigen::VectorXd rhs = problem_.external(0.0) - f_int_;
     problem_.zero_constrained(rhs);
     LinearSolver mass_solver(LinearSolverKind::cholesky);
-    if (!mass_solver.factorize(m)) throw Error("time integration: the mass matrix is singular");
+    if (!mass_solver.factorize(m, MatrixStorage::lower_symmetric)) throw Error("time integration: the mass matrix is singular");
     a_ = mass_solver.solve(rhs);
   }
 }
@@ -115,7 +115,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     if (!e.assembly.ok) return e;
     if (dynamic) {
       e.a1 = (u - u_ - dt * v_ - dt * dt * (0.5 - b) * a_) / (b * dt * dt);
-      const Eigen::VectorXd inertia = *mass * ((1.0 - am) * e.a1 + am * a_);
+      const Eigen::VectorXd inertia = mass->selfadjointView<Eigen::Lower>() * ((1.0 - am) * e.a1 + am * a_);
       e.residual = inertia + (1.0 - af) * e.assembly.internal + af * f_int_ - (1.0 - af) * f_ext1 - af * f_ext0;
       e.scale = std::max({e.assembly.internal.norm(), f_ext1.norm(), inertia.norm()});
     } else {
@@ -169,7 +169,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
             mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
       }
       problem_.constrain(k);
-      if (!solver_.factorize(k)) {
+      if (!solver_.factorize(k, MatrixStorage::lower_symmetric)) {
         at.reason = solver_.reason();
         return at;
       }
