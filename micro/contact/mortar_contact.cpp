@@ -201,14 +201,18 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
   }
   if (tangent == nullptr) return true;
   // ε A_a G_a G_aᵀ for every active node, G_a = ∂g_a/∂u = (1/A_a) Σ_q N_a(q) w_q (−R_b n_q).
+  std::vector<std::pair<int, Eigen::Vector2d>> gradient;
   for (size_t a = 0; a < surface_nodes_.size(); ++a) {
     if (p(static_cast<Eigen::Index>(a)) <= 0.0) continue;
-    std::unordered_map<int, Eigen::Vector2d> gradient;  // node → ∂g_a/∂u_node
+    // node → ∂g_a/∂u_node over the few (p + 2) nodes of the support: a linear search in a small
+    // vector instead of a hash map (which allocated per node and assembly).
+    gradient.clear();
     for (const auto& [q, local] : node_points_[a]) {
       const auto& sp = points_[static_cast<size_t>(q)];
       const double factor = sp.values(local) * sp.weight / node_area_[a];
       for (size_t b = 0; b < sp.nodes.size(); ++b) {
-        auto [it, inserted] = gradient.try_emplace(sp.nodes[b], Eigen::Vector2d::Zero());
+        auto it = std::find_if(gradient.begin(), gradient.end(), [&](const auto& e) { return e.first == sp.nodes[b]; });
+        if (it == gradient.end()) it = gradient.insert(gradient.end(), {sp.nodes[b], Eigen::Vector2d::Zero()});
         it->second -= factor * sp.values(static_cast<Eigen::Index>(b)) * g[static_cast<size_t>(q)].normal;
       }
     }

@@ -42,6 +42,12 @@ void SolidProblem::build_pattern() {
   }
   element_first_point_.push_back(static_cast<int>(qps.size()));
   element_nodes_count_ = qps.empty() ? 0 : static_cast<int>(qps.front().nodes.size());
+  for (size_t e = 0; e + 1 < element_first_point_.size(); ++e) {
+    // The element kernel keeps two rows per point in arrays sized for (p + 1)(q + 1) points.
+    if (element_first_point_[e + 1] - element_first_point_[e] > element_nodes_count_) {
+      throw Error("solid problem: an element has more quadrature points than basis functions");
+    }
+  }
   point_gradients_.resize(qps.size() * 2 * static_cast<size_t>(element_nodes_count_));
   point_weights_.resize(qps.size());
   for (size_t k = 0; k < qps.size(); ++k) {
@@ -191,26 +197,27 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
   // The tangent in 2 × 2 blocks of nen × nen, block (i, k) = Σ w gᵀ A_ik g with A_ik(j, l) = ∂S_ij/∂H_kl
   // (δH_kl = δu_k ∂R/∂X_l). Block (y, x) is the transpose of (x, y): the material tangent has major
   // symmetry, so three blocks are computed.
-  Block kxx, kxy, kyy;
-  if (with_tangent) kxx = kxy = kyy = Block::Zero(nen, nen);
-  Row c0(nen), c1(nen);
-  // K_block(a, b) += g0(a) c0(b) + g1(a) c1(b), c = w A_ik g.
-  const auto rank_two_update = [&](Block& k, const double* g0, const double* g1) {
-    for (int b = 0; b < nen; ++b) {
-      double* column = k.data() + static_cast<Eigen::Index>(b) * nen;
-      const double p = c0(b), q = c1(b);
-      for (int a = 0; a < nen; ++a) column[a] += g0[a] * p + g1[a] * q;
-    }
-  };
-  for (int k = element_first_point_[element]; k < element_first_point_[element + 1]; ++k) {
-    const auto uk = static_cast<size_t>(k);
-    // Local copies of ∂R_a/∂X and ∂R_a/∂Y: the compiler then knows they alias nothing it writes.
+  // Per quadrature point q, rows 2q and 2q + 1 hold ∂R/∂X and ∂R/∂Y (G) and, for each block, the rows of
+  // w A_ik g (C): block = Gᵀ C, summed over all points at once after the loop, so that each row of a
+  // block accumulates in registers instead of being read and written back once per point.
+  // G's and C's rows are padded with zeros to a multiple of 4 (9 → 12): whole AVX2 vectors, which
+  // Eigen's fixed-size expressions use (at width 9 the compiler kept 27 scalar accumulators).
+  constexpr int kMaxRows = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
+  constexpr int kPadded = Nen == Eigen::Dynamic ? Eigen::Dynamic : (Nen + 3) / 4 * 4;
+  using PaddedRows = Eigen::Matrix<double, Eigen::Dynamic, kPadded, Eigen::RowMajor, kMaxRows, kPadded>;
+  using PaddedRow = Eigen::Matrix<double, 1, kPadded>;
+  const int padded = kPadded == Eigen::Dynamic ? nen : kPadded;
+  const int first = element_first_point_[element], points = element_first_point_[element + 1] - first;
+  PaddedRows g_rows = PaddedRows::Zero(2 * points, padded);
+  PaddedRows cxx, cxy, cyy;
+  if (with_tangent) cxx = cxy = cyy = PaddedRows::Zero(2 * points, padded);
+  for (int q = 0; q < points; ++q) {
+    const auto uk = static_cast<size_t>(first + q);
     const double* gradients = point_gradients_.data() + uk * 2 * static_cast<size_t>(nen);
-    Row g0_row(nen), g1_row(nen);
-    std::copy_n(gradients, nen, g0_row.data());
-    std::copy_n(gradients + nen, nen, g1_row.data());
-    const double* g0 = g0_row.data();
-    const double* g1 = g1_row.data();
+    std::copy_n(gradients, nen, g_rows.row(2 * q).data());
+    std::copy_n(gradients + nen, nen, g_rows.row(2 * q + 1).data());
+    const double* g0 = g_rows.row(2 * q).data();
+    const double* g1 = g_rows.row(2 * q + 1).data();
     Eigen::Matrix2d h = Eigen::Matrix2d::Zero();
     for (int a = 0; a < nen; ++a) {
       h(0, 0) += ux(a) * g0[a];
@@ -220,8 +227,8 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
     }
     StressResponse r = material_->update(h, states_[uk], dt, with_tangent, iterate != nullptr ? &(*iterate)[uk] : nullptr);
     if (!r.ok) {
-      const auto& q = space_.quadrature()[uk];
-      failure = r.reason + " at X = (" + std::to_string(q.position.x()) + ", " + std::to_string(q.position.y()) + ")";
+      const auto& point = space_.quadrature()[uk];
+      failure = r.reason + " at X = (" + std::to_string(point.position.x()) + ", " + std::to_string(point.position.y()) + ")";
       return;
     }
     const double w = point_weights_[uk];
@@ -233,13 +240,28 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
     out.states[uk] = std::move(r.state);
     out.stresses[uk] = r.stress;
     if (!with_tangent) continue;
-    for (const auto& [block, row, col] : {std::tuple{&kxx, 0, 0}, std::tuple{&kxy, 0, 2}, std::tuple{&kyy, 2, 2}}) {
+    for (const auto& [c, row, col] : {std::tuple{&cxx, 0, 0}, std::tuple{&cxy, 0, 2}, std::tuple{&cyy, 2, 2}}) {
       const Eigen::Matrix2d a_ik = w * r.tangent.block<2, 2>(row, col);
-      for (int b = 0; b < nen; ++b) {
-        c0(b) = a_ik(0, 0) * g0[b] + a_ik(0, 1) * g1[b];
-        c1(b) = a_ik(1, 0) * g0[b] + a_ik(1, 1) * g1[b];
+      c->row(2 * q) = a_ik(0, 0) * g_rows.row(2 * q) + a_ik(0, 1) * g_rows.row(2 * q + 1);
+      c->row(2 * q + 1) = a_ik(1, 0) * g_rows.row(2 * q) + a_ik(1, 1) * g_rows.row(2 * q + 1);
+    }
+  }
+  Block kxx, kxy, kyy;
+  if (with_tangent) {
+    kxx.resize(nen, nen);
+    kxy.resize(nen, nen);
+    kyy.resize(nen, nen);
+    for (int a = 0; a < nen; ++a) {
+      PaddedRow xx = PaddedRow::Zero(padded), xy = PaddedRow::Zero(padded), yy = PaddedRow::Zero(padded);
+      for (int r = 0; r < 2 * points; ++r) {
+        const double g = g_rows(r, a);
+        xx.noalias() += g * cxx.row(r);
+        xy.noalias() += g * cxy.row(r);
+        yy.noalias() += g * cyy.row(r);
       }
-      rank_two_update(*block, g0, g1);
+      kxx.row(a) = xx.head(nen);
+      kxy.row(a) = xy.head(nen);
+      kyy.row(a) = yy.head(nen);
     }
   }
   for (int a = 0; a < nen; ++a) {
