@@ -321,6 +321,12 @@ TEST(ClosestPoint, AgreesWithBruteForceOnRoughProfilesOfEveryDegree) {
       window.window_lo = global.u - 0.07;
       window.window_hi = global.u + 0.05;
       EXPECT_NEAR(project(c, x, window).distance, global.distance, 1e-14);
+      // And so does a search seeded from a precomputed table of the curve's samples.
+      const ProjectionSeeds seeds(c);
+      window.seeds = &seeds;
+      const Projection seeded = project(c, x, window);
+      EXPECT_NEAR(seeded.distance, global.distance, 1e-14);
+      EXPECT_NEAR(seeded.u, project(c, x, ProjectionOptions{.seeds = &seeds}).u, 1e-12);
     }
   }
 }

@@ -12,6 +12,7 @@ double RigidTool::lowest_y() const { return surface.points().col(1).minCoeff(); 
 MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty, int points_per_span)
     : tool_(std::move(tool)), penalty_(penalty) {
   if (!(penalty_ > 0.0)) throw Error("contact: the penalty factor must be positive");
+  seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
   const auto& basis = tool_.surface.basis();
   if (basis.is_periodic() && tool_.surface.shift().y() == 0.0 && tool_.surface.shift().x() > 0.0) {
@@ -60,6 +61,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
 
 spline::ProjectionOptions MortarContact::search_window(const Eigen::Vector2d& x) const {
   spline::ProjectionOptions options;
+  options.seeds = seeds_.get();  // refers to tool_.surface: a copy of this object searches without it
   if (graph_.empty()) return options;
   const double length = tool_.surface.shift().x(), period = tool_.surface.basis().period();
   // Tool height and parameter at an x anywhere, through the periodic table.

@@ -78,6 +78,7 @@ class MortarContact final : public solid::BoundaryInteraction {
   spline::ProjectionOptions search_window(const Eigen::Vector2d& x) const;
 
   RigidTool tool_;
+  std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once
   double penalty_;
   std::vector<GraphSample> graph_;  // empty: the tool is not a graph over x, search globally
   std::vector<SurfacePoint> points_;

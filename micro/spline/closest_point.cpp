@@ -107,7 +107,20 @@ LocalResult refine(const SplineCurve& curve, const Eigen::Vector2d& x, double a,
   return result;
 }
 
+// A table is used when it was built for this curve's spans with the sampling density asked for.
+bool seeds_usable(const ProjectionOptions& options, const SplineCurve& curve, int per_span) {
+  return options.seeds != nullptr && options.seeds->curve() == &curve && options.seeds->samples_per_span() == per_span;
+}
+
 }  // namespace
+
+ProjectionSeeds::ProjectionSeeds(const SplineCurve& curve, int samples_per_span)
+    : curve_(&curve), per_span_(samples_per_span > 0 ? samples_per_span : 2 * curve.basis().degree() + 4),
+      breaks_(curve.basis().breakpoints()) {
+  for (size_t e = 0; e + 1 < breaks_.size(); ++e) {
+    for (int q = 0; q < per_span_; ++q) points_.push_back(curve.point(breaks_[e] + (breaks_[e + 1] - breaks_[e]) * q / per_span_));
+  }
+}
 
 Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const ProjectionOptions& options) {
   const SplineBasis& basis = curve.basis();
@@ -127,33 +140,39 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
   }
   const int per_span = options.samples_per_span > 0 ? options.samples_per_span : 2 * basis.degree() + 4;
   // Parameter range: open curves their domain; periodic curves with a shift a few periods around
-  // the period the point's position along the shift falls into.
-  double lo = basis.lo(), hi = basis.hi();
-  std::vector<double> breaks = basis.breakpoints();
+  // the period the point's position along the shift falls into. Each span searched is a span of
+  // the basis moved by a whole number of periods.
+  struct Span {
+    double a, b;
+    int base, period;  // span `base` of [lo, hi], moved by `period` periods
+  };
+  const bool tabulated = seeds_usable(options, curve, per_span);
+  std::vector<double> own_breaks;
+  if (!tabulated) own_breaks = basis.breakpoints();
+  const std::vector<double>& base_breaks = tabulated ? options.seeds->breaks() : own_breaks;
+  const double period_length = basis.is_periodic() ? basis.period() : 0.0;
+  std::vector<Span> spans;
+  const auto add_periods = [&](int first, int last, bool (*keep)(double, double, const ProjectionOptions&)) {
+    for (int q = first; q <= last; ++q) {
+      const double offset = q * period_length;
+      for (size_t e = 0; e + 1 < base_breaks.size(); ++e) {
+        const double a = base_breaks[e] + offset, b = base_breaks[e + 1] + offset;
+        if (keep(a, b, options)) spans.push_back({a, b, static_cast<int>(e), q});
+      }
+    }
+  };
+  const auto everything = [](double, double, const ProjectionOptions&) { return true; };
   const bool windowed = options.window_lo < options.window_hi;
   if (windowed) {
     // The spans meeting the window, continued periodically for periodic curves.
-    const double period = basis.period();
-    const int first = basis.is_periodic() ? static_cast<int>(std::floor((options.window_lo - lo) / period)) : 0;
-    const int last = basis.is_periodic() ? static_cast<int>(std::floor((options.window_hi - lo) / period)) : 0;
-    std::vector<double> spans;
-    for (int q = first; q <= last; ++q) {
-      const double offset = q * period;
-      for (size_t e = 0; e + 1 < breaks.size(); ++e) {
-        const double a = breaks[e] + offset, b = breaks[e + 1] + offset;
-        if (b < options.window_lo || a > options.window_hi) continue;
-        if (spans.empty() || spans.back() != a) spans.push_back(a);
-        spans.push_back(b);
-      }
-    }
-    if (spans.size() >= 2) {
-      breaks = std::move(spans);
-      lo = breaks.front();
-      hi = breaks.back();
-    }
+    const double lo0 = basis.lo();
+    const int first = basis.is_periodic() ? static_cast<int>(std::floor((options.window_lo - lo0) / period_length)) : 0;
+    const int last = basis.is_periodic() ? static_cast<int>(std::floor((options.window_hi - lo0) / period_length)) : 0;
+    add_periods(first, last, [](double a, double b, const ProjectionOptions& o) { return !(b < o.window_lo || a > o.window_hi); });
+    if (spans.empty()) add_periods(0, 0, everything);
   } else if (basis.is_periodic() && !curve.shift().isZero() && options.periods > 1) {
     const Eigen::Vector2d s = curve.shift();
-    const double along = (x - curve.point(lo)).dot(s) / s.squaredNorm();
+    const double along = (x - curve.point(basis.lo())).dot(s) / s.squaredNorm();
     if (!(std::abs(along) < 1e9)) {
       Projection failed;
       failed.reason = "the point is too many periods from the curve (a diverged iterate)";
@@ -161,20 +180,19 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
     }
     const int centre = static_cast<int>(std::floor(along));
     const int first = centre - (options.periods - 1) / 2;
-    std::vector<double> extended;
-    for (int q = first; q < first + options.periods; ++q) {
-      for (size_t e = 0; e + 1 < breaks.size(); ++e) extended.push_back(breaks[e] + q * basis.period());
-    }
-    extended.push_back(breaks.back() + (first + options.periods - 1) * basis.period());
-    breaks = std::move(extended);
-    lo = breaks.front();
-    hi = breaks.back();
+    add_periods(first, first + options.periods - 1, everything);
+  } else {
+    add_periods(0, 0, everything);
   }
+  const double lo = spans.front().a, hi = spans.back().b;
+  // Seeding: C at per_span points of every span, from the caller's table when it has one.
   std::vector<Sample> samples;
-  for (size_t e = 0; e + 1 < breaks.size(); ++e) {
+  samples.reserve(spans.size() * static_cast<size_t>(per_span) + 1);
+  for (const Span& span : spans) {
     for (int q = 0; q < per_span; ++q) {
-      const double u = breaks[e] + (breaks[e + 1] - breaks[e]) * q / per_span;
-      const Eigen::Vector2d c = curve.point(u);
+      const double u = span.a + (span.b - span.a) * q / per_span;
+      const Eigen::Vector2d c = tabulated ? Eigen::Vector2d(options.seeds->point(span.base, q) + span.period * curve.shift())
+                                          : curve.point(u);
       samples.push_back({u, (c - x).squaredNorm(), c});
     }
   }
