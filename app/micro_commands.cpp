@@ -104,6 +104,7 @@ void print_summary(const scene::MicroResult& r, const scene::Scene& sc) {
               r.solver.line_search_reductions, r.solver.cutbacks.size(), r.wall_seconds, r.solver.seconds_assembly,
               r.solver.seconds_contact, r.solver.seconds_solve);
   for (const auto& c : r.solver.cutbacks) std::printf("  cut-back at %.2f ns (dt %.3g s): %s\n", c.time * 1e9, c.dt_failed, c.reason.c_str());
+  for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
 int run_command(const RunCommandOptions& o) {

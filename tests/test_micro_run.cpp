@@ -132,6 +132,20 @@ TEST(MicroRun, DefaultSceneSmokeTest) {
   EXPECT_GT(r.max_temperature, scene.temperature);  // adiabatic heating of the flattened peaks
   EXPECT_GT(r.max_contact_pressure, scene.pressure);
   EXPECT_FALSE(r.history.front().mu.has_value() && r.history.front().contact_fraction > 0.5);
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+}
+
+TEST(MicroRun, AChipAtItsMeltingTemperatureIsReportedOutsideTheModel) {
+  nlohmann::json j = small_scene();
+  for (const char* s : {"discretisation.elements_x=16", "geometry.chip_surface.fit.control_points=16",
+                        "time.duration=\"6ns\"", "time.average_from=\"3ns\"", "load.ramp=\"3ns\"",
+                        "load.temperature=\"1500C\""}) {
+    apply_override(j, s);
+  }
+  const MicroResult r = run_micro(parse_scene(j, "molten"));
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings.front().find("melting temperature"), std::string::npos) << r.warnings.front();
+  EXPECT_EQ(r.to_json(parse_scene(j, "molten"))["warnings"].size(), 1u);
 }
 
 }  // namespace

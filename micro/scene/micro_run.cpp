@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "common/units.hpp"
 #include "common/version.hpp"
 #include "micro/scene/vtu.hpp"
 
@@ -96,6 +97,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
   j["scene"] = scene.effective;
   j["completed"] = completed;
   if (!completed) j["reason"] = reason;
+  j["warnings"] = warnings;
   j["mu"] = completed ? nlohmann::json(mu) : nlohmann::json(nullptr);
   j["mu_window_s"] = {scene.average_from, scene.duration};
   j["averaged_steps"] = averaged_steps;
@@ -208,9 +210,17 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   result.contact_fraction = last.surface_length > 0.0 ? last.contact_length / last.surface_length : 0.0;
   result.max_contact_pressure = last.max_pressure;
+  int molten = 0;
   for (const auto& s : problem.states()) {
     result.max_plastic_strain = std::max(result.max_plastic_strain, s.equivalent_plastic_strain);
     result.max_temperature = std::max(result.max_temperature, s.temperature);
+    molten += s.temperature >= scene.material.melting_temperature;
+  }
+  if (molten > 0) {
+    result.warnings.push_back("the chip reached its melting temperature (" +
+                              format_human(scene.material.melting_temperature, QuantityKind::temperature) + ") at " +
+                              std::to_string(molten) + " of " + std::to_string(problem.states().size()) +
+                              " quadrature points: Johnson-Cook leaves it no strength there, so mu is outside the model's range");
   }
   if (!report.completed) {
     result.reason = report.reason;

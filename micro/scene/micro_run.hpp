@@ -31,6 +31,9 @@ struct MicroResult {
   std::vector<MicroStep> history;
   double contact_fraction = 0.0, max_contact_pressure = 0.0;  // at the end
   double max_plastic_strain = 0.0, max_temperature = 0.0;     // over the chip, at the end
+  // A completed run whose result lies outside what the model describes (the chip reached its
+  // melting temperature, where Johnson–Cook leaves it no strength), one sentence each.
+  std::vector<std::string> warnings;
   int dofs = 0, elements = 0;
   solid::IntegrationReport solver;  // the time integration's own record: Newton work, cut-backs, seconds
   double wall_seconds = 0.0;
