@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The speed goal of issue 5: the default dry scene at its converged resolution (128 x 24 elements,
+# bench/RESULTS.md) on one core, run by two builds at the same time, one core each, so that their
+# ratio is meaningful on a shared machine. With one build, the peer is the same build on the default
+# 64 x 12 mesh. Prints a markdown table; every run's result.json is kept in the output directory.
+# Usage: bash bench/micro_speed.sh BUILD [PEER_BUILD] [OUT_DIR] [extra --set overrides...]
+set -uo pipefail
+if [[ $# -lt 1 || $1 == -h || $1 == --help ]]; then
+  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+  exit 2
+fi
+build=$1
+peer=${2:-}
+out=${3:-micro-speed}
+shift $(( $# < 3 ? $# : 3 ))
+mkdir -p "$out"
+converged=(--set discretisation.elements_x=128 --set discretisation.elements_y=24)
+echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc --all) cores; one core per run"
+run() {  # label build dir overrides...
+  local label=$1 bin=$2/app/mufric dir=$out/$3
+  shift 3
+  mkdir -p "$dir"
+  OMP_NUM_THREADS=1 "$bin" micro run --quiet --out "$dir" "$@" > "$dir/summary.txt" 2>&1
+  echo "$label" > "$dir/label"
+}
+if [[ -n $peer ]]; then
+  run "$build, 128 x 24" "$build" a "${converged[@]}" "$@" &
+  run "$peer, 128 x 24" "$peer" b "${converged[@]}" "$@" &
+else
+  run "$build, 128 x 24" "$build" a "${converged[@]}" "$@" &
+  run "$build, 64 x 12 (default mesh)" "$build" b "$@" &
+fi
+wait
+printf '| run | dofs | Newton | assemblies | cut-backs | mu | wall [s] |\n|---|---|---|---|---|---|---|\n'
+/usr/bin/python3 - "$out" <<'PY'
+import json, sys, pathlib
+out = pathlib.Path(sys.argv[1])
+rows = []
+for name in ("a", "b"):
+    d = out / name
+    try:
+        r = json.load(open(d / "result.json"))
+    except (OSError, ValueError):
+        print(f"| {(d / 'label').read_text().strip()} | error: {(d / 'summary.txt').read_text().strip()[-120:]} |")
+        continue
+    g = r["diagnostics"]
+    rows.append(g["wall_seconds"])
+    mu = f'{r["mu"]:.5f}' if r["completed"] else "not completed"
+    print(f'| {(d / "label").read_text().strip()} | {g["dofs"]} | {g["newton_iterations"]} | {g["assemblies"]} | '
+          f'{g["cutbacks"]} | {mu} | {g["wall_seconds"]:.1f} |')
+if len(rows) == 2:
+    print(f"ratio first / second: {rows[0] / rows[1]:.2f}")
+PY
