@@ -197,6 +197,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
     out.tangent.setZero();
     return out;
   }
+  const Eigen::Matrix2d f_inv = f.inverse();
   const KirchhoffTrial<double> trial = trial_strain<double>(f, start);
   const double q_trial = 2.0 * mu_ * trial.norm;  // ‖dev τ_trial‖
   const double theta = start.temperature;
@@ -262,7 +263,7 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
     Eigen::Matrix2d tau;
     tau << 2.0 * mu_ * trial.dev.xx * scale + pressure, 2.0 * mu_ * trial.dev.xy * scale,
         2.0 * mu_ * trial.dev.xy * scale, 2.0 * mu_ * trial.dev.yy * scale + pressure;
-    out.stress = tau * f.inverse().transpose();
+    out.stress = tau * f_inv.transpose();
   }
 
   if (dgamma == 0.0) {
@@ -278,7 +279,6 @@ StressResponse J2JohnsonCook::update(const Eigen::Matrix2d& h, const MaterialSta
                                                2.0 * (trial.dev.yy * keep + third)});
   Eigen::Matrix2d be_matrix;
   be_matrix << be.xx, be.xy, be.xy, be.yy;
-  const Eigen::Matrix2d f_inv = f.inverse();
   const Eigen::Matrix2d cp_inv = f_inv * be_matrix * f_inv.transpose();
   out.state.plastic_metric_inverse = {cp_inv(0, 0), 0.5 * (cp_inv(0, 1) + cp_inv(1, 0)), cp_inv(1, 1),
                                       std::exp(2.0 * (trial.dev_zz * keep + third))};

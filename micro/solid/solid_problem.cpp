@@ -112,18 +112,19 @@ void SolidProblem::build_pattern() {
   // through a shared node has): elements of a colour touch disjoint dofs, so they add into the
   // global arrays concurrently, and every entry sums its contributions in colour order whatever the
   // thread count. A tensor-product patch of degree p needs about (p + 1)² colours.
+  const auto node_of = [&](size_t e, int a) {
+    return static_cast<size_t>(element_nodes_[e * static_cast<size_t>(element_nodes_count_) + static_cast<size_t>(a)]);
+  };
   std::vector<std::vector<int>> node_elements(static_cast<size_t>(space_.node_count()));
   for (size_t e = 0; e < elements; ++e) {
-    for (int a = 0; a < element_nodes_count_; ++a) {
-      node_elements[static_cast<size_t>(element_nodes_[e * static_cast<size_t>(element_nodes_count_) + static_cast<size_t>(a)])].push_back(static_cast<int>(e));
-    }
+    for (int a = 0; a < element_nodes_count_; ++a) node_elements[node_of(e, a)].push_back(static_cast<int>(e));
   }
   std::vector<int> colour(elements, -1);
   colours_.clear();
   for (size_t e = 0; e < elements; ++e) {
     std::vector<bool> taken(colours_.size() + 1, false);
     for (int a = 0; a < element_nodes_count_; ++a) {
-      for (const int other : node_elements[static_cast<size_t>(element_nodes_[e * static_cast<size_t>(element_nodes_count_) + static_cast<size_t>(a)])]) {
+      for (const int other : node_elements[node_of(e, a)]) {
         if (colour[static_cast<size_t>(other)] >= 0) taken[static_cast<size_t>(colour[static_cast<size_t>(other)])] = true;
       }
     }
@@ -182,8 +183,8 @@ template <int Nen>
 void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent,
                                     const std::vector<MaterialState>* iterate, Assembly& out,
                                     std::string& failure) const {
-  // Arrays indexed [node] (or [column · nen + row]) and written as plain loops over nodes: with the
-  // count fixed at compile time they vectorise, where Eigen's fixed 9-row products stayed scalar.
+  // Sizes fixed at compile time for the common node counts, so that the loops over nodes and the
+  // padded row expressions below vectorise.
   using Row = Eigen::Matrix<double, Nen, 1>;
   using Block = Eigen::Matrix<double, Nen, Nen>;
   const int nen = Nen == Eigen::Dynamic ? element_nodes_count_ : Nen;  // a compile-time trip count where possible

@@ -129,6 +129,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   Evaluation current = evaluate(u1, true);
   last_states = &current.assembly.states;  // `current` is reassigned in place: the pointer stays valid
   double force_scale = 0.0;
+  const auto tolerance_at = [&](double scale) { return options_.relative_tolerance * scale + 1e-300; };
   bool factorized = false, last_full_step = false;
   double previous_norm = 0.0;
   for (int it = 0;; ++it) {
@@ -141,7 +142,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
       return at;
     }
     force_scale = std::max(force_scale, current.scale);
-    const double tolerance = options_.relative_tolerance * force_scale + 1e-300;
+    const double tolerance = tolerance_at(force_scale);
     if (trace_newton()) {
       std::fprintf(stderr, "newton t %.4g dt %.3g it %d residual %.6e tolerance %.3e\n", t1, dt, it, current.norm, tolerance);
     }
@@ -209,7 +210,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
     const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
                            trial.norm <= 1e3 * tolerance;
     last_full_step = s == 1.0;
-    const double next_tolerance = options_.relative_tolerance * std::max(force_scale, trial.scale) + 1e-300;
+    const double next_tolerance = tolerance_at(std::max(force_scale, trial.scale));
     if (trial_has_tangent || stagnated || !trial.assembly.ok || trial.norm <= next_tolerance) {
       current = std::move(trial);  // evaluated at the new u1 (with its tangent unless it will not be needed)
     } else {

@@ -107,6 +107,11 @@ LocalResult refine(const SplineCurve& curve, const Eigen::Vector2d& x, double a,
   return result;
 }
 
+// The seeding density when the caller does not choose one: 2p + 4 samples per span.
+int samples_per_span_for(const ProjectionOptions& options, const SplineBasis& basis) {
+  return options.samples_per_span > 0 ? options.samples_per_span : 2 * basis.degree() + 4;
+}
+
 // A table is used when it was built for this curve's spans with the sampling density asked for.
 bool seeds_usable(const ProjectionOptions& options, const SplineCurve& curve, int per_span) {
   return options.seeds != nullptr && options.seeds->curve() == &curve && options.seeds->samples_per_span() == per_span;
@@ -115,7 +120,7 @@ bool seeds_usable(const ProjectionOptions& options, const SplineCurve& curve, in
 }  // namespace
 
 ProjectionSeeds::ProjectionSeeds(const SplineCurve& curve, int samples_per_span)
-    : curve_(&curve), per_span_(samples_per_span > 0 ? samples_per_span : 2 * curve.basis().degree() + 4),
+    : curve_(&curve), per_span_(samples_per_span_for(ProjectionOptions{.samples_per_span = samples_per_span}, curve.basis())),
       breaks_(curve.basis().breakpoints()) {
   for (size_t e = 0; e + 1 < breaks_.size(); ++e) {
     for (int q = 0; q < per_span_; ++q) points_.push_back(curve.point(breaks_[e] + (breaks_[e + 1] - breaks_[e]) * q / per_span_));
@@ -138,7 +143,7 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
                     " periods from the curve (a diverged iterate)";
     return failed;
   }
-  const int per_span = options.samples_per_span > 0 ? options.samples_per_span : 2 * basis.degree() + 4;
+  const int per_span = samples_per_span_for(options, basis);
   // Parameter range: open curves their domain; periodic curves with a shift a few periods around
   // the period the point's position along the shift falls into. Each span searched is a span of
   // the basis moved by a whole number of periods.
@@ -183,6 +188,11 @@ Projection project(const SplineCurve& curve, const Eigen::Vector2d& x, const Pro
     add_periods(first, first + options.periods - 1, everything);
   } else {
     add_periods(0, 0, everything);
+  }
+  if (spans.empty()) {  // a basis has at least one span; this states it for the reader and the compiler
+    Projection failed;
+    failed.reason = "the curve has no spans to search";
+    return failed;
   }
   const double lo = spans.front().a, hi = spans.back().b;
   // Seeding: C at per_span points of every span, from the caller's table when it has one.

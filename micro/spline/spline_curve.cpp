@@ -34,11 +34,10 @@ Eigen::Vector2d SplineCurve::extended_point(int index, int period) const {
   return points_.row(index).transpose() + period * shift_;
 }
 
-Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3> SplineCurve::homogeneous_derivatives(double u, int n) const {
-  using Homogeneous = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3>;
+SplineCurve::HomogeneousDerivatives SplineCurve::homogeneous_derivatives(double u, int n) const {
   const auto at = basis_.locate(u);
   const BasisDerivatives ders = basis_.derivatives(at.span, at.u, n);
-  Homogeneous h = Homogeneous::Zero(n + 1, 3);
+  HomogeneousDerivatives h = HomogeneousDerivatives::Zero(n + 1, 3);
   for (int j = 0; j <= basis_.degree(); ++j) {
     const int i = basis_.function_index(at.span, j);
     const double weight = extended_weight(i);

@@ -52,7 +52,8 @@ class SplineCurve {
  private:
   // Rows r = 0..n: d^r/du^r of the homogeneous curve (w·C, w) at u (A3.2 applied to the weighted
   // control points; A4.2 turns it into the curve's derivatives).
-  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3> homogeneous_derivatives(double u, int n) const;
+  using HomogeneousDerivatives = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxDegree + 1, 3>;
+  HomogeneousDerivatives homogeneous_derivatives(double u, int n) const;
 
   SplineBasis basis_;
   Points2 points_;
