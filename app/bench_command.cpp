@@ -146,6 +146,7 @@ void add_bench_command(CLI::App& app) {
     const EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
     client::Options options;
     options.streaming = o->streaming;
+    options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
     if (!o->replay.empty()) {
       if (o->replay[0] <= 0 || o->replay[1] <= 0) throw Error("--replay: POINTS and INCREMENTS must be positive");
       const Measurement m = replay(o->model, options, o->replay[0], o->replay[1], what);

@@ -142,7 +142,7 @@ int threads_per_job(int jobs, int threads) {
 }
 
 void run_command(const RunOptions& o) {
-  Dataset plan = read_dataset(o.plan);
+  Dataset plan = read_dataset_isolated(o.plan);
   if (plan.plan.rows() == 0) throw Error(o.plan + ": has no plan (/plan/inputs is empty); make one with mufric dataset plan");
   const scene::Scene sc = run_scene(o.scene_path, o.overrides, plan, o.plan);
   plan.scene_json = sc.effective.dump(2);
@@ -215,14 +215,14 @@ void report_round(int round, const GaussianProcess& gp, const TrainingSet& data,
 }
 
 void refine_command(const RefineOptions& o) {
-  Dataset db = read_dataset(o.db);
+  Dataset db = read_dataset_isolated(o.db);
   if (db.plan.rows() == 0 || db.plan_index.size() != static_cast<size_t>(db.size())) {
     throw Error(o.db + ": not a micro-model database (no plan rows); start with mufric dataset plan and run");
   }
   const scene::Scene sc = run_scene("", {}, db, o.db);
   const SampleEvaluator evaluate = scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads));
   std::optional<TrainingSet> test;
-  if (!o.test.empty()) test = training_set(read_dataset(o.test), o.test);
+  if (!o.test.empty()) test = training_set(read_dataset_isolated(o.test), o.test);
   GpTrainingOptions training;
   training.restarts = o.restarts;
   training.seed = o.seed;
@@ -261,7 +261,7 @@ void refine_command(const RefineOptions& o) {
     };
     const GenerationReport r = generate_dataset(db, o.db, evaluate, options);
     spent += r.ran;
-    db = read_dataset(o.db);
+    db = read_dataset_isolated(o.db);
     if (r.ran == 0) break;  // nothing new could be run
   }
   std::printf("%s: %lld micro-model runs spent of a budget of %lld%s%s\n", o.db.c_str(), spent, o.budget,
@@ -270,7 +270,7 @@ void refine_command(const RefineOptions& o) {
 
 // What a database holds: provenance, how much of its plan is done, why samples failed.
 void status_command(const std::string& path) {
-  const Dataset d = read_dataset(path);
+  const Dataset d = read_dataset_isolated(path);
   long long converged = 0;
   std::map<std::string, long long> reasons;
   std::set<long long> answered;

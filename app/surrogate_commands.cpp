@@ -88,7 +88,7 @@ void add_train(CLI::App& app) {
               "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).");
   cmd->callback([o] {
     o->gp.noise_term = !o->no_noise;
-    const Dataset dataset = read_dataset(o->data);
+    const Dataset dataset = read_dataset_isolated(o->data);
     const TrainingSet data = training_set(dataset, o->data);
     std::printf("training data: %s (%lld converged of %lld samples, %zu inputs)\n", o->data.c_str(),
                 static_cast<long long>(data.x.rows()), static_cast<long long>(dataset.size()), data.inputs.size());
@@ -113,8 +113,8 @@ void add_eval(CLI::App& app) {
   cmd->add_option("--level", o->level, "Confidence level of the interval whose coverage is reported")
       ->capture_default_str()->check(CLI::Range(0.5, 0.9999));
   cmd->callback([o] {
-    const auto model = load_model(model_path_from_uri(o->model));
-    const TrainingSet test = training_set(read_dataset(o->test), o->test);
+    const auto model = load_model_isolated(model_path_from_uri(o->model));
+    const TrainingSet test = training_set(read_dataset_isolated(o->test), o->test);
     const AccuracyReport r = held_out_accuracy(*model, test, o->level);
     std::printf("model %s (%s) on %s: %lld points (%lld outside the training box)\n", o->model.c_str(),
                 std::string(model->kind()).c_str(), o->test.c_str(), r.points, r.extrapolated);
@@ -151,7 +151,9 @@ void add_predict(CLI::App& app) {
       ->check(CLI::Range(0.5, 0.9999));
   cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput");
   cmd->callback([o] {
-    const auto client = client::connect(o->model);
+    client::Options options;
+    options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
+    const auto client = client::connect(o->model, options);
     const client::ModelInfo info = client->describe();
     const InputSpace& inputs = info.inputs;
     std::vector<double> values(inputs.size());
@@ -189,7 +191,7 @@ void add_describe(CLI::App& app) {
   auto* cmd = app.add_subcommand("describe", "Inputs, units, training box and accuracy figures of a model file");
   cmd->add_option("model", *model_uri, "Model file or file:// URI")->required();
   cmd->callback([model_uri] {
-    const auto model = load_model(model_path_from_uri(*model_uri));
+    const auto model = load_model_isolated(model_path_from_uri(*model_uri));
     std::printf("%s: kind %s\ninputs (training box):\n", model_uri->c_str(), std::string(model->kind()).c_str());
     for (const auto& input : model->inputs()) {
       std::printf("  %-18s [%s, %s]  stored in %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
@@ -258,7 +260,7 @@ void add_dataset_from_model(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   from_model->add_option("--out", o->out, "Dataset file to write (HDF5)")->required();
   from_model->callback([o] {
-    const auto model = load_model(model_path_from_uri(o->model));
+    const auto model = load_model_isolated(model_path_from_uri(o->model));
     const Dataset data = sample_model(*model, o->sampling, "model:" + o->model);
     write_dataset(o->out, data);
     std::printf("wrote %s: %lld samples of %s (seed %llu, noise std %g)\n", o->out.c_str(),

@@ -24,7 +24,8 @@ const double* input_pointer(const Block& block, const std::string& name) {
 
 class InProcessClient final : public FrictionClient {
  public:
-  explicit InProcessClient(const std::string& path) : path_(path), model_(load_model(path)) {}
+  InProcessClient(const std::string& path, bool isolate)
+      : path_(path), model_(isolate ? load_model_isolated(path) : load_model(path)) {}
 
   Answer evaluate(const Block& block, const EvaluationRequest& what) override {
     const auto& inputs = model_->inputs();
@@ -290,7 +291,7 @@ std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& o
     }
     return std::make_unique<GrpcClient>(server->target, server->model, server->tls, options);
   }
-  return std::make_unique<InProcessClient>(model_path_from_uri(uri));
+  return std::make_unique<InProcessClient>(model_path_from_uri(uri), options.isolate_file_parsing);
 }
 
 }  // namespace mufric::client

@@ -9,6 +9,7 @@
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/isolation.hpp"
 #include "common/version.hpp"
 
 namespace mufric {
@@ -105,6 +106,14 @@ Dataset read_csv_dataset(const std::string& path) {
 
 Dataset read_dataset(const std::string& path) {
   return ends_with(path, ".csv") ? read_csv_dataset(path) : read_hdf5_dataset(path);
+}
+
+Dataset read_dataset_isolated(const std::string& path) {
+  if (ends_with(path, ".csv")) return read_csv_dataset(path);  // our own parser, no HDF5
+  const IsolatedCopy copy = rewrite_in_child(path, "dataset", [](const std::string& original, const std::string& rewritten) {
+    write_dataset(rewritten, read_hdf5_dataset(original));
+  });
+  return read_hdf5_dataset(copy.path());
 }
 
 void write_dataset(const std::string& path, const Dataset& d) {

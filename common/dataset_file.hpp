@@ -53,6 +53,9 @@ struct TrainingSet {
 
 // Reads .h5 (dataset schema) or .csv; throws Error naming the file and the problem.
 Dataset read_dataset(const std::string& path);
+// read_dataset for a file that may be corrupt: an HDF5 file is parsed in a child process and read
+// back from the copy it wrote (common/isolation.hpp), so a crash of the HDF5 library is an Error.
+Dataset read_dataset_isolated(const std::string& path);
 void write_dataset(const std::string& path, const Dataset& dataset);
 TrainingSet training_set(const Dataset& dataset, const std::string& path);
 

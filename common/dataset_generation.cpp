@@ -68,7 +68,7 @@ Dataset empty_database(const Dataset& plan) {
 Dataset open_database(const std::string& db_path, const Dataset& plan) {
   if (plan.plan.rows() == 0) throw Error("the plan has no points (/plan/inputs is empty)");
   if (!std::filesystem::exists(db_path)) return empty_database(plan);
-  Dataset d = read_dataset(db_path);
+  Dataset d = read_dataset_isolated(db_path);
   if (!same_inputs(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
   if (!same_plan(d.plan, plan.plan)) {
     throw Error(db_path + ": was made from a different plan (" + std::to_string(d.plan.rows()) + " rows, the plan has " +
@@ -227,7 +227,7 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
   report = MergeReport{};
   std::vector<Dataset> files;
   for (const auto& path : paths) {
-    files.push_back(read_dataset(path));
+    files.push_back(read_dataset_isolated(path));
     const Dataset& d = files.back();
     const Dataset& first = files.front();
     if (!same_inputs(d.inputs, first.inputs)) throw Error("merge: " + path + ": inputs or box differ from " + paths[0]);

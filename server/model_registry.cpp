@@ -39,7 +39,7 @@ int ModelRegistry::refresh() {
     served->size = size;
     try {
       served->version = sha256_file(entry.path().string()).substr(0, kVersionDigits);
-      served->model = load_model(entry.path().string());
+      served->model = load_model_isolated(entry.path().string());
     } catch (const std::exception& e) {
       log_("warning", "refused model file " + entry.path().string() + ": " + e.what() +
                           " (the previous version, if any, keeps serving)");

@@ -1,8 +1,10 @@
 #include "surrogate/model_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/error.hpp"
+#include "common/isolation.hpp"
 #include "common/version.hpp"
 #include "surrogate/cholesky.hpp"
 #include "surrogate/empirical_laws.hpp"
@@ -96,6 +98,13 @@ std::unique_ptr<FrictionModel> load_model(const std::string& path) {
     in.fail("/" + kind, message);
   }
   in.fail("/", "unknown model kind '" + kind + "' (known: gp, mlr, coulomb)");
+}
+
+std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path) {
+  const IsolatedCopy copy = rewrite_in_child(path, "model", [](const std::string& original, const std::string& rewritten) {
+    save_model(rewritten, *load_model(original));
+  });
+  return load_model(copy.path());
 }
 
 std::string model_path_from_uri(const std::string& uri) {
@@ -217,18 +226,24 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
     const auto chol = cholesky_with_jitter(kf, diagonal, s.cholesky);
     if (!chol.ok || chol.jitter > 0.0) in.fail("/gp", "covariance cannot be refactorised with the stored jitter");
   }
-  // Consistency: K α = y and L Lᵀ α = y, both O(n²).
+  // Consistency, O(n²): α̂ = (L Lᵀ)⁻¹ y from the factor, then K α = y and α = α̂ entry by entry. Every
+  // scale below comes from α̂ as well as from α: scaled by ‖α‖ alone, one entry blown up to 1e180 by a
+  // flipped exponent bit inflated its own tolerance and passed.
+  if (!s.y_train.allFinite()) in.fail("/gp/y_train", "contains non-finite values");
+  if (!std::isfinite(s.y_mean)) in.fail("/gp", "attribute y_mean must be finite");
   const Eigen::VectorXd y = (s.y_train.array() - s.y_mean) / s.y_scale;
+  Eigen::VectorXd alpha_from_factor = s.cholesky.triangularView<Eigen::Lower>().solve(y);
+  s.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(alpha_from_factor);
+  const double alpha_size = std::min(s.alpha.lpNorm<Eigen::Infinity>(), alpha_from_factor.lpNorm<Eigen::Infinity>());
+  if ((alpha_from_factor - s.alpha).lpNorm<Eigen::Infinity>() > kAlphaRecomputeTolerance * alpha_size) {
+    in.fail("/gp/alpha", "is inconsistent with the Cholesky factor and y_train (alpha != K⁻¹y)");
+  }
   Eigen::VectorXd k_alpha = kf.selfadjointView<Eigen::Lower>() * s.alpha;
   k_alpha += diagonal * s.alpha;
-  const double scale = kf.norm() * s.alpha.norm() + y.norm();
-  if ((k_alpha - y).norm() > kLoadBackwardErrorTolerance * scale) {
+  const double n_alpha = static_cast<double>(n) * alpha_size;
+  const double scale = (kf.lpNorm<Eigen::Infinity>() + diagonal) * n_alpha + y.lpNorm<Eigen::Infinity>();
+  if ((k_alpha - y).lpNorm<Eigen::Infinity>() > kLoadBackwardErrorTolerance * scale) {
     in.fail("/gp/alpha", "is inconsistent with x_train, y_train and the hyper-parameters (K·alpha != y)");
-  }
-  Eigen::VectorXd recomputed = s.cholesky.triangularView<Eigen::Lower>().solve(y);
-  s.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(recomputed);
-  if ((recomputed - s.alpha).norm() > kAlphaRecomputeTolerance * s.alpha.norm()) {
-    in.fail("/gp/alpha", "is inconsistent with the Cholesky factor and y_train (alpha != K⁻¹y)");
   }
   if (in.has(kSummaryGroup)) {
     for (const auto& [name, field] : kSummaryNumbers) s.summary.*field = in.double_attribute(kSummaryGroup, name);

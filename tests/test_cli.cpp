@@ -12,6 +12,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <algorithm>
+
+#include "corrupt_files.hpp"
 
 namespace {
 
@@ -49,6 +52,19 @@ TEST_F(Cli, HelpExplainsTheSubcommands) {
     EXPECT_NE(r.output.find(word), std::string::npos) << word;
   }
   EXPECT_EQ(run("train --help").exit_code, 0);
+}
+
+// Regression: `mufric describe` on a model file with a flipped global-heap string length died of
+// SIGSEGV inside the HDF5 library. Now a one-line error naming the file, exit code 2.
+TEST_F(Cli, FileThatCrashesTheHdf5LibraryIsAOneLineError) {
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("c.h5")).exit_code, 0);
+  mufric::test::flip_global_heap_string_length(path("c.h5"));
+  for (const std::string& command : {"describe " + path("c.h5"), "predict --model " + path("c.h5") + " --p 1MPa --v 1m/s --T 20C"}) {
+    const CommandResult r = run(command);
+    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.output;
+    EXPECT_NE(r.output.find(path("c.h5")), std::string::npos) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  }
 }
 
 TEST_F(Cli, LawPredictTrainEvalChain) {

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "common/error.hpp"
+#include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/gp_training.hpp"
@@ -132,6 +133,33 @@ TEST(ModelFile, CorruptAlphaIsRefusedNamingTheField) {
   std::filesystem::remove(path);
 }
 
+// Regression: one α entry blown up by a flipped exponent bit (0.57 -> ~1e180) inflated the norms the
+// consistency checks were scaled by, so the file was served and answered mu ~ 1e182 with status OK.
+TEST(ModelFile, HugeAlphaEntryIsRefused) {
+  const std::string path = temp_path("alpha_huge.h5");
+  const GaussianProcess gp = small_gp();
+  save_model(path, gp);
+  for (const double bad : {1e180, -1e30, 1e6}) {
+    std::vector<double> alpha(gp.state().alpha.data(), gp.state().alpha.data() + gp.state().alpha.size());
+    alpha[21] = bad;
+    overwrite_doubles(path, "/gp/alpha", alpha);
+    EXPECT_NE(load_error(path).find("/gp/alpha"), std::string::npos) << "alpha[21] = " << bad;
+  }
+  std::filesystem::remove(path);
+}
+
+// The same with y_train blown up: the reference α̂ = K⁻¹y then is the huge one.
+TEST(ModelFile, HugeTrainingTargetIsRefused) {
+  const std::string path = temp_path("y_huge.h5");
+  const GaussianProcess gp = small_gp();
+  save_model(path, gp);
+  std::vector<double> y(gp.state().y_train.data(), gp.state().y_train.data() + gp.state().y_train.size());
+  y[3] = 1e180;
+  overwrite_doubles(path, "/gp/y_train", y);
+  EXPECT_FALSE(load_error(path).empty());
+  std::filesystem::remove(path);
+}
+
 TEST(ModelFile, CorruptLengthScaleIsDetectedThroughAlpha) {
   const std::string path = temp_path("length.h5");
   const GaussianProcess gp = small_gp();
@@ -178,6 +206,44 @@ TEST(ModelFile, MissingDatasetIsNamed) {
     file.unlink("/gp/y_train");
   }
   EXPECT_NE(load_error(path).find("/gp/y_train: missing"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+// Regression: a flipped byte in a global-heap string length made the HDF5 library dereference
+// wild pointers; `mufric serve` and `mufric describe` died of SIGSEGV. Parsed in a child process,
+// the same file is an Error naming it, and the calling process lives on.
+TEST(ModelFile, FileThatCrashesTheHdf5LibraryIsAnErrorNamingIt) {
+  const std::string path = temp_path("heap.h5");
+  save_model(path, small_gp(30));
+  test::flip_global_heap_string_length(path);
+  try {
+    load_model_isolated(path);
+    ADD_FAILURE() << "a corrupt file was loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, IsolatedLoadGivesTheSameModelAsALoad) {
+  const std::string path = temp_path("isolated.h5");
+  const GaussianProcess gp = small_gp(40);
+  save_model(path, gp);
+  const auto direct = load_model(path), isolated = load_model_isolated(path);
+  const TrainingSet q = test::smooth_training_set(100, 5);
+  const EvaluationRequest what{.std = true, .ci_level = 0.95, .gradient = true};
+  const Evaluation a = direct->evaluate(q.x, what), b = isolated->evaluate(q.x, what);
+  EXPECT_TRUE(bitwise_equal(a.mu, b.mu));
+  EXPECT_TRUE(bitwise_equal(a.std, b.std));
+  EXPECT_TRUE(bitwise_equal(a.gradient, b.gradient));
+  // An ordinary validation failure in the child arrives with its own message.
+  overwrite_doubles(path, "/gp/length_scales", {-1.0, 1.0, 1.0});
+  try {
+    load_model_isolated(path);
+    ADD_FAILURE() << "a negative length scale was loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/gp/length_scales"), std::string::npos) << e.what();
+  }
   std::filesystem::remove(path);
 }
 

@@ -20,6 +20,7 @@
 #include "client/friction_client.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
 #include "server/friction_service.hpp"
 #include "server/server.hpp"
@@ -277,6 +278,21 @@ TEST_F(Service, HotReloadUnderLoadFailsNoRequestAndRefusesABadFile) {
   EXPECT_EQ(failures.load(), 0);
   // The bad file was refused: the last good version (μ = 0.32) keeps serving.
   EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.32);
+}
+
+// Regression: a model file whose global-heap string length had one flipped byte, dropped into the
+// served directory, killed `mufric serve` with SIGSEGV. It is now refused, and every other model
+// keeps serving (this test process is the server: a crash would end it).
+TEST_F(Service, FileThatCrashesTheHdf5LibraryIsRefusedAndTheServerLives) {
+  LoopbackServer server(dir_);
+  fs::copy_file(dir_ / "gp.h5", dir_ / "corrupt.h5");
+  test::flip_global_heap_string_length((dir_ / "corrupt.h5").string());
+  server.registry().refresh();
+  EXPECT_EQ(server.registry().find("corrupt"), nullptr);
+  const Points pts = random_points(8);
+  const auto gp = client::connect("grpc://" + server.address() + "/gp");
+  EXPECT_EQ(gp->evaluate(pts.block(), {}).mu.size(), 8u);
+  EXPECT_THROW(client::connect("grpc://" + server.address() + "/corrupt")->evaluate(pts.block(), {}), Error);
 }
 
 TEST_F(Service, ClientReconnectsAfterTheServerRestarts) {

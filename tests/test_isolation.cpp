@@ -1,0 +1,82 @@
+// common/isolation: a child that crashes, hangs, runs out of memory or throws becomes an Error
+// naming the file; a child that succeeds hands over its copy, which is removed after use.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include "common/error.hpp"
+#include "common/isolation.hpp"
+
+namespace mufric {
+namespace {
+
+std::string failure(const Rewrite& rewrite, const IsolationLimits& limits = {}) {
+  try {
+    rewrite_in_child("/some/file.h5", "model", rewrite, limits);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Isolation, CrashIsAnErrorNamingTheFileAndSignal) {
+  const std::string message = failure([](const std::string&, const std::string&) { std::raise(SIGSEGV); });
+  EXPECT_NE(message.find("model '/some/file.h5'"), std::string::npos) << message;
+  // SIGSEGV itself, or SIGABRT where a sanitizer's handler catches it first.
+  EXPECT_NE(message.find("parsing it crashed (signal "), std::string::npos) << message;
+}
+
+TEST(Isolation, HangIsKilledAfterTheLimit) {
+  IsolationLimits limits;
+  limits.seconds = 0.5;
+  const auto start = std::chrono::steady_clock::now();
+  const std::string message =
+      failure([](const std::string&, const std::string&) { std::this_thread::sleep_for(std::chrono::hours(1)); }, limits);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  EXPECT_NE(message.find("did not finish within"), std::string::npos) << message;
+}
+
+TEST(Isolation, ExceptionMessagePassesThrough) {
+  const std::string message = failure([](const std::string&, const std::string&) { throw Error("model 'x': /gp/alpha: bad"); });
+  EXPECT_EQ(message, "model 'x': /gp/alpha: bad");
+}
+
+#if !defined(__SANITIZE_ADDRESS__)
+TEST(Isolation, HugeAllocationHitsTheMemoryLimit) {
+  IsolationLimits limits;
+  limits.memory_bytes = 256ULL << 20;
+  const std::string message = failure(
+      [](const std::string&, const std::string&) {
+        std::vector<char> huge(1ULL << 30, 1);  // what a corrupt size field would ask for
+        if (huge[12345] != 1) throw Error("unreachable");
+      },
+      limits);
+  EXPECT_NE(message.find("more memory than the limit"), std::string::npos) << message;
+}
+#endif
+
+TEST(Isolation, ChildThatWritesNothingIsRefused) {
+  EXPECT_NE(failure([](const std::string&, const std::string&) {}).find("wrote no copy"), std::string::npos);
+}
+
+TEST(Isolation, CopyIsHandedOverAndRemoved) {
+  std::string copy_path;
+  {
+    const IsolatedCopy copy = rewrite_in_child("/in.h5", "model", [](const std::string& original, const std::string& out) {
+      std::ofstream(out) << "rewritten " << original;
+    });
+    copy_path = copy.path();
+    std::ifstream in(copy_path);
+    std::string a, b;
+    in >> a >> b;
+    EXPECT_EQ(a + " " + b, "rewritten /in.h5");
+  }
+  EXPECT_FALSE(std::filesystem::exists(copy_path));
+}
+
+}  // namespace
+}  // namespace mufric
