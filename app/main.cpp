@@ -2,14 +2,38 @@
 #include <CLI/CLI.hpp>
 #include <H5Cpp.h>
 
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 
 #include "app/commands.hpp"
 #include "common/error.hpp"
 #include "common/version.hpp"
 
+namespace {
+
+// How long an idle OpenMP thread spins before it sleeps (libgomp's default: 300 000 spins when the
+// wait policy is unset). On a node shared with another CPU-bound process, a thread spinning at a
+// barrier holds the core its descheduled team-mate needs: the default micro run took 8× its one-core
+// time with one competing process. 5000 spins keep the idle-machine speed and cost 1.25× there
+// (bench/RESULTS.md, "busy machine").
+constexpr const char* kOpenMpSpinCount = "5000";
+
+// libgomp reads its wait policy once, when it is loaded, so it must be in the environment before
+// the process starts: unless the user chose one, set it and start again (once: the second start
+// sees it set). A failed exec leaves everything as it was.
+void bound_openmp_spinning(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
+  if (::setenv("GOMP_SPINCOUNT", kOpenMpSpinCount, 0) != 0) return;
+  ::execv("/proc/self/exe", argv);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  bound_openmp_spinning(argv);
   CLI::App app{
       "mufric — a friction service for machining simulation.\n"
       "Answers mu(contact pressure, sliding velocity, temperature) with a confidence interval from a\n"

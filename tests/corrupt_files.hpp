@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iterator>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,8 +18,11 @@ namespace mufric::test {
 // dereferences past the heap reading it and dies of SIGSEGV.
 inline void flip_global_heap_string_length(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::stringstream content;
+  content << in.rdbuf();
   in.close();
+  const std::string text = content.str();
+  std::vector<char> bytes(text.begin(), text.end());
   const std::string signature = "GCOL";
   const auto at = std::search(bytes.begin(), bytes.end(), signature.begin(), signature.end());
   if (at == bytes.end()) throw std::runtime_error(path + ": no global heap collection");

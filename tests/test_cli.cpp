@@ -13,6 +13,7 @@
 #include <fstream>
 #include <string>
 #include <algorithm>
+#include <sstream>
 
 #include "corrupt_files.hpp"
 
@@ -130,6 +131,8 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   if (pid == 0) {
     const std::string log = path("serve.log");
     freopen(log.c_str(), "w", stderr);
+    unsetenv("GOMP_SPINCOUNT");  // as a user who chose no wait policy
+    unsetenv("OMP_WAIT_POLICY");
     execl(MUFRIC_EXE, MUFRIC_EXE, "serve", "--models", path("models").c_str(), "--listen", "127.0.0.1:0",
           "--ready-file", path("address").c_str(), static_cast<char*>(nullptr));
     _exit(127);
@@ -140,6 +143,15 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
     std::ifstream(path("address")) >> address;
   }
   ASSERT_FALSE(address.empty()) << "server did not start";
+  {
+    // Regression: with libgomp's default spinning, a micro run beside one CPU-bound process took
+    // 8–15× its one-core time. mufric restarts itself with a bounded spin count unless the user set
+    // a wait policy; the running server's environment shows it.
+    std::ifstream environ_file("/proc/" + std::to_string(pid) + "/environ");
+    std::stringstream environ_text;
+    environ_text << environ_file.rdbuf();
+    EXPECT_NE(environ_text.str().find(std::string("GOMP_SPINCOUNT=5000") + '\0'), std::string::npos);
+  }
   const CommandResult r = run("predict --model grpc://" + address + "/law --p 80MPa --v 10m/min --angle 90deg");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mu = 0.221001"), std::string::npos) << r.output;
