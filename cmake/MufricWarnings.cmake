@@ -10,6 +10,12 @@ if(MUFRIC_NATIVE)
   # inlines them (GCC bug 105593); silenced for native builds only.
   target_compile_options(mufric_options INTERFACE -march=native $<$<COMPILE_LANGUAGE:CXX>:-Wno-maybe-uninitialized>)
 endif()
+if(MUFRIC_FUZZ)
+  # Coverage for libFuzzer in every library; the targets add -fsanitize=fuzzer (libFuzzer's main).
+  target_compile_options(mufric_options INTERFACE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+                         -fno-sanitize-recover=undefined -g)
+  target_link_options(mufric_options INTERFACE -fsanitize=address,undefined)
+endif()
 if(MUFRIC_SANITIZE)
   target_compile_options(mufric_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
                          -fno-sanitize-recover=undefined)

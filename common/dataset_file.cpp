@@ -105,15 +105,20 @@ Dataset read_csv_dataset(const std::string& path) {
 }  // namespace
 
 Dataset read_dataset(const std::string& path) {
-  return ends_with(path, ".csv") ? read_csv_dataset(path) : read_hdf5_dataset(path);
+  if (ends_with(path, ".csv")) return read_csv_dataset(path);
+  try {
+    return read_hdf5_dataset(path);
+  } catch (const H5::Exception& e) {  // what the field-naming reads above do not translate themselves
+    throw Error("dataset '" + path + "': unreadable HDF5 (" + e.getDetailMsg() + ")");
+  }
 }
 
-Dataset read_dataset_isolated(const std::string& path) {
+Dataset read_dataset_isolated(const std::string& path, const IsolationLimits& limits) {
   if (ends_with(path, ".csv")) return read_csv_dataset(path);  // our own parser, no HDF5
   const IsolatedCopy copy = rewrite_in_child(path, "dataset", [](const std::string& original, const std::string& rewritten) {
-    write_dataset(rewritten, read_hdf5_dataset(original));
-  });
-  return read_hdf5_dataset(copy.path());
+    write_dataset(rewritten, read_dataset(original));
+  }, limits);
+  return read_dataset(copy.path());
 }
 
 void write_dataset(const std::string& path, const Dataset& d) {

@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 
 #include "common/h5_file.hpp"
+#include "common/isolation.hpp"
 #include "common/input_space.hpp"
 
 namespace mufric {
@@ -55,7 +56,7 @@ struct TrainingSet {
 Dataset read_dataset(const std::string& path);
 // read_dataset for a file that may be corrupt: an HDF5 file is parsed in a child process and read
 // back from the copy it wrote (common/isolation.hpp), so a crash of the HDF5 library is an Error.
-Dataset read_dataset_isolated(const std::string& path);
+Dataset read_dataset_isolated(const std::string& path, const IsolationLimits& limits = {});
 void write_dataset(const std::string& path, const Dataset& dataset);
 TrainingSet training_set(const Dataset& dataset, const std::string& path);
 

@@ -110,19 +110,33 @@ H5::Attribute Reader::open_attribute(const std::string& object, const std::strin
 std::string Reader::string_attribute(const std::string& object, const std::string& name) const {
   H5::Attribute attribute = open_attribute(object, name, {H5T_STRING}, "a string");
   std::string value;
-  attribute.read(attribute.getStrType(), value);
+  try {
+    attribute.read(attribute.getStrType(), value);
+  } catch (const H5::Exception& e) {
+    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
+  }
   return value;
 }
 
 double Reader::double_attribute(const std::string& object, const std::string& name) const {
   double value = 0.0;
-  open_attribute(object, name, {H5T_FLOAT, H5T_INTEGER}, "a number").read(H5::PredType::NATIVE_DOUBLE, &value);
+  H5::Attribute attribute = open_attribute(object, name, {H5T_FLOAT, H5T_INTEGER}, "a number");
+  try {
+    attribute.read(H5::PredType::NATIVE_DOUBLE, &value);
+  } catch (const H5::Exception& e) {
+    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
+  }
   return value;
 }
 
 long long Reader::int_attribute(const std::string& object, const std::string& name) const {
   long long value = 0;
-  open_attribute(object, name, {H5T_INTEGER}, "an integer").read(H5::PredType::NATIVE_LLONG, &value);
+  H5::Attribute attribute = open_attribute(object, name, {H5T_INTEGER}, "an integer");
+  try {
+    attribute.read(H5::PredType::NATIVE_LLONG, &value);
+  } catch (const H5::Exception& e) {
+    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
+  }
   return value;
 }
 

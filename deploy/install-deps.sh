@@ -18,6 +18,8 @@ packages=(
   libopenblas-dev
   # benchmark peer (scikit-learn on OpenBLAS) and plots; run with /usr/bin/python3
   python3-sklearn python3-numpy python3-h5py python3-matplotlib libopenblas0-pthread
+  # fuzzing: clang with libFuzzer and its OpenMP runtime (tests/fuzz, a second build)
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev libomp-14-dev
   # a single-node Slurm cluster for the array-job integration test (deploy/slurm)
   slurm-wlm munge
 )

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite on a fresh Debian 12 machine: installs dependencies, builds (Release, with
 # tests) and runs every test, then builds the unit tests with AddressSanitizer + UndefinedBehavior-
-# Sanitizer and runs them again. This is the README's test command and what .ci/run calls.
+# Sanitizer and runs them again, and runs every libFuzzer target briefly (a clang build). This is the
+# README's test command and what .ci/run calls.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${MUFRIC_JOBS:-2}
@@ -12,6 +13,12 @@ echo "== Release build and full test suite"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DMUFRIC_BUILD_TESTS=ON
 cmake --build build -j "$jobs"
 ctest --test-dir build -j "$jobs" --output-on-failure --timeout 600
+
+echo "== Fuzzing: clang build with libFuzzer + ASan/UBSan, every target ${MUFRIC_FUZZ_SECONDS:-10} s, faults triaged"
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMUFRIC_FUZZ=ON \
+  -DMUFRIC_NATIVE=OFF -DMUFRIC_BUILD_TESTS=OFF -DMUFRIC_BUILD_BENCH=OFF
+cmake --build build-fuzz -j "$jobs" --target fuzz_targets
+bash tests/fuzz/run_fuzzers.sh build-fuzz build/app/mufric "${MUFRIC_FUZZ_SECONDS:-10}" build-fuzz/run
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build: unit (incl. micro-solver), service and CLI tests"
 # Portable code generation here: the sanitizers check correctness, and GCC 12 emits false

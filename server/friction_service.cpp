@@ -111,8 +111,8 @@ int threads_per_evaluation(int evaluation_threads, int in_flight) {
   return std::max(1, evaluation_threads / std::max(1, in_flight));
 }
 
-grpc::Status FrictionService::evaluate(const grpc::CallbackServerContext& context, const EvaluateRequest& request,
-                                       mufric::v1::EvaluateResponse& response) {
+grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v1::EvaluateResponse& response,
+                                       const CallerCheck& gone_check) {
   const auto served = registry_.find(request.model());
   if (!served) {
     return {grpc::StatusCode::NOT_FOUND, "model '" + request.model() + "' is not served; serving: " + registry_.names()};
@@ -153,7 +153,7 @@ grpc::Status FrictionService::evaluate(const grpc::CallbackServerContext& contex
   // Chunks, so that a call whose caller has given up (deadline passed, cancelled) stops within a
   // few milliseconds instead of computing an answer nobody reads.
   for (int first = 0; first < n; first += static_cast<int>(kPointsBetweenDeadlineChecks)) {
-    if (grpc::Status gone = caller_gone(context, first, n); !gone.ok()) {
+    if (grpc::Status gone = gone_check ? gone_check(first, n) : grpc::Status::OK; !gone.ok()) {
       ++counters_.abandoned;
       return gone;
     }
@@ -211,7 +211,7 @@ grpc::Status FrictionService::handle(const grpc::CallbackServerContext& context,
   omp_set_num_threads(threads_per_evaluation(limits_.evaluation_threads, counters_.in_flight.load()));
   grpc::Status status;
   try {
-    status = evaluate(context, request, response);
+    status = evaluate(request, response, [&context](int done, int total) { return caller_gone(context, done, total); });
   } catch (const std::exception& e) {
     status = grpc::Status(grpc::StatusCode::INTERNAL, std::string("evaluation failed: ") + e.what());
   }

@@ -1,6 +1,7 @@
 #pragma once
 // The gRPC FrictionService (callback API) over a ModelRegistry.
 #include <array>
+#include <functional>
 #include <atomic>
 #include <chrono>
 #include <string>
@@ -65,6 +66,14 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   };
   const Counters& counters() const { return counters_; }
 
+  // OK while the caller still waits after `done` of `total` points; otherwise why it is gone.
+  using CallerCheck = std::function<grpc::Status(int done, int total)>;
+  // Everything an Evaluate does after authorisation, without a gRPC call around it (the request
+  // fuzzer drives this): validates the request, evaluates it in chunks, asking `caller_gone`
+  // between chunks (empty: the caller always waits). Throws only what a model throws.
+  grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response,
+                        const CallerCheck& caller_gone = {});
+
  private:
   class StreamReactor;
   grpc::Status authorise(const grpc::CallbackServerContext& context) const;
@@ -74,8 +83,6 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   // `context` gives the call's deadline and cancellation, checked between chunks of points.
   grpc::Status handle(const grpc::CallbackServerContext& context, const mufric::v1::EvaluateRequest& request,
                       mufric::v1::EvaluateResponse& response);
-  grpc::Status evaluate(const grpc::CallbackServerContext& context, const mufric::v1::EvaluateRequest& request,
-                        mufric::v1::EvaluateResponse& response);
 
   const ModelRegistry& registry_;
   ServiceLimits limits_;

@@ -81,7 +81,8 @@ void save_model(const std::string& path, const FrictionModel& model) {
   out.commit();
 }
 
-std::unique_ptr<FrictionModel> load_model(const std::string& path) {
+namespace {
+std::unique_ptr<FrictionModel> read_model(const std::string& path) {
   const h5::Reader in(path, "model");
   in.require_format(kModelFormat, kModelSchemaVersion, "mufric model");
   InputSpace inputs = read_input_space(in);
@@ -99,11 +100,20 @@ std::unique_ptr<FrictionModel> load_model(const std::string& path) {
   }
   in.fail("/", "unknown model kind '" + kind + "' (known: gp, mlr, coulomb)");
 }
+}  // namespace
 
-std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path) {
+std::unique_ptr<FrictionModel> load_model(const std::string& path) {
+  try {
+    return read_model(path);
+  } catch (const H5::Exception& e) {  // what the field-naming reads do not translate themselves
+    throw Error("model '" + path + "': unreadable HDF5 (" + e.getDetailMsg() + ")");
+  }
+}
+
+std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, const IsolationLimits& limits) {
   const IsolatedCopy copy = rewrite_in_child(path, "model", [](const std::string& original, const std::string& rewritten) {
     save_model(rewritten, *load_model(original));
-  });
+  }, limits);
   return load_model(copy.path());
 }
 

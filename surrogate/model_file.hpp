@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "common/isolation.hpp"
 #include "surrogate/friction_model.hpp"
 
 namespace mufric {
@@ -19,7 +20,7 @@ std::unique_ptr<FrictionModel> load_model(const std::string& path);
 // load_model for a file that may be corrupt or hostile: parsed and validated in a child process
 // (common/isolation.hpp), then read back from the copy the child wrote. A file that crashes or hangs
 // the HDF5 library becomes an Error naming it. For the CLI and the server, not for a meso code.
-std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path);
+std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, const IsolationLimits& limits = {});
 
 // "file:///abs/model.h5", "file://rel/model.h5" or a plain path → the path; other schemes throw.
 std::string model_path_from_uri(const std::string& uri);
