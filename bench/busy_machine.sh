@@ -30,16 +30,16 @@ serve_load() {  # ADDRESS
   "$mufric" bench --model "grpc://$1/gp" --batch 1024 --seconds 3 --std --clients 4 --json |
     sed -n 's/.*"points_per_second": \([0-9.e+]*\).*/\1/p' | awk '{ printf "%.4f", 1e6 / $1 }'
 }
-start_server() {  # NAME [PREFIX...]: starts a server, prints its address
+start_server() {  # NAME [PREFIX...]: starts a server in the background; its address goes to NAME.address
   local name=$1; shift
-  "$@" "$mufric" serve --models models --listen 127.0.0.1:0 --ready-file "$name.address" 2>"$name.log" &
+  "$@" "$mufric" serve --models models --listen 127.0.0.1:0 --ready-file "$name.address" >"$name.out" 2>"$name.log" &
   servers+=($!)
-  for _ in $(seq 100); do [[ -s $name.address ]] && break; sleep 0.05; done
-  cat "$name.address"
 }
 servers=()
-address=$(start_server default)
-address_one_core=$(start_server one env OMP_NUM_THREADS=1 taskset -c 0)
+start_server default
+start_server one env OMP_NUM_THREADS=1 taskset -c 0
+for _ in $(seq 100); do [[ -s default.address && -s one.address ]] && break; sleep 0.05; done
+address=$(cat default.address) address_one_core=$(cat one.address)
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; load before: $(cut -d' ' -f1 /proc/loadavg)"
 echo
 echo "serve_load: seconds per million points (4 clients, batch 1024, mean + 95 % interval); its one-core"
