@@ -4,25 +4,39 @@
 # Run as root (or with sudo available) on a fresh Debian 12 machine.
 set -euo pipefail
 
-packages=(
-  # toolchain and test/bench frameworks
+# What to install: "all" (default: build, tests, benchmarks, fuzzing, Slurm and container tests) or
+# "build" (only what compiling the mufric executable needs, e.g. inside deploy/Dockerfile).
+profile=${1:-all}
+build_packages=(
+  # toolchain
   build-essential cmake ninja-build pkg-config git
-  libgtest-dev libgmock-dev libbenchmark-dev
   # numerical core
   libeigen3-dev libsuitesparse-dev libnlopt-dev libnlopt-cxx-dev libboost-dev
   # files and command line
-  libhdf5-dev hdf5-tools nlohmann-json3-dev libcli11-dev libssl-dev openssl
-  # the service: gRPC + Protobuf (C++ and Python), Fortran for the Fortran client
-  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc python3-grpcio python3-grpc-tools gfortran
+  libhdf5-dev nlohmann-json3-dev libcli11-dev libssl-dev
+  # the service: gRPC + Protobuf
+  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   # LAPACK (Cholesky, inverse) from OpenBLAS
   libopenblas-dev
+)
+test_packages=(
+  libgtest-dev libgmock-dev libbenchmark-dev hdf5-tools openssl
+  # Python clients and Fortran for the Fortran client
+  python3-grpcio python3-grpc-tools gfortran
   # benchmark peer (scikit-learn on OpenBLAS) and plots; run with /usr/bin/python3
   python3-sklearn python3-numpy python3-h5py python3-matplotlib libopenblas0-pthread
   # fuzzing: clang with libFuzzer and its OpenMP runtime (tests/fuzz, a second build)
   clang-14 libclang-rt-14-dev libfuzzer-14-dev libomp-14-dev
   # a single-node Slurm cluster for the array-job integration test (deploy/slurm)
   slurm-wlm munge
+  # the container test: podman with runc, and mmdebstrap for a base image made offline
+  podman runc uidmap mmdebstrap
 )
+case $profile in
+  all) packages=("${build_packages[@]}" "${test_packages[@]}") ;;
+  build) packages=("${build_packages[@]}") ;;
+  *) echo "install-deps: unknown profile '$profile' (all or build)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
