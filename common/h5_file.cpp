@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -33,11 +35,20 @@ std::vector<hsize_t> dims_of(const H5::DataSet& ds) {
   return dims;
 }
 
-hsize_t count_of(const std::vector<hsize_t>& dims) {
+// The product of `dims`, or nothing when it overflows.
+std::optional<hsize_t> count_of(const std::vector<hsize_t>& dims) {
   hsize_t n = 1;
-  for (hsize_t d : dims) n *= d;
+  for (hsize_t d : dims) {
+    if (d != 0 && n > std::numeric_limits<hsize_t>::max() / d) return std::nullopt;
+    n *= d;
+  }
   return n;
 }
+
+// Every value mufric stores takes at least this many bytes in the file: 8 for a double or an
+// integer, 16 for a variable-length string's global-heap reference.
+constexpr size_t kBytesPerNumber = 8;
+constexpr size_t kBytesPerString = 16;
 
 }  // namespace
 
@@ -46,6 +57,8 @@ void quiet_hdf5_errors() { H5::Exception::dontPrint(); }
 Reader::Reader(const std::string& path, const std::string& what) : path_(path), what_(what) {
   quiet_hdf5_errors();
   if (!std::filesystem::exists(path)) throw Error(what + " '" + path + "': no such file");
+  std::error_code size_error;
+  file_bytes_ = std::filesystem::file_size(path, size_error);
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     throw Error(what + " '" + path + "': not an HDF5 file (corrupt, truncated or another format)");
   }
@@ -71,6 +84,20 @@ H5::DataSet Reader::open_dataset(const std::string& dataset) const {
   } catch (const H5::Exception& e) {
     fail(dataset, "unreadable (" + e.getDetailMsg() + ")");
   }
+}
+
+size_t Reader::value_count(const std::string& dataset, const H5::DataSet& ds, size_t min_bytes_per_value) const {
+  std::vector<hsize_t> dims;
+  try {
+    dims = dims_of(ds);
+  } catch (const H5::Exception& e) {
+    fail(dataset, "unreadable shape (" + e.getDetailMsg() + ")");
+  }
+  const auto count = count_of(dims);
+  if (!count || *count > file_bytes_ / min_bytes_per_value) {
+    fail(dataset, "declares more values than the file (" + std::to_string(file_bytes_) + " bytes) can hold: corrupt");
+  }
+  return static_cast<size_t>(*count);
 }
 
 H5::H5Object& Reader::object_for_attribute(const std::string& object, H5::Group& group_storage) const {
@@ -154,7 +181,7 @@ void Reader::require_format(const std::string& format, long long version, const 
 std::vector<double> Reader::doubles(const std::string& dataset) const {
   H5::DataSet ds = open_dataset(dataset);
   if (ds.getTypeClass() != H5T_FLOAT) fail(dataset, "is not floating point");
-  std::vector<double> values(count_of(dims_of(ds)));
+  std::vector<double> values(value_count(dataset, ds, kBytesPerNumber));
   try {
     if (!values.empty()) ds.read(values.data(), H5::PredType::NATIVE_DOUBLE);
   } catch (const H5::Exception& e) {
@@ -166,7 +193,7 @@ std::vector<double> Reader::doubles(const std::string& dataset) const {
 std::vector<long long> Reader::ints(const std::string& dataset) const {
   H5::DataSet ds = open_dataset(dataset);
   if (ds.getTypeClass() != H5T_INTEGER) fail(dataset, "is not integer");
-  std::vector<long long> values(count_of(dims_of(ds)));
+  std::vector<long long> values(value_count(dataset, ds, kBytesPerNumber));
   try {
     if (!values.empty()) ds.read(values.data(), H5::PredType::NATIVE_LLONG);
   } catch (const H5::Exception& e) {
@@ -178,7 +205,7 @@ std::vector<long long> Reader::ints(const std::string& dataset) const {
 std::vector<std::string> Reader::strings(const std::string& dataset) const {
   H5::DataSet ds = open_dataset(dataset);
   if (ds.getTypeClass() != H5T_STRING) fail(dataset, "is not a string array");
-  const hsize_t n = count_of(dims_of(ds));
+  const size_t n = value_count(dataset, ds, kBytesPerString);
   std::vector<char*> raw(n, nullptr);
   H5::StrType type = variable_string_type();
   try {
@@ -201,6 +228,7 @@ RowMatrix Reader::matrix(const std::string& dataset) const {
   const auto dims = dims_of(ds);
   if (dims.size() != 2) fail(dataset, "expected a 2-D array, found rank " + std::to_string(dims.size()));
   if (ds.getTypeClass() != H5T_FLOAT) fail(dataset, "is not floating point");
+  value_count(dataset, ds, kBytesPerNumber);
   RowMatrix values(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(dims[1]));
   try {
     if (values.size() > 0) ds.read(values.data(), H5::PredType::NATIVE_DOUBLE);

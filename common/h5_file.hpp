@@ -4,6 +4,7 @@
 #include <H5Cpp.h>
 
 #include <Eigen/Dense>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -40,12 +41,16 @@ class Reader {
 
  private:
   H5::DataSet open_dataset(const std::string& dataset) const;
+  // The number of values `dataset` declares, refused when the file is too small to hold them at
+  // `min_bytes_per_value` each: a corrupt dataspace must not make us allocate terabytes.
+  size_t value_count(const std::string& dataset, const H5::DataSet& ds, size_t min_bytes_per_value) const;
   H5::H5Object& object_for_attribute(const std::string& object, H5::Group& group_storage) const;
   // Opens an existing attribute of `object` whose type class is one of `classes`, or fails naming it.
   H5::Attribute open_attribute(const std::string& object, const std::string& name, std::initializer_list<H5T_class_t> classes,
                                const std::string& expected) const;
   std::string path_;
   std::string what_;
+  std::uintmax_t file_bytes_ = 0;
   mutable H5::H5File file_;
 };
 

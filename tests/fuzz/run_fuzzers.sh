@@ -50,12 +50,14 @@ seed() {  # builds $out/seeds/<target>
 }
 
 # The owner of a fault: an exception nobody caught is always mufric's (whoever threw it); otherwise
-# the library of the first stack frame that is not the sanitizers', libFuzzer's or the C/C++ runtime's.
+# the library of the first stack frame that is not the sanitizers' (their interceptors of malloc,
+# str*, mem* included), libFuzzer's, main's or the C/C++ runtime's. For an out-of-memory report that
+# is the first live allocation not made by libFuzzer itself.
 owner() {  # log
   local frame
   if grep -qE 'std::terminate|__cxa_throw|uncaught exception' "$1"; then echo mufric; return; fi
   frame=$(grep -E '^ +#[0-9]+ ' "$1" |
-          grep -vE 'libclang_rt|compiler-rt|sanitizer_common|/asan/|/ubsan/|libFuzzer|fuzzer/Fuzzer| in fuzzer::|libc\.so|nptl/|stdlib/|signal/|sysdeps/|libstdc\+\+|libgcc|in (abort|raise|__GI_|gsignal|malloc|free|calloc|realloc|operator new|operator delete|__interceptor_|__asan|__sanitizer|__ubsan)' |
+          grep -vE 'libclang_rt|compiler-rt|sanitizer_common|/asan/|/ubsan/|libFuzzer|fuzzer/Fuzzer| in fuzzer::|libc\.so|nptl/|stdlib/|signal/|sysdeps/|libstdc\+\+|libgcc|in (abort|raise|__GI_|gsignal|malloc|free|calloc|realloc|operator new|operator delete|__interceptor_|__asan|__sanitizer|__ubsan|str[a-z]*|mem[a-z]*|main|_start) |in main \\(|__libc_start' |
           head -1)
   if [[ -z $frame ]]; then echo unknown; elif [[ $frame == *libhdf5* || $frame == *H5* ]]; then echo hdf5; else echo mufric; fi
 }
