@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <numbers>
+#include <sstream>
 
 #include "common/error.hpp"
 #include "micro/scene/micro_run.hpp"
@@ -57,6 +58,30 @@ TEST(Scene, ErrorsNameTheKey) {
   apply_override(kelvin, "load.temperature=500K");
   EXPECT_DOUBLE_EQ(parse_scene(kelvin, "s").temperature, 500.0);
   EXPECT_THROW(apply_override(kelvin, "novalue"), Error);
+}
+
+// Regression (fuzz_scene_json): a number JSON cannot hold (1e999...) threw nlohmann's out_of_range,
+// which nothing caught, from a scene file and from a --set override. Both are now an Error or a
+// value the key's own check refuses; the fuzzer's inputs are replayed as a file and as an override.
+TEST(Scene, NumbersJsonCannotHoldAreErrors) {
+  EXPECT_THROW(scene_with_overrides(default_scene_json(), {"load.pressure=1e999"}, "test"), Error);
+  const std::string path = (std::filesystem::temp_directory_path() / "mufric_overflow_scene.json").string();
+  std::ofstream(path) << R"({"physics": "dry", "contact": {"penalty": 1e999}})";
+  EXPECT_THROW(load_scene(path, {}), Error);
+  std::filesystem::remove(path);
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(MUFRIC_SOURCE_DIR) / "tests/fuzz/regressions/fuzz_scene_json")) {
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    try {
+      load_scene(entry.path().string(), {});
+    } catch (const Error&) {
+    }
+    try {
+      scene_with_overrides(default_scene_json(), {bytes.str()}, "fuzz");
+    } catch (const Error&) {
+    }
+  }
 }
 
 TEST(MicroRun, FlatToolTransmitsNoTangentialForce) {

@@ -131,7 +131,7 @@ nlohmann::json read_scene_json(const std::string& path) {
   if (!text) throw Error(path + ": cannot read the scene file");
   try {
     return json::parse(*text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
     throw Error(path + ": not valid JSON: " + e.what());
   }
 }
@@ -143,8 +143,8 @@ void apply_override(nlohmann::json& scene, const std::string& assignment) {
   json value;
   try {
     value = json::parse(text);
-  } catch (const json::parse_error&) {
-    value = text;  // "800MPa" and other unit strings
+  } catch (const json::exception&) {
+    value = text;  // "800MPa" and other unit strings (and numbers JSON cannot hold, refused by the key's check)
   }
   json* node = &scene;
   size_t start = 0;
