@@ -38,6 +38,13 @@ std::string unique_copy_path() {
 
 [[noreturn]] void child_main(int fd, const std::string& original, const std::string& copy, const Rewrite& rewrite,
                              const IsolationLimits& limits) {
+  // What a dying parse prints (glibc's "malloc(): corrupted ...", a sanitizer's report) is not the
+  // caller's output: its one-line error says what happened.
+  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
+    ::dup2(null, STDOUT_FILENO);
+    ::dup2(null, STDERR_FILENO);
+    ::close(null);
+  }
   if (kAddressSpaceLimitAllowed && limits.memory_bytes > 0) {
     const rlimit memory{limits.memory_bytes, limits.memory_bytes};
     setrlimit(RLIMIT_AS, &memory);
