@@ -140,7 +140,7 @@ for name in duplicated-same duplicated-conflicting clustered-1e-6 noisy-50pct n1
     train_cell="ok: $(grep -oE 'mean relative error [0-9.e+-]+ %' <<< "$train" | head -1)"
     predict=$("$mufric" predict --model "$out/$name.h5" --p 800MPa --v 100m/min --T 500C 2>&1 | grep -E '^mu' || echo "predict failed")
   else
-    train_cell="refused (exit $code): $(tail -1 <<< "$train" | cut -c1-150)"; predict="-"
+    train_cell="refused (exit $code): $(grep -m1 'error:' <<< "$train" | cut -c1-170)"; predict="-"
   fi
   printf '| %s | %s | %s |\n' "$name" "${train_cell//|//}" "${predict//|//}"
 done
