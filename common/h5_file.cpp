@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -134,36 +135,32 @@ H5::Attribute Reader::open_attribute(const std::string& object, const std::strin
   }
 }
 
-std::string Reader::string_attribute(const std::string& object, const std::string& name) const {
-  H5::Attribute attribute = open_attribute(object, name, {H5T_STRING}, "a string");
-  std::string value;
+void Reader::read_attribute(const std::string& object, const std::string& name, const std::function<void()>& read) const {
   try {
-    attribute.read(attribute.getStrType(), value);
+    read();
   } catch (const H5::Exception& e) {
     fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
   }
+}
+
+std::string Reader::string_attribute(const std::string& object, const std::string& name) const {
+  H5::Attribute attribute = open_attribute(object, name, {H5T_STRING}, "a string");
+  std::string value;
+  read_attribute(object, name, [&] { attribute.read(attribute.getStrType(), value); });
   return value;
 }
 
 double Reader::double_attribute(const std::string& object, const std::string& name) const {
   double value = 0.0;
   H5::Attribute attribute = open_attribute(object, name, {H5T_FLOAT, H5T_INTEGER}, "a number");
-  try {
-    attribute.read(H5::PredType::NATIVE_DOUBLE, &value);
-  } catch (const H5::Exception& e) {
-    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
-  }
+  read_attribute(object, name, [&] { attribute.read(H5::PredType::NATIVE_DOUBLE, &value); });
   return value;
 }
 
 long long Reader::int_attribute(const std::string& object, const std::string& name) const {
   long long value = 0;
   H5::Attribute attribute = open_attribute(object, name, {H5T_INTEGER}, "an integer");
-  try {
-    attribute.read(H5::PredType::NATIVE_LLONG, &value);
-  } catch (const H5::Exception& e) {
-    fail(object, "attribute '" + name + "' unreadable (" + e.getDetailMsg() + ")");
-  }
+  read_attribute(object, name, [&] { attribute.read(H5::PredType::NATIVE_LLONG, &value); });
   return value;
 }
 

@@ -4,6 +4,7 @@
 #include <H5Cpp.h>
 
 #include <Eigen/Dense>
+#include <functional>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -48,6 +49,8 @@ class Reader {
   // Opens an existing attribute of `object` whose type class is one of `classes`, or fails naming it.
   H5::Attribute open_attribute(const std::string& object, const std::string& name, std::initializer_list<H5T_class_t> classes,
                                const std::string& expected) const;
+  // Runs an attribute read; an HDF5 exception from it becomes Error naming the object and attribute.
+  void read_attribute(const std::string& object, const std::string& name, const std::function<void()>& read) const;
   std::string path_;
   std::string what_;
   std::uintmax_t file_bytes_ = 0;
