@@ -1,9 +1,9 @@
 #pragma once
 // The gRPC FrictionService (callback API) over a ModelRegistry.
 #include <array>
-#include <functional>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -69,10 +69,10 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
   // OK while the caller still waits after `done` of `total` points; otherwise why it is gone.
   using CallerCheck = std::function<grpc::Status(int done, int total)>;
   // Everything an Evaluate does after authorisation, without a gRPC call around it (the request
-  // fuzzer drives this): validates the request, evaluates it in chunks, asking `caller_gone`
+  // fuzzer drives this): validates the request, evaluates it in chunks, asking `gone_check`
   // between chunks (empty: the caller always waits). Throws only what a model throws.
   grpc::Status evaluate(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response,
-                        const CallerCheck& caller_gone = {});
+                        const CallerCheck& gone_check = {});
 
  private:
   class StreamReactor;
