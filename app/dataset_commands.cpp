@@ -271,12 +271,16 @@ void refine_command(const RefineOptions& o) {
 // What a database holds: provenance, how much of its plan is done, why samples failed.
 void status_command(const std::string& path) {
   const Dataset d = read_dataset_isolated(path);
-  long long converged = 0;
-  std::map<std::string, long long> reasons;
+  long long converged = 0, outside = 0, with_std = 0;
+  std::map<std::string, long long> reasons, outside_reasons;
   std::set<long long> answered;
   for (Eigen::Index i = 0; i < d.size(); ++i) {
     if (d.converged(i)) {
       ++converged;
+      with_std += std::isfinite(d.mu_std(i));
+    } else if (d.outside_model(i)) {
+      ++outside;
+      ++outside_reasons[d.failure_reason[static_cast<size_t>(i)].substr(0, 120)];
     } else {
       ++reasons[d.failure_reason[static_cast<size_t>(i)].substr(0, 120)];
     }
@@ -287,8 +291,8 @@ void status_command(const std::string& path) {
   std::printf("  plan: %lld points%s%s", static_cast<long long>(d.plan.rows()), d.plan_design.empty() ? "" : ", design ",
               d.plan_design.c_str());
   if (!d.plan_design.empty()) std::printf(" (seed %lld)", d.plan_seed);
-  std::printf("\n  samples: %lld (%lld converged, %lld failed)", static_cast<long long>(d.size()), converged,
-              static_cast<long long>(d.size()) - converged);
+  std::printf("\n  samples: %lld (%lld converged, %lld outside the model, %lld failed)", static_cast<long long>(d.size()),
+              converged, outside, static_cast<long long>(d.size()) - converged - outside);
   if (!d.plan_index.empty() || d.size() == 0) {
     std::printf("; %lld of %lld plan points not yet run", static_cast<long long>(d.plan.rows()) - static_cast<long long>(answered.size()),
                 static_cast<long long>(d.plan.rows()));
@@ -302,14 +306,18 @@ void status_command(const std::string& path) {
       lo = std::min(lo, d.mu(i));
       hi = std::max(hi, d.mu(i));
     }
-    std::printf("  mu: %.5f .. %.5f\n", lo, hi);
+    std::printf("  mu: %.5f .. %.5f; %lld of %lld converged samples carry their standard error\n", lo, hi, with_std, converged);
   }
+  if (!d.note.empty()) std::printf("  note: %s\n", d.note.c_str());
   if (const auto it = d.diagnostics.find("wall_seconds"); it != d.diagnostics.end() && d.size() > 0) {
     const double total = it->second.array().isNaN().select(0.0, it->second.array()).sum();
     std::printf("  micro-model time: %s in total, %s per sample\n", duration_text(total).c_str(),
                 duration_text(total / static_cast<double>(d.size())).c_str());
   }
   for (const auto& [reason, count] : reasons) std::printf("  failed x%lld: %s\n", count, reason.c_str());
+  for (const auto& [reason, count] : outside_reasons) {
+    std::printf("  outside the model (not trained on) x%lld: %s\n", count, reason.c_str());
+  }
 }
 
 struct MergeOptions {

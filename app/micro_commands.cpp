@@ -1,6 +1,8 @@
 // `mufric micro …`: the micro-model's user-facing steps. So far: surface profiles (measured or
 // synthetic), their roughness and their periodic spline fit.
+#include <chrono>
 #include <cmath>
+#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -83,64 +85,128 @@ std::string mu_text(const std::optional<double>& mu) {
   return text;
 }
 
-void print_progress(const scene::MicroStep& s, const scene::Scene& sc) {
-  std::fprintf(stderr, "t %7.1f ns / %.1f ns  mu %s  contact %5.1f %%  max p %8.1f MPa\n", s.time * 1e9,
-               sc.duration * 1e9, mu_text(s.mu).c_str(), 100.0 * s.contact_fraction, s.max_pressure / 1e6);
+// Per-step progress, throttled for measurements of several draws running at once (one line per
+// draw and second at most, and every line says which draw it is).
+class Progress {
+ public:
+  explicit Progress(size_t draws) : last_(draws, std::chrono::steady_clock::time_point{}), draws_(draws) {}
+  void operator()(int draw, const scene::MicroStep& s, const scene::Scene& sc) {
+    const auto now = std::chrono::steady_clock::now();
+    auto& last = last_[static_cast<size_t>(draw)];
+    if (draws_ > 1 && now - last < std::chrono::seconds(1)) return;
+    last = now;
+    const std::string who = draws_ > 1 ? "draw " + std::to_string(draw + 1) + "/" + std::to_string(draws_) + "  " : "";
+    if (sc.protocol.name == scene::Protocol::seed000) {
+      std::fprintf(stderr, "%st %7.1f ns / %.1f ns  mu %s  contact %5.1f %%  max p %8.1f MPa\n", who.c_str(),
+                   s.time * 1e9, sc.duration * 1e9, mu_text(s.mu).c_str(), 100.0 * s.contact_fraction, s.max_pressure / 1e6);
+    } else {
+      const double total = sc.protocol.run_in + sc.protocol.window;
+      std::fprintf(stderr, "%st %8.1f ns  %s %6.3f / %.3f um  mu %s  contact %5.1f %%  max p %8.1f MPa\n", who.c_str(),
+                   s.time * 1e9, s.sliding_distance > 0.0 ? "slid" : "pressing, slid", s.sliding_distance * 1e6,
+                   total * 1e6, mu_text(s.mu).c_str(), 100.0 * s.contact_fraction, s.max_pressure / 1e6);
+    }
+  }
+
+ private:
+  std::vector<std::chrono::steady_clock::time_point> last_;
+  size_t draws_;
+};
+
+std::string relative_percent(double value, double mu) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f %%", 100.0 * value / std::max(std::abs(mu), 1e-300));
+  return text;
 }
 
-void print_summary(const scene::MicroResult& r, const scene::Scene& sc) {
-  if (r.completed) {
-    std::printf("mu = %.5f  (eq. 17, time average over [%.1f, %.1f] ns, %d steps)\n", r.mu, sc.average_from * 1e9,
-                sc.duration * 1e9, r.averaged_steps);
+void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
+  const scene::ProtocolSpec& q = sc.protocol;
+  if (m.completed && q.name == scene::Protocol::seed000) {
+    const auto& r = m.draws.front().result;
+    std::printf("mu = %.5f  (seed 000 protocol: one draw, eq. 17 time-averaged over [%.1f, %.1f] ns, %d steps; no "
+                "error bar)\n", m.mu, sc.average_from * 1e9, sc.duration * 1e9, r.averaged_steps);
+  } else if (m.completed) {
+    std::printf("mu = %.5f +- %.5f (standard error, %s)  press-slide protocol: mean of %zu draws (%d tool phases x %d "
+                "realisations), each pressed %.0f + %.0f ns, then averaged over %.3f um of sliding after a %.3f um "
+                "run-in; largest drift over a window %s\n",
+                m.mu, m.std_error.value_or(0.0), relative_percent(m.std_error.value_or(0.0), m.mu).c_str(), m.draws.size(),
+                q.phases, q.realisations, sc.ramp * 1e9, q.press_hold * 1e9, q.window * 1e6, q.run_in * 1e6,
+                relative_percent(m.max_abs_drift(), 1.0).c_str());
+    if (m.draws.size() > 1) {
+      std::printf("| draw | tool shift | tool seed | mu | block means | drift | steps | Newton | cut-backs | wall [s] |\n"
+                  "|---|---|---|---|---|---|---|---|---|---|\n");
+      for (size_t i = 0; i < m.draws.size(); ++i) {
+        const auto& d = m.draws[i];
+        std::string blocks;
+        for (double b : d.result.block_means) {
+          char t[16];
+          std::snprintf(t, sizeof t, "%s%.4f", blocks.empty() ? "" : " ", b);
+          blocks += t;
+        }
+        std::printf("| %zu | %.3f | %llu | %.5f | %s | %s | %zu | %d | %zu | %.1f |\n", i + 1, d.shift_fraction,
+                    static_cast<unsigned long long>(d.seed), d.result.mu, blocks.c_str(),
+                    relative_percent(d.result.drift, 1.0).c_str(), d.result.history.size(),
+                    d.result.solver.newton_iterations, d.result.solver.cutbacks.size(), d.result.wall_seconds);
+      }
+    }
   } else {
-    std::printf("run did not complete: %s\n", r.reason.c_str());
+    std::printf("run did not complete: %s\n", m.reason.c_str());
   }
-  std::printf("contact area %.1f %% of the interval, max contact pressure %s, max plastic strain %.4f, max temperature %s\n",
+  const auto& r = m.draws.front().result;
+  std::printf("first draw: contact area %.1f %% of the interval, max contact pressure %s, max plastic strain %.4f, max "
+              "temperature %s\n",
               100.0 * r.contact_fraction, format_human(r.max_contact_pressure, QuantityKind::pressure).c_str(),
               r.max_plastic_strain, format_human(r.max_temperature, QuantityKind::temperature).c_str());
-  std::printf("%d elements, %d dofs, %zu steps, %d Newton iterations (%d assemblies, %d line-search reductions), "
-              "%zu cut-backs, %.2f s (assembly %.2f s of which contact %.2f s, solve %.2f s)\n",
+  std::printf("%d elements, %d dofs; first draw: %zu steps, %d Newton iterations (%d assemblies, %d line-search "
+              "reductions), %zu cut-backs, %.2f s (assembly %.2f s of which contact %.2f s, solve %.2f s); all %zu "
+              "draws on %d thread(s): %.2f s\n",
               r.elements, r.dofs, r.history.size(), r.solver.newton_iterations, r.solver.assemblies,
               r.solver.line_search_reductions, r.solver.cutbacks.size(), r.wall_seconds, r.solver.seconds_assembly,
-              r.solver.seconds_contact, r.solver.seconds_solve);
-  for (const auto& c : r.solver.cutbacks) std::printf("  cut-back at %.2f ns (dt %.3g s): %s\n", c.time * 1e9, c.dt_failed, c.reason.c_str());
-  for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
+              r.solver.seconds_contact, r.solver.seconds_solve, m.draws.size(), m.threads, m.wall_seconds);
+  for (size_t i = 0; i < m.draws.size(); ++i) {
+    for (const auto& c : m.draws[i].result.solver.cutbacks) {
+      std::printf("  draw %zu: cut-back at %.2f ns (dt %.3g s): %s\n", i + 1, c.time * 1e9, c.dt_failed, c.reason.c_str());
+    }
+  }
+  for (const auto& w : m.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
 int run_command(const RunCommandOptions& o) {
   const scene::Scene sc = load_scene(o);
   std::filesystem::create_directories(o.out);
-  scene::RunOptions options;
+  scene::MeasureOptions options;
   options.vtu_directory = o.out;
-  if (!o.quiet) options.on_step = print_progress;
-  const scene::MicroResult r = scene::run_micro(sc, options);
-  write_file_atomically(o.out + "/result.json", r.to_json(sc).dump(2) + "\n");
-  print_summary(r, sc);
-  std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu\n", o.out.c_str(), o.out.c_str(), o.out.c_str());
-  return r.completed ? 0 : 3;
+  Progress progress(scene::protocol_draws(sc).size());
+  if (!o.quiet) options.on_step = std::ref(progress);
+  const scene::MuMeasurement m = scene::measure_mu(sc, options);
+  write_file_atomically(o.out + "/result.json", m.to_json(sc).dump(2) + "\n");
+  print_summary(m, sc);
+  std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu (first draw)\n", o.out.c_str(), o.out.c_str(), o.out.c_str());
+  return m.completed ? 0 : 3;
 }
 
 int converge_command(const RunCommandOptions& o) {
   scene::Scene sc = load_scene(o);
-  std::printf("| level | elements | dofs | mu | change | wall [s] |\n|---|---|---|---|---|---|\n");
+  std::printf("| level | elements | dofs | mu | std error | change | wall [s] |\n|---|---|---|---|---|---|---|\n");
   std::optional<double> previous;
   for (int level = 0; level <= o.max_levels; ++level) {
-    const scene::MicroResult r = scene::run_micro(sc);
-    if (!r.completed) {
-      std::printf("| %d | %d | %d | failed | | %.2f |\n", level, r.elements, r.dofs, r.wall_seconds);
-      std::printf("level %d did not complete: %s\n", level, r.reason.c_str());
+    const scene::MuMeasurement m = scene::measure_mu(sc);
+    const auto& r = m.draws.front().result;
+    if (!m.completed) {
+      std::printf("| %d | %d | %d | failed | | | %.2f |\n", level, r.elements, r.dofs, m.wall_seconds);
+      std::printf("level %d did not complete: %s\n", level, m.reason.c_str());
       return 3;
     }
-    const double change = previous ? std::abs(r.mu - *previous) / std::max(std::abs(r.mu), 1e-12) : 0.0;
-    std::printf("| %d | %d | %d | %.5f | %s | %.2f |\n", level, r.elements, r.dofs, r.mu,
-                previous ? (std::to_string(100.0 * change).substr(0, 5) + " %").c_str() : "", r.wall_seconds);
+    const double change = previous ? std::abs(m.mu - *previous) / std::max(std::abs(m.mu), 1e-12) : 0.0;
+    std::printf("| %d | %d | %d | %.5f | %s | %s | %.2f |\n", level, r.elements, r.dofs, m.mu,
+                m.std_error ? relative_percent(*m.std_error, m.mu).c_str() : "",
+                previous ? (std::to_string(100.0 * change).substr(0, 5) + " %").c_str() : "", m.wall_seconds);
     std::fflush(stdout);
     if (previous && change < o.tolerance) {
       std::printf("converged at level %d: mu changed by %.2f %% (< %.2f %%) from the previous level\n", level,
                   100.0 * change, 100.0 * o.tolerance);
       return 0;
     }
-    previous = r.mu;
+    previous = m.mu;
     if (o.direction != "y") sc.elements_x *= 2;
     if (o.direction != "x") sc.elements_y *= 2;
   }
@@ -180,7 +246,13 @@ void add_micro_commands(CLI::App& app) {
   run->add_option("--set", r->overrides, "Override a scene value, e.g. --set load.pressure=1300MPa (repeatable)");
   run->add_option("--out", r->out, "Directory for result.json, chip.vtu and tool.vtu")->capture_default_str();
   run->add_flag("--quiet", r->quiet, "No per-step progress on stderr");
-  run->footer("Exit code 0 when the run completed and mu was averaged, 3 when it did not (result.json says why),\n"
+  run->footer("The scene's protocol says what mu means. press-slide (the default): the chip is pressed, then slid;\n"
+              "mu is averaged over protocol.window of sliding after protocol.run_in, for protocol.phases tool\n"
+              "positions (x protocol.realisations tools of the same roughness), run in parallel on the cores\n"
+              "OMP_NUM_THREADS allows, and printed with its standard error and each draw's block means and drift.\n"
+              "seed-000 (--set protocol.name=seed-000): the paper's one draw, pressure ramped while sliding, mu\n"
+              "averaged over [time.average_from, time.duration].\n"
+              "Exit code 0 when the run completed and mu was averaged, 3 when it did not (result.json says why),\n"
               "2 for a bad scene (the message names the key). The default scene is micro/scene/dry_default.json.");
   run->callback([r] {
     const int code = run_command(*r);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include <openssl/sha.h>
 
@@ -21,7 +22,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 Dataset read_hdf5_dataset(const std::string& path) {
   const h5::Reader in(path, "dataset");
-  in.require_format(kDatasetFormat, kDatasetSchemaVersion, "mufric dataset");
+  const long long version = in.require_format(kDatasetFormat, kOldestReadableDatasetSchema, kDatasetSchemaVersion, "mufric dataset");
   Dataset d;
   d.inputs = read_input_space(in);
   const auto dims = static_cast<Eigen::Index>(d.inputs.size());
@@ -32,8 +33,26 @@ Dataset read_hdf5_dataset(const std::string& path) {
   }
   const Eigen::Index n = d.x.rows();
   d.mu = in.vector("/samples/mu", n);
+  if (in.has("/samples/mu_std")) {
+    d.mu_std = in.vector("/samples/mu_std", n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (d.mu_std(i) < 0.0) in.fail("/samples/mu_std", "row " + std::to_string(i) + " is negative");
+    }
+  } else {
+    d.mu_std = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+    if (version < 2) {
+      d.note = "schema version " + std::to_string(version) + ": no /samples/mu_std (each sample's standard error is "
+               "unknown; a GP trained on it learns one noise level for all)";
+    }
+  }
   d.status = in.ints("/samples/status");
   if (static_cast<Eigen::Index>(d.status.size()) != n) in.fail("/samples/status", "length differs from /samples/inputs");
+  for (size_t i = 0; i < d.status.size(); ++i) {
+    if (d.status[i] < 0 || d.status[i] > static_cast<long long>(SampleStatus::outside_model)) {
+      in.fail("/samples/status", "row " + std::to_string(i) + " is " + std::to_string(d.status[i]) +
+                                     " (0 converged, 1 failed, 2 outside the model)");
+    }
+  }
   d.failure_reason = in.has("/samples/failure_reason") ? in.strings("/samples/failure_reason")
                                                        : std::vector<std::string>(static_cast<size_t>(n));
   if (static_cast<Eigen::Index>(d.failure_reason.size()) != n) {
@@ -79,7 +98,7 @@ Dataset read_csv_dataset(const std::string& path) {
   d.source = "csv:" + std::filesystem::path(path).filename().string();
   std::vector<std::vector<double>> columns;
   for (const auto& c : table.columns) {
-    if (c.name == "mu") continue;
+    if (c.name == "mu" || c.name == "mu_std") continue;
     columns.push_back(table.si_column(c.name));
     d.inputs.push_back({c.name, std::string(si_unit(kind_of_input(c.name))), 0.0, 0.0});
   }
@@ -96,6 +115,16 @@ Dataset read_csv_dataset(const std::string& path) {
   }
   const auto mu = table.si_column("mu");
   d.mu = Eigen::Map<const Eigen::VectorXd>(mu.data(), n);
+  d.mu_std = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  if (table.has_column("mu_std")) {
+    const auto std_error = table.si_column("mu_std");
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (!(std_error[static_cast<size_t>(i)] >= 0.0)) {
+        throw Error(path + ": row " + std::to_string(i + 2) + ", column mu_std: a standard error must be a number >= 0");
+      }
+      d.mu_std(i) = std_error[static_cast<size_t>(i)];
+    }
+  }
   d.status.assign(static_cast<size_t>(n), static_cast<long long>(SampleStatus::converged));
   d.failure_reason.assign(static_cast<size_t>(n), "");
   d.plan = d.x;
@@ -123,7 +152,7 @@ Dataset read_dataset_isolated(const std::string& path, const IsolationLimits& li
 
 void write_dataset(const std::string& path, const Dataset& d) {
   const auto n = d.x.rows();
-  if (d.mu.size() != n || static_cast<Eigen::Index>(d.status.size()) != n ||
+  if (d.mu.size() != n || (d.mu_std.size() != 0 && d.mu_std.size() != n) || static_cast<Eigen::Index>(d.status.size()) != n ||
       static_cast<Eigen::Index>(d.failure_reason.size()) != n ||
       (!d.plan_index.empty() && static_cast<Eigen::Index>(d.plan_index.size()) != n)) {
     throw Error("write_dataset '" + path + "': samples arrays differ in length");
@@ -140,6 +169,7 @@ void write_dataset(const std::string& path, const Dataset& d) {
   out.group("/samples");
   out.matrix("/samples/inputs", d.x);
   out.doubles("/samples/mu", d.mu);
+  out.doubles("/samples/mu_std", d.mu_std.size() == n ? d.mu_std : Eigen::VectorXd(Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN())));
   out.ints("/samples/status", d.status);
   out.strings("/samples/failure_reason", d.failure_reason);
   out.group("/samples/diagnostics");
@@ -161,6 +191,7 @@ TrainingSet training_set(const Dataset& d, const std::string& path) {
   t.source_hash = sha256_file(path);
   std::vector<Eigen::Index> rows;
   for (Eigen::Index i = 0; i < d.size(); ++i) {
+    t.outside_model += d.outside_model(i);
     if (!d.converged(i)) continue;
     for (Eigen::Index j = 0; j < d.x.cols(); ++j) {
       if (!std::isfinite(d.x(i, j))) {
@@ -176,9 +207,11 @@ TrainingSet training_set(const Dataset& d, const std::string& path) {
   if (rows.empty()) throw Error(path + ": no converged samples to train on");
   t.x.resize(static_cast<Eigen::Index>(rows.size()), d.x.cols());
   t.mu.resize(static_cast<Eigen::Index>(rows.size()));
+  t.mu_std.resize(static_cast<Eigen::Index>(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) {
     t.x.row(static_cast<Eigen::Index>(k)) = d.x.row(rows[k]);
     t.mu(static_cast<Eigen::Index>(k)) = d.mu(rows[k]);
+    t.mu_std(static_cast<Eigen::Index>(k)) = d.mu_std.size() == d.size() ? d.mu_std(rows[k]) : std::numeric_limits<double>::quiet_NaN();
   }
   return t;
 }

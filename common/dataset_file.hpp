@@ -1,7 +1,9 @@
 #pragma once
 // The training database (ARCHITECTURE.md "Dataset"): one HDF5 file, SI units, self-describing.
-//   /samples/inputs n×d, /samples/mu n, /samples/status n (0 converged, 1 failed),
-//   /samples/failure_reason n, /samples/diagnostics/<name> n (optional), /plan/inputs m×d;
+//   /samples/inputs n×d, /samples/mu n, /samples/mu_std n (μ's standard error over tool phases and
+//   realisations; NaN where not known), /samples/status n (0 converged, 1 failed, 2 outside the
+//   model: completed, but e.g. molten), /samples/failure_reason n (why failed / outside the model),
+//   /samples/diagnostics/<name> n (optional), /plan/inputs m×d;
 //   /samples/plan_index n (optional: the plan row each sample answers, −1 for none), /plan
 //   attributes design and seed (optional);
 //   root attributes: format, schema_version, input_names/units (in /inputs), box, provenance.
@@ -18,15 +20,19 @@
 
 namespace mufric {
 
-inline constexpr long long kDatasetSchemaVersion = 1;
+// Version 2 added /samples/mu_std and status 2; version-1 files are still read (μ's standard error
+// unknown: NaN, and Dataset::note says so).
+inline constexpr long long kDatasetSchemaVersion = 2;
+inline constexpr long long kOldestReadableDatasetSchema = 1;
 inline constexpr const char* kDatasetFormat = "mufric-dataset";
 
-enum class SampleStatus : long long { converged = 0, failed = 1 };
+enum class SampleStatus : long long { converged = 0, failed = 1, outside_model = 2 };
 
 struct Dataset {
   InputSpace inputs;                // names, SI units, box
   h5::RowMatrix x;                  // n × d, SI
   Eigen::VectorXd mu;               // n (NaN allowed only for failed samples)
+  Eigen::VectorXd mu_std;           // n, μ's standard error; NaN where not known
   std::vector<long long> status;    // n, SampleStatus
   std::vector<std::string> failure_reason;  // n, empty when converged
   std::map<std::string, Eigen::VectorXd> diagnostics;  // each n
@@ -38,9 +44,15 @@ struct Dataset {
   std::string scene_json;           // scene text when made by the micro-model
   std::string code_version;
   std::string created_utc;
+  std::string note;                 // what a reader should know about an older file (empty: nothing)
 
   Eigen::Index size() const { return x.rows(); }
+  // Trained on: completed and inside the model.
   bool converged(Eigen::Index i) const { return status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::converged); }
+  bool failed(Eigen::Index i) const { return status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::failed); }
+  bool outside_model(Eigen::Index i) const {
+    return status[static_cast<size_t>(i)] == static_cast<long long>(SampleStatus::outside_model);
+  }
 };
 
 // Samples that converged, validated: finite inputs and μ. Errors name file, row and input.
@@ -48,6 +60,8 @@ struct TrainingSet {
   InputSpace inputs;
   Eigen::MatrixXd x;   // n × d, SI
   Eigen::VectorXd mu;  // n
+  Eigen::VectorXd mu_std;  // n, μ's standard error; NaN where not known
+  long long outside_model = 0;  // samples left out because they lie outside the model (molten)
   std::string source_path;
   std::string source_hash;  // SHA-256 of the file bytes, for model provenance
 };

@@ -54,6 +54,7 @@ Dataset empty_database(const Dataset& plan) {
   d.inputs = plan.inputs;
   d.x.resize(0, static_cast<Eigen::Index>(plan.inputs.size()));
   d.mu.resize(0);
+  d.mu_std.resize(0);
   d.plan = plan.plan;
   d.plan_design = plan.plan_design;
   d.plan_seed = plan.plan_seed;
@@ -88,8 +89,18 @@ void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, con
   d.x.row(n) = x.transpose();
   d.mu.conservativeResize(n + 1);
   d.mu(n) = outcome.converged ? outcome.mu : std::numeric_limits<double>::quiet_NaN();
-  d.status.push_back(static_cast<long long>(outcome.converged ? SampleStatus::converged : SampleStatus::failed));
-  d.failure_reason.push_back(outcome.converged ? "" : outcome.failure_reason);
+  if (d.mu_std.size() != n) d.mu_std = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  d.mu_std.conservativeResize(n + 1);
+  d.mu_std(n) = outcome.converged ? outcome.mu_std : std::numeric_limits<double>::quiet_NaN();
+  // A completed run with warnings (a molten chip) is kept, with its μ, but outside the model: the
+  // warnings are its reason, and training leaves it out.
+  const bool outside = outcome.converged && !outcome.warnings.empty();
+  d.status.push_back(static_cast<long long>(!outcome.converged ? SampleStatus::failed
+                                            : outside          ? SampleStatus::outside_model
+                                                               : SampleStatus::converged));
+  std::string reason = outcome.converged ? "" : outcome.failure_reason;
+  for (const auto& w : outcome.warnings) reason += (reason.empty() ? "" : "; ") + w;
+  d.failure_reason.push_back(reason);
   d.plan_index.push_back(plan_row);
   for (auto& [name, values] : d.diagnostics) {
     values.conservativeResize(n + 1);
@@ -116,6 +127,7 @@ void remove_rows(Dataset& d, const std::set<long long>& rows) {
   const auto m = static_cast<Eigen::Index>(keep.size());
   k.x.resize(m, d.x.cols());
   k.mu.resize(m);
+  k.mu_std.resize(m);
   k.status.clear();
   k.failure_reason.clear();
   k.plan_index.clear();
@@ -124,6 +136,7 @@ void remove_rows(Dataset& d, const std::set<long long>& rows) {
     const Eigen::Index i = keep[static_cast<size_t>(r)];
     k.x.row(r) = d.x.row(i);
     k.mu(r) = d.mu(i);
+    k.mu_std(r) = d.mu_std.size() == d.size() ? d.mu_std(i) : std::numeric_limits<double>::quiet_NaN();
     k.status.push_back(d.status[static_cast<size_t>(i)]);
     k.failure_reason.push_back(d.failure_reason[static_cast<size_t>(i)]);
     k.plan_index.push_back(d.plan_index[static_cast<size_t>(i)]);
@@ -143,7 +156,7 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
   std::set<long long> done, failed_rows;
   for (Eigen::Index i = 0; i < db.size(); ++i) {
     const long long row = db.plan_index[static_cast<size_t>(i)];
-    const bool failed = !db.converged(i);
+    const bool failed = db.failed(i);  // a sample outside the model would only melt again
     if (failed && options.retry_failed) {
       failed_rows.insert(row);
     } else {
@@ -263,9 +276,11 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
     const Dataset& d = files[at.first];
     const Eigen::Index i = at.second;
     SampleOutcome o;
-    o.converged = converged(at);
+    o.converged = !d.failed(i);
     o.mu = d.mu(i);
-    o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
+    o.mu_std = d.mu_std(i);
+    if (d.failed(i)) o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
+    if (d.outside_model(i)) o.warnings = {d.failure_reason[static_cast<size_t>(i)]};
     for (const auto& [name, values] : d.diagnostics) o.diagnostics[name] = values(i);
     append_sample(merged, d.x.row(i).transpose(), row, o);
     (o.converged ? report.converged : report.failed) += 1;

@@ -165,14 +165,20 @@ long long Reader::int_attribute(const std::string& object, const std::string& na
 }
 
 void Reader::require_format(const std::string& format, long long version, const std::string& kind_of_file) const {
+  require_format(format, version, version, kind_of_file);
+}
+
+long long Reader::require_format(const std::string& format, long long oldest, long long newest,
+                                 const std::string& kind_of_file) const {
   if (!has_attribute("/", "format") || string_attribute("/", "format") != format) {
     fail("/", "not a " + kind_of_file + " (attribute 'format' is not '" + format + "')");
   }
   const long long found = int_attribute("/", "schema_version");
-  if (found != version) {
+  if (found < oldest || found > newest) {
     fail("/", "schema_version " + std::to_string(found) + " is not supported (this build reads " +
-                  std::to_string(version) + ")");
+                  (oldest == newest ? std::to_string(newest) : std::to_string(oldest) + " to " + std::to_string(newest)) + ")");
   }
+  return found;
 }
 
 std::vector<double> Reader::doubles(const std::string& dataset) const {

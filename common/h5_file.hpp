@@ -37,6 +37,8 @@ class Reader {
 
   // Refuses a file whose root attributes 'format' and 'schema_version' are not `format`, `version`.
   void require_format(const std::string& format, long long version, const std::string& kind_of_file) const;
+  // Accepts schema versions oldest…newest; returns the file's.
+  long long require_format(const std::string& format, long long oldest, long long newest, const std::string& kind_of_file) const;
 
   [[noreturn]] void fail(const std::string& object, const std::string& problem) const;
 

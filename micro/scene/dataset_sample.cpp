@@ -1,5 +1,7 @@
 #include "micro/scene/dataset_sample.hpp"
 
+#include <limits>
+
 #include <omp.h>
 
 #include "common/error.hpp"
@@ -35,19 +37,27 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     s.pressure = x(pressure);
     s.velocity = x(velocity);
     s.temperature = x(temperature);
-    const MicroResult r = run_micro(s);
+    // The sample's draws (tool phases, realisations) share its cores.
+    MeasureOptions options;
+    options.threads = std::max(threads_per_sample, 1);
+    const MuMeasurement m = measure_mu(s, options);
     SampleOutcome o;
-    o.converged = r.completed;
-    o.mu = r.mu;
-    o.failure_reason = r.reason;
-    o.diagnostics = {{"contact_area_fraction", r.contact_fraction},
-                     {"max_contact_pressure_pa", r.max_contact_pressure},
-                     {"max_plastic_strain", r.max_plastic_strain},
-                     {"max_temperature_k", r.max_temperature},
-                     {"newton_iterations", r.solver.newton_iterations},
-                     {"cutbacks", static_cast<double>(r.solver.cutbacks.size())},
-                     {"dofs", r.dofs},
-                     {"micro_wall_seconds", r.wall_seconds}};
+    o.converged = m.completed;
+    o.mu = m.mu;
+    o.mu_std = m.std_error.value_or(std::numeric_limits<double>::quiet_NaN());
+    o.failure_reason = m.reason;
+    o.warnings = m.warnings;
+    const nlohmann::json d = m.to_json(s)["diagnostics"];
+    o.diagnostics = {{"contact_area_fraction", d["contact_area_fraction"].get<double>()},
+                     {"max_contact_pressure_pa", d["max_contact_pressure_pa"].get<double>()},
+                     {"max_plastic_strain", d["max_plastic_strain"].get<double>()},
+                     {"max_temperature_k", d["max_temperature_k"].get<double>()},
+                     {"newton_iterations", d["newton_iterations"].get<double>()},
+                     {"cutbacks", d["cutbacks"].get<double>()},
+                     {"dofs", d["dofs"].get<double>()},
+                     {"draws", static_cast<double>(m.draws.size())},
+                     {"max_abs_drift", m.max_abs_drift()},
+                     {"micro_wall_seconds", m.wall_seconds}};
     return o;
   };
 }

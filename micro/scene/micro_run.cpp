@@ -1,13 +1,21 @@
 #include "micro/scene/micro_run.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <mutex>
+#include <numeric>
+#include <thread>
+
+#include <omp.h>
 
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
 #include "micro/scene/vtu.hpp"
+#include "micro/solid/heat_conduction.hpp"
 
 namespace mufric::scene {
 namespace {
@@ -99,7 +107,12 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
   if (!completed) j["reason"] = reason;
   j["warnings"] = warnings;
   j["mu"] = completed ? nlohmann::json(mu) : nlohmann::json(nullptr);
-  j["mu_window_s"] = {scene.average_from, scene.duration};
+  if (scene.protocol.name == Protocol::seed000) {
+    j["mu_window_s"] = {scene.average_from, scene.duration};
+  } else {
+    j["mu_window_sliding_distance_m"] = {scene.protocol.run_in, scene.protocol.run_in + scene.protocol.window};
+    j["slide_start_s"] = slide_start_time;
+  }
   j["averaged_steps"] = averaged_steps;
   j["diagnostics"] = {{"contact_area_fraction", contact_fraction},
                       {"max_contact_pressure_pa", max_contact_pressure},
@@ -122,6 +135,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
   auto& h = j["history"] = nlohmann::json::array();
   for (const auto& s : history) {
     h.push_back({{"time_s", s.time},
+                 {"sliding_distance_m", s.sliding_distance},
                  {"mu", s.mu ? nlohmann::json(*s.mu) : nlohmann::json(nullptr)},
                  {"force_x_n_per_m", s.force.x()},
                  {"force_y_n_per_m", s.force.y()},
@@ -132,9 +146,79 @@ nlohmann::json MicroResult::to_json(const Scene& scene) const {
   return j;
 }
 
+namespace {
+
+// Where Γ_B is and how far it has slid, for the scene's protocol.
+class BottomMotion {
+ public:
+  explicit BottomMotion(const Scene& scene) : velocity_(scene.velocity) {
+    if (scene.protocol.name == Protocol::seed000) return;
+    const ProtocolSpec& q = scene.protocol;
+    const double speed = std::abs(velocity_);
+    slide_start_ = scene.ramp + q.press_hold;
+    acceleration_time_ = 2.0 * kAccelerationShareOfRunIn * q.run_in / speed;
+    end_time_ = slide_start_ + 0.5 * acceleration_time_ + (q.run_in + q.window) / speed;
+  }
+  // Horizontal displacement of Γ_B at t: v t (seed 000), or held during pressing, then a linear
+  // rise of the velocity to v over acceleration_time_, then v.
+  double displacement(double t) const {
+    const double s = t - slide_start_;
+    if (s <= 0.0) return 0.0;
+    if (s < acceleration_time_) return velocity_ * s * s / (2.0 * acceleration_time_);
+    return velocity_ * (s - 0.5 * acceleration_time_);
+  }
+  double distance(double t) const { return std::abs(displacement(t)); }
+  double slide_start() const { return slide_start_; }
+  double end_time() const { return end_time_; }
+
+ private:
+  double velocity_;
+  double slide_start_ = 0.0, acceleration_time_ = 0.0, end_time_ = 0.0;
+};
+
+// μ averaged over a window of "position" (time for seed 000, sliding distance for press-slide),
+// the value at the end of each step standing for the step's whole segment, and over equal blocks.
+class WindowAverage {
+ public:
+  // blocks = 0: no block means (the window may then be unbounded)
+  WindowAverage(double from, double to, int blocks) : from_(from), to_(to), sums_(static_cast<size_t>(blocks), 0.0) {}
+  void add(double position_before, double position_after, double mu) {
+    const double a = std::max(position_before, from_), b = std::min(position_after, to_);
+    if (!(b > a)) return;
+    sum_ += mu * (b - a);
+    weight_ += b - a;
+    ++steps_;
+    if (sums_.empty()) return;
+    const double block = (to_ - from_) / static_cast<double>(sums_.size());
+    for (size_t k = 0; k < sums_.size(); ++k) {
+      const double lo = from_ + block * static_cast<double>(k), hi = lo + block;
+      const double overlap = std::min(b, hi) - std::max(a, lo);
+      if (overlap > 0.0) sums_[k] += mu * overlap;
+    }
+  }
+  double weight() const { return weight_; }
+  double mean() const { return sum_ / weight_; }
+  int steps() const { return steps_; }
+  std::vector<double> block_means() const {
+    std::vector<double> means;
+    const double block = (to_ - from_) / static_cast<double>(sums_.size());
+    for (double s : sums_) means.push_back(s / block);
+    return means;
+  }
+
+ private:
+  double from_, to_;
+  double sum_ = 0.0, weight_ = 0.0;
+  int steps_ = 0;
+  std::vector<double> sums_;
+};
+
+}  // namespace
+
 MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   MicroResult result;
+  const bool seed000 = scene.protocol.name == Protocol::seed000;
   const SceneGeometry geometry = build_geometry(scene);
   const auto fit_spans = static_cast<int>(geometry.chip_surface.basis().breakpoints().size()) - 1;
   if (scene.elements_x < fit_spans) {
@@ -153,10 +237,16 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   auto contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
                                                           scene.penalty, scene.contact_points_per_span);
   problem.add_interaction(contact);
-  // Γ_B: dragged along x at the sliding velocity, pushed toward the tool by p (or moved by a
-  // prescribed vertical displacement), both vertical loads ramped over `ramp`.
+  // Γ_B: dragged along x (at the sliding velocity from t = 0 for seed 000; after pressing for
+  // press-slide), pushed toward the tool by p (or moved by a prescribed vertical displacement), the
+  // vertical load ramped over `ramp`.
   const double velocity = scene.velocity, ramp_time = scene.ramp;
-  problem.fix_side(solid::Side::bottom, 0, velocity, [](double t) { return t; });
+  const BottomMotion motion(scene);
+  if (seed000) {
+    problem.fix_side(solid::Side::bottom, 0, velocity, [](double t) { return t; });
+  } else {
+    problem.fix_side(solid::Side::bottom, 0, 1.0, [motion](double t) { return motion.displacement(t); });
+  }
   if (scene.pressure_controlled) {
     problem.add_load({solid::Side::bottom, Eigen::Vector2d::Zero(), scene.pressure,
                       [ramp_time](double t) { return ramp(t, ramp_time); }});
@@ -166,44 +256,72 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   result.dofs = problem.dof_count();
   result.elements = problem.space().element_count();
+  result.slide_start_time = motion.slide_start();
 
   solid::TimeIntegrationOptions o;
   o.scheme = scene.scheme;
   o.spectral_radius = scene.spectral_radius;
   o.dt = scene.dt;
   o.max_dt = scene.max_dt;
-  o.end_time = scene.duration;
+  o.end_time = seed000 ? scene.duration : motion.end_time();
   o.relative_tolerance = scene.relative_tolerance;
   o.max_newton_iterations = scene.max_newton_iterations;
   o.max_cutbacks = scene.max_cutbacks;
   o.linear_solver = scene.linear_solver;
+  if (!seed000) {
+    // Once sliding, steps are sized by distance: inertia plays no part at these sliding speeds
+    // (an asperity passes in ~100 ns, the chip's slowest mode rings at ~5 ns), so slow sliding
+    // costs no more steps than fast sliding.
+    const double sliding_step = scene.protocol.step_distance / std::abs(velocity);
+    const double pressing_step = scene.max_dt, slide_start = motion.slide_start();
+    o.max_dt_at = [=](double t) { return t < slide_start ? pressing_step : sliding_step; };
+  }
+  std::unique_ptr<solid::HeatConduction> heat;
+  if (scene.heat_conduction) {
+    heat = std::make_unique<solid::HeatConduction>(
+        problem.space(), solid::HeatConductionOptions{.conductivity = scene.conductivity,
+                                                      .density = scene.material.density,
+                                                      .specific_heat = scene.material.specific_heat,
+                                                      .held_side = solid::Side::bottom,
+                                                      .held_temperature = scene.temperature});
+    o.after_step = [&problem, &heat](double, double dt, const Eigen::VectorXd& u, std::string& reason) {
+      std::vector<solid::MaterialState> states = problem.states();
+      if (!heat->step(u, dt, states, reason)) return false;
+      problem.commit(std::move(states));
+      return true;
+    };
+  }
   solid::TimeIntegrator integrator(problem, o);
-  if (scene.scheme == solid::TimeScheme::generalized_alpha) {
+  if (seed000 && scene.scheme == solid::TimeScheme::generalized_alpha) {
     // The chip starts moving with Γ_B: a rigid translation at the sliding velocity.
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(problem.dof_count());
     for (Eigen::Index i = 0; i < v0.size(); i += 2) v0(i) = velocity;
     integrator.set_initial(Eigen::VectorXd::Zero(problem.dof_count()), v0);
   }
+  // Seed 000 averages over time, press-slide over sliding distance.
+  // (Seed 000's window has no upper end: the run stops at its end, and the arithmetic stays the one
+  // that gave the published figures, to the bit.)
+  WindowAverage average = seed000 ? WindowAverage(scene.average_from, std::numeric_limits<double>::infinity(), 0)
+                                  : WindowAverage(scene.protocol.run_in, scene.protocol.run_in + scene.protocol.window,
+                                                  scene.protocol.blocks);
+  const auto position = [&](double t) { return seed000 ? t : motion.distance(t); };
   contact::ContactState last;
-  double weighted_mu = 0.0, weight = 0.0, previous_time = 0.0;
+  double previous_time = 0.0;
   result.solver = integrator.run([&](const solid::StepView& view) {
     last = contact->state(view.u);
     MicroStep step;
     step.time = view.time;
+    step.sliding_distance = seed000 ? std::abs(velocity) * view.time : motion.distance(view.time);
     step.force = last.force;
     if (last.force.y() != 0.0) step.mu = last.force.x() / last.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;
     step.max_pressure = last.max_pressure;
     result.history.push_back(step);
-    if (step.mu && view.time > scene.average_from) {
-      const double dt = view.time - std::max(previous_time, scene.average_from);
-      weighted_mu += *step.mu * dt;
-      weight += dt;
-      ++result.averaged_steps;
-    }
+    if (step.mu) average.add(position(previous_time), position(view.time), *step.mu);
     previous_time = view.time;
     if (options.on_step) options.on_step(step, scene);
   });
+  result.averaged_steps = average.steps();
   const solid::IntegrationReport& report = result.solver;
   for (size_t k = 0; k < report.steps.size() && k < result.history.size(); ++k) {
     result.history[k].newton_iterations = report.steps[k].newton_iterations;
@@ -224,12 +342,16 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   if (!report.completed) {
     result.reason = report.reason;
-  } else if (weight <= 0.0) {
+  } else if (average.weight() <= 0.0) {
     result.reason = "the chip did not touch the tool during the averaging window; raise load.pressure or lower "
                     "geometry.initial_gap";
   } else {
     result.completed = true;
-    result.mu = weighted_mu / weight;
+    result.mu = average.mean();
+    if (!seed000) {
+      result.block_means = average.block_means();
+      result.drift = (result.block_means.back() - result.block_means.front()) / std::max(std::abs(result.mu), 1e-300);
+    }
   }
   if (!options.vtu_directory.empty()) {
     write_chip_vtu(options.vtu_directory + "/chip.vtu", problem, integrator.u(), last);
@@ -237,6 +359,178 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+
+std::vector<Draw> protocol_draws(const Scene& scene) {
+  if (scene.protocol.name == Protocol::seed000) return {Draw{0, 0, 0.0, scene.tool_surface.synthetic.seed, {}}};
+  std::vector<Draw> draws;
+  const int phases = scene.protocol.phases, realisations = scene.protocol.realisations;
+  for (int r = 0; r < realisations; ++r) {
+    for (int k = 0; k < phases; ++k) {
+      draws.push_back({k, r, static_cast<double>(k) / phases, scene.tool_surface.synthetic.seed + static_cast<std::uint64_t>(r), {}});
+    }
+  }
+  return draws;
+}
+
+Scene draw_scene(const Scene& scene, const Draw& draw) {
+  Scene s = scene;
+  // A shift by a whole interval is no shift: keep the fraction in [0, 1).
+  const double shift = scene.tool_surface.shift_fraction + draw.shift_fraction;
+  s.tool_surface.shift_fraction = shift - std::floor(shift);
+  s.tool_surface.synthetic.seed = draw.seed;
+  return s;
+}
+
+double MuMeasurement::max_abs_drift() const {
+  double d = 0.0;
+  for (const auto& draw : draws) d = std::max(d, std::abs(draw.result.drift));
+  return d;
+}
+
+MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  MuMeasurement m;
+  m.draws = protocol_draws(scene);
+  const int cores = std::max(options.threads > 0 ? options.threads : omp_get_max_threads(), 1);
+  const int workers = std::min(cores, static_cast<int>(m.draws.size()));
+  m.threads = workers;
+  // Draws are independent runs: one per worker, each worker's OpenMP share of the cores for its
+  // assembly (a single draw gets them all).
+  const int threads_per_draw = std::max(cores / workers, 1);
+  std::mutex progress_lock;
+  std::atomic<size_t> next{0};
+  std::vector<std::string> failures(m.draws.size());
+  auto worker = [&] {
+    omp_set_num_threads(threads_per_draw);
+    for (size_t i = next++; i < m.draws.size(); i = next++) {
+      RunOptions run;
+      if (i == 0) run.vtu_directory = options.vtu_directory;
+      if (options.on_step) {
+        run.on_step = [&, i](const MicroStep& step, const Scene& sc) {
+          const std::lock_guard<std::mutex> lock(progress_lock);
+          options.on_step(static_cast<int>(i), step, sc);
+        };
+      }
+      try {
+        m.draws[i].result = run_micro(draw_scene(scene, m.draws[i]), run);
+      } catch (const std::exception& e) {  // a bad scene fails every draw alike: reported once below
+        failures[i] = e.what();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (size_t i = 0; i < failures.size(); ++i) {
+    if (!failures[i].empty()) throw Error(failures[i]);
+  }
+
+  std::vector<double> values;
+  for (const auto& draw : m.draws) {
+    const MicroResult& r = draw.result;
+    for (const auto& w : r.warnings) {
+      if (std::find(m.warnings.begin(), m.warnings.end(), w) == m.warnings.end()) m.warnings.push_back(w);
+    }
+    if (!r.completed && m.reason.empty()) {
+      m.reason = m.draws.size() == 1 ? r.reason
+                                     : "draw " + std::to_string(&draw - m.draws.data()) + " (tool phase " +
+                                           std::to_string(draw.phase) + ", realisation " +
+                                           std::to_string(draw.realisation) + ") did not complete: " + r.reason;
+    }
+    values.push_back(r.mu);
+  }
+  if (m.reason.empty()) {
+    m.completed = true;
+    const double n = static_cast<double>(values.size());
+    m.mu = std::accumulate(values.begin(), values.end(), 0.0) / n;
+    if (values.size() > 1) {
+      double squares = 0.0;
+      for (double x : values) squares += (x - m.mu) * (x - m.mu);
+      m.std_error = std::sqrt(squares / (n - 1.0) / n);  // sample standard deviation / √n
+    }
+  }
+  m.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return m;
+}
+
+nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
+  nlohmann::json j;
+  j["code_version"] = code_version();
+  j["created_utc"] = utc_timestamp();
+  j["scene"] = scene.effective;
+  j["completed"] = completed;
+  if (!completed) j["reason"] = reason;
+  j["warnings"] = warnings;
+  j["mu"] = completed ? nlohmann::json(mu) : nlohmann::json(nullptr);
+  j["mu_std_error"] = completed && std_error ? nlohmann::json(*std_error) : nlohmann::json(nullptr);
+  const ProtocolSpec& q = scene.protocol;
+  nlohmann::json& p = j["protocol"];
+  if (q.name == Protocol::seed000) {
+    p = {{"name", "seed-000"},
+         {"means", "one draw; pressure ramped over load.ramp while sliding; mu averaged over a time window"},
+         {"window_s", {scene.average_from, scene.duration}},
+         {"draws", draws.size()}};
+  } else {
+    p = {{"name", "press-slide"},
+         {"means", "pressed (ramp, then hold), then slid; mu averaged over a sliding-distance window after a run-in, "
+                   "then over tool phases and realisations; mu_std_error is the standard error of that mean"},
+         {"press_ramp_s", scene.ramp},
+         {"press_hold_s", q.press_hold},
+         {"run_in_m", q.run_in},
+         {"window_m", q.window},
+         {"window_in_tool_correlation_lengths",
+          scene.tool_surface.csv.empty() && !scene.tool_surface.flat
+              ? nlohmann::json(q.window / scene.tool_surface.synthetic.correlation_length)
+              : nlohmann::json(nullptr)},
+         {"step_distance_m", q.step_distance},
+         {"phases", q.phases},
+         {"realisations", q.realisations},
+         {"draws", draws.size()},
+         {"max_abs_drift", max_abs_drift()}};
+  }
+  // Aggregates over the draws (sums of work, extremes of state), for scripts that read one run.
+  nlohmann::json diagnostics = {{"wall_seconds", wall_seconds}, {"threads", threads}};
+  int newton = 0, cutbacks = 0;
+  double max_p = 0.0, max_eps = 0.0, max_t = 0.0, area = 0.0, cpu = 0.0;
+  for (const auto& d : draws) {
+    newton += d.result.solver.newton_iterations;
+    cutbacks += static_cast<int>(d.result.solver.cutbacks.size());
+    max_p = std::max(max_p, d.result.max_contact_pressure);
+    max_eps = std::max(max_eps, d.result.max_plastic_strain);
+    max_t = std::max(max_t, d.result.max_temperature);
+    area += d.result.contact_fraction / static_cast<double>(draws.size());
+    cpu += d.result.wall_seconds;
+  }
+  diagnostics.update({{"newton_iterations", newton},
+                      {"cutbacks", cutbacks},
+                      {"max_contact_pressure_pa", max_p},
+                      {"max_plastic_strain", max_eps},
+                      {"max_temperature_k", max_t},
+                      {"contact_area_fraction", area},
+                      {"draw_seconds_sum", cpu},
+                      {"dofs", draws.empty() ? 0 : draws.front().result.dofs},
+                      {"elements", draws.empty() ? 0 : draws.front().result.elements}});
+  j["diagnostics"] = diagnostics;
+  auto& list = j["draws"] = nlohmann::json::array();
+  for (const auto& d : draws) {
+    nlohmann::json one = d.result.to_json(scene);
+    one.erase("scene");
+    one.erase("code_version");
+    one.erase("created_utc");
+    one["phase"] = d.phase;
+    one["realisation"] = d.realisation;
+    one["tool_shift_fraction"] = d.shift_fraction;
+    one["tool_seed"] = d.seed;
+    if (!d.result.block_means.empty()) {
+      one["block_means"] = d.result.block_means;
+      one["drift"] = d.result.drift;
+    }
+    list.push_back(std::move(one));
+  }
+  return j;
 }
 
 }  // namespace mufric::scene

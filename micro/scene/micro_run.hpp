@@ -1,7 +1,10 @@
 #pragma once
 // One high-fidelity dry run (seed 000 sections 3.1 and 4): the chip interval, pressed with p on Γ_B
 // against the rigid rough tool and dragged at v, at initial temperature T; μ by eq. (17) from the
-// contact tractions at every step and time-averaged over a window.
+// contact tractions at every step, averaged over a window (scene.protocol: seed 000's time window
+// while the load ramps, or press-slide's sliding-distance window after pressing). measure_mu repeats
+// the run over tool phases and realisations and reports the mean with its standard error.
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -16,6 +19,7 @@ namespace mufric::scene {
 
 struct MicroStep {
   double time = 0.0;
+  double sliding_distance = 0.0;                    // m, of Γ_B since sliding started
   std::optional<double> mu;                         // ∫Tx/∫Ty; none while nothing touches
   Eigen::Vector2d force = Eigen::Vector2d::Zero();  // contact resultant on the chip, N/m
   double contact_fraction = 0.0;                    // of the interval's surface length
@@ -26,8 +30,13 @@ struct MicroStep {
 struct MicroResult {
   bool completed = false;
   std::string reason;           // why not, if not
-  double mu = 0.0;              // time average over [average_from, duration]
+  double mu = 0.0;              // average over the protocol's window
   int averaged_steps = 0;
+  // press-slide: μ averaged over equal-distance blocks of the window, and the relative drift
+  // (last block − first block) / μ; empty/0 for seed 000's protocol.
+  std::vector<double> block_means;
+  double drift = 0.0;
+  double slide_start_time = 0.0;  // s, when Γ_B starts to move (0 for seed 000)
   std::vector<MicroStep> history;
   double contact_fraction = 0.0, max_contact_pressure = 0.0;  // at the end
   double max_plastic_strain = 0.0, max_temperature = 0.0;     // over the chip, at the end
@@ -44,6 +53,43 @@ struct RunOptions {
   std::string vtu_directory;  // empty: no VTU output; else chip.vtu and tool.vtu at the end
   std::function<void(const MicroStep&, const Scene&)> on_step;  // progress
 };
+
+// One draw of a press-slide measurement: the tool shifted by `shift_fraction` of the interval (on top
+// of the scene's own shift) and, for a synthetic tool, drawn with `seed`.
+struct Draw {
+  int phase = 0, realisation = 0;
+  double shift_fraction = 0.0;
+  std::uint64_t seed = 0;
+  MicroResult result;
+};
+
+// μ as a property of (p, v, T, roughness statistics): the mean over the draws, with the standard
+// error of that mean (sample standard deviation / √draws; none for a single draw).
+struct MuMeasurement {
+  bool completed = false;
+  std::string reason;
+  double mu = 0.0;
+  std::optional<double> std_error;
+  std::vector<Draw> draws;
+  std::vector<std::string> warnings;  // the draws' warnings, each once
+  double wall_seconds = 0.0;
+  int threads = 1;  // draws run at once
+  double max_abs_drift() const;
+  nlohmann::json to_json(const Scene& scene) const;
+};
+
+struct MeasureOptions {
+  int threads = 0;            // cores to use (draws run in parallel); 0: OpenMP's maximum
+  std::string vtu_directory;  // VTU of the first draw
+  // progress: the draw (index into draws) and its step; called from the draws' threads, serialised
+  std::function<void(int, const MicroStep&, const Scene&)> on_step;
+};
+
+// The draws a scene's protocol asks for (one for seed 000's).
+std::vector<Draw> protocol_draws(const Scene& scene);
+// The scene of one draw.
+Scene draw_scene(const Scene& scene, const Draw& draw);
+MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options = {});
 
 // The chip surface and the tool surface as fitted periodic curves, the tool placed above the chip
 // at the scene's initial gap.

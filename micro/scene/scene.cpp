@@ -239,6 +239,39 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     t.finish();
   }
   {
+    Section p = root.child("protocol");
+    auto& q = s.protocol;
+    q.name = p.text("name", "press-slide", {"press-slide", "seed-000"}) == "seed-000" ? Protocol::seed000 : Protocol::press_slide;
+    q.press_hold = p.quantity("press_hold", QuantityKind::time, q.press_hold, 0.0, 1.0);
+    q.run_in = p.quantity("run_in", QuantityKind::length, q.run_in, 0.0, 1.0);
+    q.window = p.quantity("window", QuantityKind::length, q.window, 1e-12, 1.0);
+    q.step_distance = p.quantity("step_distance", QuantityKind::length, q.step_distance, 1e-12, 1.0);
+    q.phases = p.integer("phases", q.phases, 1, 1024);
+    q.realisations = p.integer("realisations", q.realisations, 1, 1024);
+    q.blocks = p.integer("blocks", q.blocks, 1, 100);
+    if (q.name == Protocol::press_slide) {
+      if (s.velocity == 0.0) p.fail("name", "press-slide averages over a sliding distance: load.velocity must not be zero");
+      if (s.scheme != solid::TimeScheme::generalized_alpha) {
+        p.fail("name", "press-slide presses dynamically (the chip's inertia holds it until the contact closes): "
+                       "time.scheme must be generalized-alpha");
+      }
+      if (q.realisations > 1 && (!s.tool_surface.csv.empty() || s.tool_surface.flat)) {
+        p.fail("realisations", "realisations redraw a synthetic tool with other seeds; this tool is " +
+                                   std::string(s.tool_surface.flat ? "flat" : "a measured profile") +
+                                   " (use phases to average over its positions)");
+      }
+      if (q.step_distance > q.window) p.fail("step_distance", "is longer than the window");
+    }
+    p.finish();
+  }
+  {
+    Section h = root.child("thermal");
+    const std::string fallback = s.protocol.name == Protocol::seed000 ? "adiabatic" : "conduction";
+    s.heat_conduction = h.text("model", fallback, {"adiabatic", "conduction"}) == "conduction";
+    s.conductivity = h.number("conductivity", s.conductivity, 0.0, 1e4);
+    h.finish();
+  }
+  {
     Section c = root.child("contact");
     s.penalty = c.number("penalty", s.penalty, 1e3, 1e30);
     c.finish();

@@ -24,6 +24,26 @@ struct SurfaceSpec {
   bool mirror = false;             // x → −x (a reflected profile, for symmetry studies)
 };
 
+// How μ is measured (README "What μ means"). Seed 000's protocol ramps the pressure while the chip
+// slides and averages one draw over a fixed time window; press-slide presses first, then slides, and
+// averages over a sliding distance and over tool phases / realisations, with a standard error.
+enum class Protocol { press_slide, seed000 };
+
+struct ProtocolSpec {
+  Protocol name = Protocol::press_slide;
+  // press-slide: the pressure rises over load.ramp with Γ_B held in x, then stays for press_hold
+  // before Γ_B starts to slide; its velocity rises linearly to load.velocity over the first
+  // kAccelerationShareOfRunIn of the run-in distance.
+  double press_hold = 25e-9;      // s
+  double run_in = 0.5e-6;         // m of sliding before the window (discarded)
+  double window = 2.5e-6;         // m of sliding over which μ is averaged
+  double step_distance = 25e-9;   // m, the longest step while sliding (dt = step_distance / |v|)
+  int phases = 4;                 // tool shifts by k/phases of the interval, k = 0…phases−1
+  int realisations = 1;           // synthetic tools with seeds seed, seed+1, … (same statistics)
+  int blocks = 4;                 // equal-distance blocks of the window, for the drift check
+};
+inline constexpr double kAccelerationShareOfRunIn = 0.25;
+
 struct Scene {
   std::string source;  // file name, for messages
   std::string physics = "dry";
@@ -56,6 +76,12 @@ struct Scene {
   double max_dt = 1e-9;               // s, the longest step the step-size control may take
   double duration = 2.5e-7;           // s (seed 000 Figs. 3–5)
   double average_from = 1.25e-7;      // s, μ is averaged over [average_from, duration]
+  ProtocolSpec protocol;
+  // Heat: adiabatic (seed 000: each point keeps the heat of its plastic work) or conducted through
+  // the chip (Γ_B held at load.temperature, the contact face insulated). The default follows the
+  // protocol: conduction for press-slide, adiabatic for seed 000 (bench/RESULTS.md, the heat study).
+  bool heat_conduction = true;
+  double conductivity = 50.0;  // W/(m K), plain carbon steel near room temperature (AISI 1045: ~50)
   // contact
   double penalty = 2e18;              // Pa/m
   // solver

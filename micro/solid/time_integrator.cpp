@@ -247,11 +247,14 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   return at;
 }
 
-double TimeIntegrator::next_step(double dt, int newton_iterations) const {
-  const double max_dt = options_.max_dt > 0.0 ? std::max(options_.max_dt, options_.dt) : options_.dt;
+double TimeIntegrator::next_step(double t, double dt, int newton_iterations) const {
+  const double max_dt = options_.max_dt_at ? options_.max_dt_at(t)
+                        : options_.max_dt > 0.0 ? std::max(options_.max_dt, options_.dt)
+                                                : options_.dt;
   const double factor = std::clamp(static_cast<double>(kTargetNewtonIterations) / std::max(newton_iterations, 1),
                                    kMaxStepShrink, kMaxStepGrowth);
-  const double shortest = std::min(dt, kShortestControlledStep * options_.dt);  // never grow a cut-back step by shrinking
+  // never grow a cut-back step by shrinking; a phase may ask for steps shorter than that floor
+  const double shortest = std::min({dt, kShortestControlledStep * options_.dt, max_dt});
   return std::clamp(factor * dt, shortest, max_dt);
 }
 
@@ -288,8 +291,16 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     report_.steps.push_back(at.record);
     report_.newton_iterations += at.record.newton_iterations;
     report_.line_search_reductions += at.record.line_search_reductions;
+    if (options_.after_step) {
+      std::string reason;
+      if (!options_.after_step(t, this_dt, u_, reason)) {
+        record_solver_counts();
+        report_.reason = "after the step to t = " + std::to_string(t) + " s: " + reason;
+        return report_;
+      }
+    }
     if (on_step) on_step(StepView{t, u_, v_, a_, reactions_, stresses_, problem_});
-    dt = next_step(this_dt, at.record.newton_iterations);
+    dt = next_step(t, this_dt, at.record.newton_iterations);
   }
   report_.completed = true;
   record_solver_counts();

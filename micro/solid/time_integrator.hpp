@@ -46,6 +46,13 @@ struct TimeIntegrationOptions {
   double spectral_radius = 0.8;  // ρ∞ ∈ [0, 1]: 1 conserves energy (trapezoidal), 0 damps the highest modes at once
   double dt = 1e-8;              // s, the first step
   double max_dt = 0.0;           // s, the longest step the controller may take (0: dt)
+  // When set, the longest step for a step starting at time t (overrides max_dt): a protocol whose
+  // phases need different steps, e.g. steps sized by sliding distance once sliding starts.
+  std::function<double(double)> max_dt_at;
+  // Called after every accepted step (t at its end, its length, u at its end), before on_step: a
+  // field solved staggered with the mechanics, e.g. heat conduction updating the committed states.
+  // false (with a reason) ends the run as not completed.
+  std::function<bool(double t, double dt, const Eigen::VectorXd& u, std::string& reason)> after_step;
   double end_time = 1e-7;        // s
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
@@ -110,7 +117,7 @@ class TimeIntegrator {
     StepRecord record;
   };
   Attempt step(double t0, double dt);
-  double next_step(double dt, int newton_iterations) const;
+  double next_step(double t, double dt, int newton_iterations) const;
   void record_solver_counts();  // the linear solver's counters into report_
   double alpha_m() const, alpha_f() const, beta() const, gamma() const;
   SolidProblem& problem_;
