@@ -52,7 +52,19 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
     std::printf("  length scale %-18s %.6g box widths = %.4g %s\n", input.name.c_str(), l, human,
                 std::string(kind == QuantityKind::temperature ? "K" : human_unit(kind)).c_str());
   }
-  if (s.hyper.noise_term) std::printf("  noise variance %.6g\n", s.hyper.noise_variance);
+  if (s.hyper.noise_term) {
+    std::printf("  learned noise variance %.6g (normalised; std %.4g in mu)\n", s.hyper.noise_variance,
+                s.y_scale * std::sqrt(s.hyper.noise_variance));
+  }
+  if (s.known_noise.size() != 0) {
+    std::printf("  known per-sample noise on the diagonal (--sample-noise): mean variance %.6g, max %.6g (normalised)\n",
+                s.known_noise.mean(), s.known_noise.maxCoeff());
+  }
+  if (s.micro_std_error > 0) {
+    std::printf("  micro-model scatter (RMS standard error of the samples' mu) %.4g = %.2f %% of mean mu: part of the "
+                "served interval\n", s.micro_std_error, 100.0 * s.micro_std_error / std::max(std::abs(s.y_mean), 1e-300));
+  }
+  std::printf("interval: %s\n", gp_interval_meaning(s.micro_std_error > 0).c_str());
   if (s.jitter > 0) std::printf("  jitter %.3g\n", s.jitter);
   const auto& t = s.summary;
   std::printf("cross-validation (leave-one-out, closed form): mean relative error %.4f %%, max %.4f %%, "
@@ -83,6 +95,10 @@ void add_train(CLI::App& app) {
                   "(0: off; used when the data have more than twice as many points)")
       ->capture_default_str()->check(CLI::Range(0, 1000000));
   cmd->add_flag("--no-noise", o->no_noise, "No white-noise term (interpolate exactly)");
+  cmd->add_flag("--sample-noise", o->gp.sample_noise,
+                "Put each sample's own variance (/samples/mu_std squared) on the covariance diagonal beside the\n"
+                "learned noise. For samples whose errors are independent; a micro-model plan's samples share\n"
+                "their tool draws, so their errors are correlated and this is off by default");
   cmd->footer("Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
               "cross-validated error. Bounds: signal variance 1e-3..1e5, length scales 1e-2..1e3 box widths,\n"
               "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).");
@@ -92,6 +108,11 @@ void add_train(CLI::App& app) {
     const TrainingSet data = training_set(dataset, o->data);
     std::printf("training data: %s (%lld converged of %lld samples, %zu inputs)\n", o->data.c_str(),
                 static_cast<long long>(data.x.rows()), static_cast<long long>(dataset.size()), data.inputs.size());
+    if (data.outside_model > 0) {
+      std::printf("left out: %lld samples outside the model (molten chip; `mufric dataset status` lists them)\n",
+                  data.outside_model);
+    }
+    if (!dataset.note.empty()) std::printf("note: %s\n", dataset.note.c_str());
     GpTrainingReport report;
     const GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
     print_training_report(gp, report);

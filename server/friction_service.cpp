@@ -103,6 +103,8 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
     out.set_loo_mean_relative_error(state.summary.loo_mean_relative_error);
     out.set_loo_max_relative_error(state.summary.loo_max_relative_error);
     out.set_loo_coverage_95(state.summary.loo_coverage_95);
+    out.set_interval_meaning(gp_interval_meaning(state.micro_std_error > 0.0));
+    out.set_micro_std_error(state.micro_std_error);
   }
   out.set_summary(model.summary());
 }

@@ -10,7 +10,8 @@ void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const 
 
 namespace mufric {
 
-CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diagonal_shift, Eigen::MatrixXd& factor) {
+CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diagonal_shift, Eigen::MatrixXd& factor,
+                                     const Eigen::VectorXd& per_point) {
   CholeskyOutcome outcome;
   const int n = static_cast<int>(source.rows());
   factor.resize(n, n);
@@ -18,7 +19,11 @@ CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diago
     outcome.ok = true;
     return outcome;
   }
-  const double mean_diagonal = source.diagonal().mean() + diagonal_shift;
+  if (per_point.size() != 0 && per_point.size() != n) {
+    outcome.reason = "per-point variances: " + std::to_string(per_point.size()) + " for " + std::to_string(n) + " rows";
+    return outcome;
+  }
+  const double mean_diagonal = source.diagonal().mean() + diagonal_shift + (per_point.size() ? per_point.mean() : 0.0);
   if (!std::isfinite(mean_diagonal) || mean_diagonal <= 0.0) {
     outcome.reason = "covariance diagonal is not positive and finite (mean " + std::to_string(mean_diagonal) + ")";
     return outcome;
@@ -29,6 +34,7 @@ CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diago
     ++outcome.attempts;
     factor.triangularView<Eigen::Lower>() = source.triangularView<Eigen::Lower>();
     factor.diagonal().array() += diagonal_shift + jitter;
+    if (per_point.size() != 0) factor.diagonal() += per_point;
     int info = 0;
     dpotrf_("L", &n, factor.data(), &n, &info);
     if (info == 0) {

@@ -21,9 +21,11 @@ struct CholeskyOutcome {
   std::string reason;    // why it failed, when !ok
 };
 
-// Factorises A = S + shift·I (+ jitter·I when needed) into its lower factor, written to `factor`;
-// only the lower triangle of `source` is read and it is left untouched, so retries start afresh.
-CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diagonal_shift, Eigen::MatrixXd& factor);
+// Factorises A = S + shift·I + diag(per_point) (+ jitter·I when needed) into its lower factor, written
+// to `factor`; only the lower triangle of `source` is read and it is left untouched, so retries
+// start afresh. `per_point` (may be empty): a known variance per row, e.g. each sample's own noise.
+CholeskyOutcome cholesky_with_jitter(const Eigen::MatrixXd& source, double diagonal_shift, Eigen::MatrixXd& factor,
+                                     const Eigen::VectorXd& per_point = Eigen::VectorXd());
 
 // Overwrites the lower factor L with the lower triangle of (L Lᵀ)⁻¹ (LAPACK dpotri).
 bool inverse_from_cholesky(Eigen::MatrixXd& lower);

@@ -100,6 +100,9 @@ GaussianProcess::GaussianProcess(State state) : FrictionModel(state.inputs), sta
   require(std::isfinite(state_.y_scale) && state_.y_scale > 0, "y_scale must be positive");
   require(std::isfinite(state_.y_mean), "y_mean must be finite");
   require(state_.alpha.allFinite() && state_.x_train.allFinite() && state_.y_train.allFinite(), "non-finite training data or alpha");
+  require(state_.known_noise.size() == 0 || state_.known_noise.size() == n, "known_noise length differs from the training points");
+  require(state_.known_noise.allFinite() && (state_.known_noise.array() >= 0).all(), "known_noise must be finite and >= 0");
+  require(std::isfinite(state_.micro_std_error) && state_.micro_std_error >= 0, "micro_std_error must be finite and >= 0");
 
   box_lo_.resize(d);
   inverse_box_width_.resize(d);
@@ -167,7 +170,8 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
   }
 
   if (need_std) {
-    // var_b = σ² + σn² − σ⁴ |L⁻¹ k̂_b|²  (R&W Algorithm 2.1, lines 5–6), in normalised units.
+    // var_b = σ² + σn² − σ⁴ |L⁻¹ k̂_b|²  (R&W Algorithm 2.1, lines 5–6), in normalised units, plus
+    // the micro-model's own scatter (GaussianProcess::State::micro_std_error).
     Eigen::RowVectorXd norms2;
     if (count <= kRowByRowMaxQueries) {
       norms2 = squared_norms_row_by_row(k_block);
@@ -176,7 +180,8 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
       norms2 = v_block.colwise().squaredNorm();
     }
     const double s2 = state_.hyper.signal_variance;
-    const double prior = s2 + state_.hyper.noise_variance;
+    const double scatter = state_.micro_std_error / state_.y_scale;
+    const double prior = s2 + state_.hyper.noise_variance + scatter * scatter;
     for (Eigen::Index b = 0; b < count; ++b) {
       double variance = prior - s2 * s2 * norms2(b);
       if (variance < 0.0) {
@@ -246,12 +251,28 @@ void GaussianProcess::evaluate_valid(const QueryBatch& x, const EvaluationReques
   out.clamped_variances += clamped;
 }
 
+std::string gp_interval_meaning(bool with_micro_scatter) {
+  return with_micro_scatter
+             ? "std = sqrt(model variance + learned noise + micro-model scatter): where the micro-model's mu, averaged "
+               "over all tools of the training scene's roughness statistics, is expected; the model part shrinks with "
+               "more training data, the scatter part (the RMS standard error of the training samples) only with more "
+               "tool phases/realisations per sample"
+             : "std = sqrt(model variance + learned noise): where a new micro-model run of the training scene is "
+               "expected (the training data carry no standard errors of their own)";
+}
+
 std::string GaussianProcess::summary() const {
   std::ostringstream s;
   const auto& h = state_.hyper;
   s << "Gaussian process, RBF-ARD kernel, " << state_.x_train.rows() << " training points\n";
-  s << "  signal variance " << h.signal_variance << ", noise variance " << (h.noise_term ? h.noise_variance : 0.0)
+  s << "  signal variance " << h.signal_variance << ", learned noise variance " << (h.noise_term ? h.noise_variance : 0.0)
     << (h.noise_term ? "" : " (no noise term)") << ", jitter " << state_.jitter << "\n";
+  if (state_.known_noise.size() != 0) {
+    s << "  known per-sample noise (micro-model standard errors): mean variance " << state_.known_noise.mean()
+      << ", max " << state_.known_noise.maxCoeff() << " (normalised); RMS standard error of mu "
+      << state_.micro_std_error << "\n";
+  }
+  s << "  interval: " << gp_interval_meaning(state_.micro_std_error > 0.0) << "\n";
   for (size_t j = 0; j < state_.inputs.size(); ++j) {
     s << "  length scale " << state_.inputs[j].name << ": " << h.length_scales(static_cast<Eigen::Index>(j))
       << " (box widths)\n";

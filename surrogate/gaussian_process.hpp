@@ -22,6 +22,9 @@ struct GpHyperParameters {
   Eigen::Index count() const { return length_scales.size() + (noise_term ? 2 : 1); }
 };
 
+// What a GP's standard deviation and interval mean, for DescribeModel and `describe`.
+std::string gp_interval_meaning(bool with_micro_scatter);
+
 // Figures from training, stored in the model file and shown by `describe`.
 struct GpTrainingSummary {
   double log_marginal_likelihood = 0.0;
@@ -48,6 +51,14 @@ class GaussianProcess final : public FrictionModel {
     double y_scale = 1.0;
     GpHyperParameters hyper;
     double jitter = 0.0;       // added to the diagonal beyond σn² when factorising
+    // Known noise of each training point (normalised-output variance, (μ_std / y_scale)², R&W eq.
+    // 2.20 with a diagonal of per-point variances, as scikit-learn's `alpha` array); empty: none.
+    Eigen::VectorXd known_noise;
+    // The micro-model's own scatter of μ (its standard error over tool phases and realisations), the
+    // root mean square over the training points, μ units; 0 when the data carry none. It is part of
+    // the served interval: the spread of the μ a converged micro-model would give about the mean
+    // over all tools of the same roughness statistics.
+    double micro_std_error = 0.0;
     Eigen::VectorXd alpha;     // K⁻¹ (y − mean)/scale
     Eigen::MatrixXd cholesky;  // lower factor of K, n × n
     GpTrainingSummary summary;

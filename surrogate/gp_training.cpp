@@ -150,8 +150,9 @@ void for_each_parallel(size_t count, int threads, Work work) {
 
 }  // namespace
 
-LogMarginalLikelihood::LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term)
-    : x_unit_(x_unit), y_(y), noise_term_(noise_term) {}
+LogMarginalLikelihood::LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term,
+                                             Eigen::VectorXd known_noise)
+    : x_unit_(x_unit), y_(y), noise_term_(noise_term), known_noise_(std::move(known_noise)) {}
 
 LogMarginalLikelihood::Value LogMarginalLikelihood::operator()(const Eigen::VectorXd& theta, bool with_gradient) {
   const Eigen::Index n = x_unit_.rows();
@@ -159,7 +160,7 @@ LogMarginalLikelihood::Value LogMarginalLikelihood::operator()(const Eigen::Vect
   const auto hyper = GpHyperParameters::from_log(theta, d, noise_term_);
   Value value;
   rbf_signal_covariance(x_unit_, hyper, kf_);
-  const auto chol = cholesky_with_jitter(kf_, hyper.noise_variance, factor_);
+  const auto chol = cholesky_with_jitter(kf_, hyper.noise_variance, factor_, known_noise_);
   value.jitter = chol.jitter;
   if (!chol.ok) {
     value.reason = chol.reason;
@@ -261,6 +262,21 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   }
   const Eigen::MatrixXd x_unit = to_unit_box(data.x, data.inputs);
   const Eigen::VectorXd y = (data.mu.array() - state.y_mean) / state.y_scale;
+  // The samples' own standard errors: their RMS widens the served interval; on request, each one's
+  // variance also goes on the diagonal.
+  const bool all_std = data.mu_std.size() == n && data.mu_std.allFinite();
+  if (all_std) {
+    state.micro_std_error = std::sqrt(data.mu_std.array().square().mean());
+    report.micro_std_error = state.micro_std_error;
+  } else if (data.mu_std.size() == n && data.mu_std.array().isFinite().any()) {
+    report.warnings.push_back("only some samples carry a standard error of mu: the micro-model's scatter is left out of "
+                              "the interval");
+  }
+  if (options.sample_noise) {
+    if (!all_std) throw Error("--sample-noise: every training sample needs its standard error of mu (/samples/mu_std)");
+    state.known_noise = (data.mu_std.array() / state.y_scale).square().matrix();
+    report.sample_noise_used = true;
+  }
 
   const LogBounds bounds = log_bounds(options.bounds, d, options.noise_term);
   GpHyperParameters initial = options.initial;
@@ -301,13 +317,15 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     std::shuffle(order.begin(), order.end(), std::mt19937_64(options.seed ^ 0x5eed5eedULL));
     Eigen::MatrixXd x_subset(options.subset_size, d);
     Eigen::VectorXd y_subset(options.subset_size);
+    Eigen::VectorXd noise_subset(state.known_noise.size() != 0 ? options.subset_size : 0);
     for (Eigen::Index k = 0; k < options.subset_size; ++k) {
       x_subset.row(k) = x_unit.row(order[static_cast<size_t>(k)]);
       y_subset(k) = y(order[static_cast<size_t>(k)]);
+      if (noise_subset.size() != 0) noise_subset(k) = state.known_noise(order[static_cast<size_t>(k)]);
     }
     for_each_parallel(starts.size(), threads, [&](size_t s) {
       const auto t_start = std::chrono::steady_clock::now();
-      LogMarginalLikelihood coarse(x_subset, y_subset, options.noise_term);
+      LogMarginalLikelihood coarse(x_subset, y_subset, options.noise_term, noise_subset);
       const LocalOptimum optimum = maximise(coarse, starts[s], options, bounds);
       report.starts[s].subset_evaluations = optimum.evaluations;
       subset_lml[s] = optimum.lml;
@@ -342,7 +360,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     const size_t s = leaders[i];
     const auto t_start = std::chrono::steady_clock::now();
     GpStartReport& r = report.starts[s];
-    LogMarginalLikelihood lml(x_unit, y, options.noise_term);
+    LogMarginalLikelihood lml(x_unit, y, options.noise_term, state.known_noise);
     if (!options.optimise || !refine[s]) {
       const auto value = lml(polish_from[s], false);
       r.final_log = polish_from[s];
@@ -396,7 +414,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
 
   Eigen::MatrixXd kf;
   rbf_signal_covariance(x_unit, state.hyper, kf);
-  const auto chol = cholesky_with_jitter(kf, state.hyper.noise_variance, state.cholesky);
+  const auto chol = cholesky_with_jitter(kf, state.hyper.noise_variance, state.cholesky, state.known_noise);
   if (!chol.ok) throw Error("Gaussian process fit failed at the optimum: " + chol.reason);
   state.jitter = chol.jitter;
   report.jitter = chol.jitter;

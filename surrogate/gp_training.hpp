@@ -36,6 +36,11 @@ struct GpTrainingOptions {
   double absolute_tolerance = 1e-5;
   int threads = 0;             // starts run in parallel; 0 = all cores
   bool optimise = true;        // false: use `initial` as given
+  // Put each sample's own variance (μ_std²) on the covariance diagonal, beside the learned noise.
+  // Right when the samples' errors are independent; a dataset whose samples share their tool draws
+  // (common random numbers: every plan row uses the same phases and seeds) has errors correlated
+  // across samples, which the diagonal would wrongly smooth away. Needs every sample's μ_std.
+  bool sample_noise = false;
 };
 
 struct GpStartReport {
@@ -55,12 +60,16 @@ struct GpTrainingReport {
   double jitter = 0.0;
   double seconds = 0.0;
   std::vector<std::string> warnings;  // constant outputs, parameter at a bound, jitter added, ...
+  bool sample_noise_used = false;     // per-sample variances on the diagonal
+  double micro_std_error = 0.0;       // RMS μ standard error of the training samples (0: none)
 };
 
 // Log marginal likelihood of normalised outputs y at unit-box inputs, and its gradient w.r.t. θ.
 class LogMarginalLikelihood {
  public:
-  LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term);
+  // known_noise: per-point variance on the diagonal (normalised), or empty.
+  LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term,
+                        Eigen::VectorXd known_noise = Eigen::VectorXd());
 
   struct Value {
     bool ok = false;
@@ -78,6 +87,7 @@ class LogMarginalLikelihood {
   const Eigen::MatrixXd& x_unit_;
   const Eigen::VectorXd& y_;
   bool noise_term_;
+  Eigen::VectorXd known_noise_;
   Eigen::MatrixXd kf_;      // σ² R, lower triangle
   Eigen::MatrixXd factor_;  // L, then (LLᵀ)⁻¹
   Eigen::MatrixXd scaled_;  // x_unit / l

@@ -84,7 +84,7 @@ void save_model(const std::string& path, const FrictionModel& model) {
 namespace {
 std::unique_ptr<FrictionModel> read_model(const std::string& path) {
   const h5::Reader in(path, "model");
-  in.require_format(kModelFormat, kModelSchemaVersion, "mufric model");
+  in.require_format(kModelFormat, kOldestReadableModelSchema, kModelSchemaVersion, "mufric model");
   InputSpace inputs = read_input_space(in);
   const std::string kind = in.string_attribute("/", "kind");
   try {
@@ -181,6 +181,8 @@ void GaussianProcess::write(h5::Writer& out) const {
   out.doubles("/gp/y_train", s.y_train);
   out.doubles("/gp/alpha", s.alpha);
   if (s.x_train.rows() <= kStoreCholeskyUpTo) out.matrix("/gp/cholesky_lower", s.cholesky);
+  if (s.known_noise.size() != 0) out.doubles("/gp/known_noise", s.known_noise);
+  out.double_attribute("/gp", "micro_std_error", s.micro_std_error);
   out.group(kSummaryGroup);
   for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(kSummaryGroup, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryCounts) out.int_attribute(kSummaryGroup, name, s.summary.*field);
@@ -219,9 +221,21 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
   }
   if (!(s.jitter >= 0) || !std::isfinite(s.jitter)) in.fail("/gp", "attribute jitter must be >= 0 and finite");
   if (!(s.y_scale > 0) || !std::isfinite(s.y_scale)) in.fail("/gp", "attribute y_scale must be positive and finite");
+  if (in.has("/gp/known_noise")) {
+    s.known_noise = in.vector("/gp/known_noise", n);
+    if (!s.known_noise.allFinite() || !(s.known_noise.array() >= 0).all()) in.fail("/gp/known_noise", "must be finite and >= 0");
+  }
+  if (in.has_attribute("/gp", "micro_std_error")) {
+    s.micro_std_error = in.double_attribute("/gp", "micro_std_error");
+    if (!(s.micro_std_error >= 0) || !std::isfinite(s.micro_std_error)) {
+      in.fail("/gp", "attribute micro_std_error must be >= 0 and finite");
+    }
+  }
 
   Eigen::MatrixXd kf;
   rbf_signal_covariance(to_unit_box(s.x_train, s.inputs), s.hyper, kf);
+  // Known per-point noise belongs to the covariance the factor was made of.
+  if (s.known_noise.size() != 0) kf.diagonal() += s.known_noise;
   const double diagonal = s.hyper.noise_variance + s.jitter;
   if (in.has("/gp/cholesky_lower")) {
     s.cholesky = in.matrix("/gp/cholesky_lower");

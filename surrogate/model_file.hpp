@@ -11,7 +11,10 @@
 
 namespace mufric {
 
-inline constexpr long long kModelSchemaVersion = 1;
+// Version 2 added a GP's optional /gp/known_noise and its micro_std_error attribute (the micro-model's
+// scatter, part of the interval); version-1 files still load (no scatter: the interval as before).
+inline constexpr long long kModelSchemaVersion = 2;
+inline constexpr long long kOldestReadableModelSchema = 1;
 inline constexpr const char* kModelFormat = "mufric-model";
 
 // Writes atomically (temporary file + rename).

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <H5Cpp.h>
+
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 
@@ -53,6 +55,65 @@ TEST(DatasetFile, RoundTripKeepsFailuresAndTrainingSetSkipsThem) {
   EXPECT_EQ(t.x.rows(), 2);
   EXPECT_EQ(t.mu(1), 0.25);
   EXPECT_EQ(t.source_hash.size(), 64u);
+  std::filesystem::remove(path);
+}
+
+// Schema 2 carries each sample's standard error and a status for samples outside the model (a molten
+// chip); schema-1 files (no /samples/mu_std) still load, with NaN standard errors and a note.
+TEST(DatasetFile, StandardErrorsAndOutsideModelSamplesRoundTripAndOldFilesLoad) {
+  Dataset d;
+  d.inputs = default_friction_box();
+  d.x.resize(3, 3);
+  d.x << 400e6, 1.0, 500.0, 500e6, 1.5, 600.0, 1300e6, 0.4, 1100.0;
+  d.mu = values({0.3, 0.28, 0.05});
+  d.mu_std = values({0.004, 0.003, 0.01});
+  d.status = {0, 0, static_cast<long long>(SampleStatus::outside_model)};
+  d.failure_reason = {"", "", "the chip reached its melting temperature"};
+  d.plan = d.x;
+  const std::string path = temp_path("std.h5");
+  write_dataset(path, d);
+  const Dataset r = read_dataset(path);
+  EXPECT_EQ(r.mu_std, d.mu_std);
+  EXPECT_TRUE(r.note.empty());
+  EXPECT_TRUE(r.outside_model(2));
+  const TrainingSet t = training_set(r, path);
+  EXPECT_EQ(t.x.rows(), 2);  // the molten sample is never trained on
+  EXPECT_EQ(t.outside_model, 1);
+  EXPECT_EQ(t.mu_std(1), 0.003);
+
+  // The same file as schema 1 wrote it: no mu_std, schema_version 1.
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    file.unlink("/samples/mu_std");
+    H5::Attribute version = file.openGroup("/").openAttribute("schema_version");
+    const long long one = 1;
+    version.write(H5::PredType::NATIVE_LLONG, &one);
+  }
+  const Dataset old = read_dataset(path);
+  EXPECT_EQ(old.mu, d.mu);
+  EXPECT_TRUE(old.mu_std.array().isNaN().all());
+  EXPECT_NE(old.note.find("schema version 1"), std::string::npos) << old.note;
+  EXPECT_EQ(training_set(old, path).mu_std.size(), 2);
+
+  // A status this build does not know is refused, naming the field and the row.
+  d.status[1] = 7;
+  write_dataset(path, d);
+  const std::string m = error_of([&] { read_dataset(path); });
+  EXPECT_NE(m.find("/samples/status"), std::string::npos) << m;
+  EXPECT_NE(m.find("row 1"), std::string::npos) << m;
+  std::filesystem::remove(path);
+}
+
+TEST(DatasetFile, CsvMayCarryStandardErrors) {
+  const std::string path = temp_path("std.csv");
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu,mu_std\n800,120,500,0.3,0.004\n"
+                         "900,60,25,0.4,0.002\n";
+  const Dataset d = read_dataset(path);
+  EXPECT_EQ(d.inputs.size(), 3u);
+  EXPECT_DOUBLE_EQ(d.mu_std(1), 0.002);
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu,mu_std\n800,120,500,0.3,-1\n";
+  const std::string m = error_of([&] { read_dataset(path); });
+  EXPECT_NE(m.find("mu_std"), std::string::npos) << m;
   std::filesystem::remove(path);
 }
 

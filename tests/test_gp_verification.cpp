@@ -114,6 +114,48 @@ TEST(GpVerification, PredictionMatchesDenseFormulaWithExplicitInverse) {
   }
 }
 
+// Known per-sample noise (R&W eq. 2.20 with diag(s_i²) added to K, scikit-learn's `alpha` array) and
+// the micro-model's scatter in the interval, against the textbook posterior with a dense inverse.
+TEST(GpVerification, KnownPerSampleNoiseMatchesDensePosterior) {
+  TrainingSet data = test::smooth_training_set(40, 13);
+  data.mu_std.resize(data.mu.size());
+  for (Eigen::Index i = 0; i < data.mu_std.size(); ++i) data.mu_std(i) = 1e-3 * (1.0 + 0.05 * static_cast<double>(i % 7));
+  const Eigen::Vector3d lengths(0.7, 0.6, 0.9);
+  GpTrainingOptions options = fixed(2.0, lengths, 1e-4);
+  options.sample_noise = true;
+  const GaussianProcess gp = train_gaussian_process(data, options);
+  const auto& s = gp.state();
+  ASSERT_EQ(s.known_noise.size(), data.mu.size());
+  const double micro = std::sqrt(data.mu_std.array().square().mean());
+  EXPECT_NEAR(s.micro_std_error, micro, 1e-15);
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  Eigen::MatrixXd k = dense_covariance(u, s.hyper, s.hyper.noise_variance + s.jitter);
+  for (Eigen::Index i = 0; i < k.rows(); ++i) k(i, i) += std::pow(data.mu_std(i) / s.y_scale, 2);
+  const Eigen::MatrixXd k_inv = k.fullPivLu().inverse();
+  const Eigen::VectorXd y = (data.mu.array() - s.y_mean) / s.y_scale;
+  // The LML with the known noise, too.
+  LogMarginalLikelihood lml(u, y, true, s.known_noise);
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(k);
+  const double dense = -0.5 * y.dot(lu.solve(y)) - 0.5 * lu.matrixLU().diagonal().array().abs().log().sum() -
+                       0.5 * static_cast<double>(y.size()) * std::log(2 * std::numbers::pi);
+  EXPECT_NEAR(lml(s.hyper.to_log(), false).lml, dense, 1e-8 * std::abs(dense));
+
+  const TrainingSet queries = test::smooth_training_set(25, 98);
+  const Evaluation e = gp.evaluate(queries.x, {.std = true, .ci_level = 0.95, .gradient = false});
+  const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
+  for (Eigen::Index q = 0; q < uq.rows(); ++q) {
+    const Eigen::VectorXd kq = dense_kernel_vector(uq.row(q), u, lengths, 2.0);
+    const double mean = s.y_mean + s.y_scale * kq.dot(k_inv * y);
+    const double var = 2.0 + 1e-4 + std::pow(micro / s.y_scale, 2) - kq.dot(k_inv * kq);
+    EXPECT_NEAR(e.mu(q), mean, 1e-10);
+    EXPECT_NEAR(e.std(q), s.y_scale * std::sqrt(var), 1e-10);
+  }
+  // Without --sample-noise the diagonal carries only the learned noise, and the scatter stays in std.
+  const GaussianProcess plain = train_gaussian_process(data, fixed(2.0, lengths, 1e-4));
+  EXPECT_EQ(plain.state().known_noise.size(), 0);
+  EXPECT_NEAR(plain.state().micro_std_error, micro, 1e-15);
+}
+
 TEST(GpVerification, MeanGradientMatchesFiniteDifferences) {
   const TrainingSet data = test::smooth_training_set(50, 21);
   const GaussianProcess gp = train_gaussian_process(data, fixed(2.0, Eigen::Vector3d(0.6, 0.7, 0.8), 1e-5));

@@ -1,0 +1,165 @@
+#!/usr/bin/env python3
+"""The press-slide protocol's studies (bench/RESULTS.md, "What mu means"): each run is one `mufric
+micro run` of the default scene with overrides; prints markdown tables.
+
+  /usr/bin/python3 bench/mu_protocol.py MUFRIC OUT_DIR [STUDY ...] [--set key=value ...]
+
+Studies: ramp (pressing ramp and hold x4, paired per draw), window (block means over a long slide),
+step (sliding step 12.5/25/50 nm), heat (adiabatic / conduction / isothermal, paired), draws
+(variance of mu over tool phases and realisations), seed000 (the paper's protocol beside). Extra
+--set overrides apply to every run (e.g. the mesh). Every result.json is kept in OUT_DIR.
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+
+def run(mufric, out, name, overrides):
+    d = os.path.join(out, name)
+    cmd = [mufric, "micro", "run", "--quiet", "--out", d]
+    for o in overrides:
+        cmd += ["--set", o]
+    start = time.time()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode not in (0, 3) or not os.path.exists(os.path.join(d, "result.json")):
+        sys.exit(f"{name}: exit {p.returncode}: {p.stdout[-500:]} {p.stderr[-500:]}")
+    r = json.load(open(os.path.join(d, "result.json")))
+    r["_wall"] = time.time() - start
+    r["_cmd"] = " ".join(cmd)
+    return r
+
+
+def draw_mus(r):
+    return [d["mu"] for d in r["draws"]]
+
+
+def mean_se(xs):
+    n = len(xs)
+    m = sum(xs) / n
+    if n < 2:
+        return m, float("nan")
+    return m, math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1) / n)
+
+
+def fmt(r):
+    se = r["mu_std_error"]
+    return f'{r["mu"]:.5f} ± {se:.5f} ({100 * se / r["mu"]:.2f} %)' if se else f'{r["mu"]:.5f}'
+
+
+def paired(base, other):
+    diffs = [b - a for a, b in zip(draw_mus(base), draw_mus(other))]
+    m, se = mean_se(diffs)
+    return f"{100 * m / base['mu']:+.2f} % ± {100 * se / base['mu']:.2f} %"
+
+
+def table(rows, header):
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for row in rows:
+        print("| " + " | ".join(str(c) for c in row) + " |")
+    print()
+
+
+def study_ramp(m, out, extra):
+    print("### Pressing: ramp and hold x4 (paired per draw, 4 tool phases)\n")
+    base = run(m, out, "ramp-25-hold-25", extra)
+    rows = [("25 ns", "25 ns", fmt(base), "", f'{base["_wall"]:.0f}')]
+    for ramp, hold in (("100ns", "25ns"), ("25ns", "100ns"), ("6.25ns", "25ns")):
+        r = run(m, out, f"ramp-{ramp}-hold-{hold}", extra + [f"load.ramp={ramp}", f"protocol.press_hold={hold}"])
+        rows.append((ramp, hold, fmt(r), paired(base, r), f'{r["_wall"]:.0f}'))
+    table(rows, ["ramp", "hold", "mu ± s.e.", "paired change vs 25/25", "wall [s]"])
+
+
+def study_window(m, out, extra):
+    print("### Window: 8 blocks of 0.625 um over a 5 um slide after a 0.5 um run-in (4 tool phases)\n")
+    r = run(m, out, "window-5um", extra + ["protocol.window=5um", "protocol.blocks=8"])
+    blocks = [d["block_means"] for d in r["draws"]]
+    rows = []
+    for k in range(8):
+        col = [b[k] for b in blocks]
+        mm, se = mean_se(col)
+        rows.append((f"{0.5 + 0.625 * k:.3f}-{0.5 + 0.625 * (k + 1):.3f}", f"{mm:.5f} ± {se:.5f}"))
+    table(rows, ["sliding distance [um]", "mean over phases ± s.e."])
+    first = [sum(b[:4]) / 4 for b in blocks]
+    second = [sum(b[4:]) / 4 for b in blocks]
+    diffs = [b - a for a, b in zip(first, second)]
+    md, sd = mean_se(diffs)
+    print(f"first half (0.5-3.0 um) {mean_se(first)[0]:.5f}, second half (3.0-5.5 um) {mean_se(second)[0]:.5f}: "
+          f"paired difference {100 * md / r['mu']:+.2f} % ± {100 * sd / r['mu']:.2f} %; max temperature "
+          f"{r['diagnostics']['max_temperature_k'] - 273.15:.0f} C; wall {r['_wall']:.0f} s\n")
+
+
+def study_step(m, out, extra):
+    print("### Sliding step (4 tool phases, paired against 12.5 nm)\n")
+    base = run(m, out, "step-12.5nm", extra + ["protocol.step_distance=12.5nm"])
+    rows = [("12.5 nm", fmt(base), "", base["diagnostics"]["newton_iterations"], f'{base["_wall"]:.0f}')]
+    for s in ("25nm", "50nm", "100nm"):
+        r = run(m, out, f"step-{s}", extra + [f"protocol.step_distance={s}"])
+        rows.append((s, fmt(r), paired(base, r), r["diagnostics"]["newton_iterations"], f'{r["_wall"]:.0f}'))
+    table(rows, ["step", "mu ± s.e.", "paired change", "Newton iterations", "wall [s]"])
+
+
+def study_heat(m, out, extra):
+    print("### Heat (4 tool phases, paired against conduction)\n")
+    base = run(m, out, "heat-conduction", extra)
+    rows = [("conduction (k = 50 W/m K)", fmt(base), "", f'{base["diagnostics"]["max_temperature_k"] - 273.15:.0f}')]
+    for name, o in (("adiabatic", ["thermal.model=adiabatic"]), ("isothermal (no heating)", ["material.heat_fraction=0"])):
+        r = run(m, out, "heat-" + name.split()[0], extra + o)
+        rows.append((name, fmt(r), paired(base, r), f'{r["diagnostics"]["max_temperature_k"] - 273.15:.0f}'))
+    table(rows, ["heat", "mu ± s.e.", "paired change", "max T [C]"])
+
+
+def study_draws(m, out, extra):
+    print("### Draws: 4 tool realisations x 4 phases\n")
+    r = run(m, out, "draws-4x4", extra + ["protocol.phases=4", "protocol.realisations=4"])
+    mus = draw_mus(r)
+    by_real = [mus[4 * k:4 * k + 4] for k in range(4)]
+    rows = []
+    for k, xs in enumerate(by_real):
+        mm, se = mean_se(xs)
+        rows.append((f"seed {r['draws'][4 * k]['tool_seed']}", " ".join(f"{x:.4f}" for x in xs), f"{mm:.5f} ± {se:.5f}"))
+    table(rows, ["tool", "mu of phases 0, 1/4, 1/2, 3/4", "mean ± s.e. over phases"])
+    within = sum(sum((x - sum(xs) / 4) ** 2 for x in xs) for xs in by_real) / (4 * 3)
+    means = [sum(xs) / 4 for xs in by_real]
+    between = sum((x - sum(means) / 4) ** 2 for x in means) / 3 - within / 4
+    print(f"all 16: {fmt(r)}; variance components: phase within a tool {math.sqrt(within):.4f} (std), "
+          f"between tools {math.sqrt(max(between, 0)):.4f} (std of a tool's full-period mean); wall {r['_wall']:.0f} s\n")
+    for nr, npz in ((1, 4), (2, 2), (4, 1), (8, 1), (16, 1)):
+        se = math.sqrt(max(between, 0) / nr + within / (nr * npz))
+        print(f"- predicted s.e. with {nr} realisations x {npz} phases: {se:.4f} ({100 * se / r['mu']:.1f} %)")
+    print()
+
+
+def study_seed000(m, out, extra):
+    print("### Seed 000's protocol beside (one draw, ramp while sliding, 250 ns)\n")
+    rows = []
+    for ramp in ("12.5ns", "25ns", "50ns"):
+        r = run(m, out, f"seed000-ramp-{ramp}", extra + ["protocol.name=seed-000", f"load.ramp={ramp}"])
+        rows.append((ramp, fmt(r), f'{r["_wall"]:.0f}'))
+    table(rows, ["ramp", "mu", "wall [s]"])
+
+
+STUDIES = {"ramp": study_ramp, "window": study_window, "step": study_step, "heat": study_heat,
+           "draws": study_draws, "seed000": study_seed000}
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    mufric, out = sys.argv[1], sys.argv[2]
+    args = sys.argv[3:]
+    extra = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
+    names = [a for i, a in enumerate(args) if a != "--set" and (i == 0 or args[i - 1] != "--set")] or list(STUDIES)
+    os.makedirs(out, exist_ok=True)
+    print(f"`{' '.join(sys.argv)}` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores\n")
+    for n in names:
+        if n not in STUDIES:
+            sys.exit(f"unknown study '{n}'; one of {', '.join(STUDIES)}")
+        STUDIES[n](mufric, out, extra)
+
+
+if __name__ == "__main__":
+    main()
