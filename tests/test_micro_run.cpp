@@ -16,10 +16,11 @@
 namespace mufric::scene {
 namespace {
 
-// The default scene made small and short: a coarse mesh, 1 ns steps, 20 ns with a 10 ns ramp.
+// The default scene made small and short under seed 000's protocol: a coarse mesh, 1 ns steps,
+// 20 ns with a 10 ns ramp (one draw, the physics of a run).
 nlohmann::json small_scene() {
   nlohmann::json j = default_scene_json();
-  for (const char* s : {"discretisation.elements_x=32", "discretisation.elements_y=4",
+  for (const char* s : {"protocol.name=\"seed-000\"", "discretisation.elements_x=32", "discretisation.elements_y=4",
                         "geometry.chip_surface.fit.control_points=32", "geometry.tool_surface.fit.control_points=32",
                         "time.duration=\"20ns\"", "time.average_from=\"10ns\"", "load.ramp=\"10ns\"",
                         "load.pressure=\"400MPa\""}) {
@@ -142,8 +143,8 @@ TEST(MicroRun, SymmetricTeethReverseMuWithTheSlidingDirection) {
 // flatten plastically, heat up, and the tool resists the sliding (μ > 0).
 TEST(MicroRun, DefaultSceneSmokeTest) {
   nlohmann::json j = default_scene_json();
-  for (const char* s : {"discretisation.elements_x=64", "discretisation.elements_y=6", "time.duration=\"60ns\"",
-                        "time.average_from=\"40ns\""}) {
+  for (const char* s : {"protocol.name=\"seed-000\"", "discretisation.elements_x=64", "discretisation.elements_y=6",
+                        "time.duration=\"60ns\"", "time.average_from=\"40ns\""}) {
     apply_override(j, s);
   }
   const Scene scene = parse_scene(j, "default, coarse");
@@ -171,6 +172,137 @@ TEST(MicroRun, AChipAtItsMeltingTemperatureIsReportedOutsideTheModel) {
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_NE(r.warnings.front().find("melting temperature"), std::string::npos) << r.warnings.front();
   EXPECT_EQ(r.to_json(parse_scene(j, "molten"))["warnings"].size(), 1u);
+}
+
+// ---- the press-slide protocol ------------------------------------------------------------------
+
+// The default scene small: coarse mesh, short slide (0.25 um run-in, 0.5 um window in 50 nm steps),
+// two tool phases, pressing 25 + 10 ns.
+nlohmann::json small_press_slide() {
+  nlohmann::json j = default_scene_json();
+  for (const char* s : {"discretisation.elements_x=32", "discretisation.elements_y=4",
+                        "geometry.chip_surface.fit.control_points=32", "geometry.tool_surface.fit.control_points=32",
+                        "protocol.run_in=\"0.25um\"", "protocol.window=\"0.5um\"", "protocol.step_distance=\"50nm\"",
+                        "protocol.phases=2", "protocol.press_hold=\"10ns\"", "load.pressure=\"400MPa\""}) {
+    apply_override(j, s);
+  }
+  return j;
+}
+
+MuMeasurement measure(const nlohmann::json& j, const std::string& name) {
+  MuMeasurement m = measure_mu(parse_scene(j, name));
+  EXPECT_TRUE(m.completed) << name << ": " << m.reason;
+  return m;
+}
+
+TEST(PressSlide, PressingFourTimesSlowerMovesMuLessThanItsStandardError) {
+  const MuMeasurement fast = measure(small_press_slide(), "ramp 25 ns");
+  nlohmann::json j = small_press_slide();
+  apply_override(j, "load.ramp=\"100ns\"");
+  const MuMeasurement slow = measure(j, "ramp 100 ns");
+  ASSERT_TRUE(fast.std_error && slow.std_error);
+  EXPECT_GT(std::abs(fast.mu), 1e-3);
+  EXPECT_LT(std::abs(slow.mu - fast.mu), std::max(*fast.std_error, *slow.std_error))
+      << fast.mu << " +- " << *fast.std_error << " vs " << slow.mu << " +- " << *slow.std_error;
+  // Seed 000's protocol on the same mesh moves by far more with the same change of ramp: the test
+  // above could fail.
+  nlohmann::json a = small_scene(), b = small_scene();
+  apply_override(a, "load.ramp=\"5ns\"");
+  apply_override(b, "load.ramp=\"20ns\"");
+  const MicroResult ra = run_micro(parse_scene(a, "seed 000 ramp 5 ns")), rb = run_micro(parse_scene(b, "seed 000 ramp 20 ns"));
+  ASSERT_TRUE(ra.completed && rb.completed);
+  EXPECT_GT(std::abs(ra.mu - rb.mu), *fast.std_error);
+}
+
+TEST(PressSlide, TwoWindowsAfterTheRunInAgreeWithinTheirError) {
+  nlohmann::json j = small_press_slide();
+  apply_override(j, "protocol.window=\"1um\"");
+  apply_override(j, "protocol.blocks=2");
+  apply_override(j, "protocol.phases=4");
+  const MuMeasurement m = measure(j, "two windows");
+  std::vector<double> first, second;
+  for (const auto& d : m.draws) {
+    ASSERT_EQ(d.result.block_means.size(), 2u);
+    first.push_back(d.result.block_means[0]);
+    second.push_back(d.result.block_means[1]);
+  }
+  auto mean_and_error = [](const std::vector<double>& x) {
+    const double n = static_cast<double>(x.size());
+    double mean = 0.0, squares = 0.0;
+    for (double v : x) mean += v / n;
+    for (double v : x) squares += (v - mean) * (v - mean);
+    return std::make_pair(mean, std::sqrt(squares / (n - 1.0) / n));
+  };
+  const auto [m1, e1] = mean_and_error(first);
+  const auto [m2, e2] = mean_and_error(second);
+  EXPECT_LT(std::abs(m1 - m2), 2.0 * std::hypot(e1, e2)) << m1 << " +- " << e1 << " vs " << m2 << " +- " << e2;
+  // The whole window's mean is the mean of its two halves.
+  EXPECT_NEAR(m.mu, 0.5 * (m1 + m2), 1e-12);
+}
+
+TEST(PressSlide, PhaseAverageIsInvariantUnderACommonShiftOfBothSurfaces) {
+  const MuMeasurement base = measure(small_press_slide(), "base");
+  nlohmann::json j = small_press_slide();
+  apply_override(j, "geometry.chip_surface.shift=0.37");
+  apply_override(j, "geometry.tool_surface.shift=0.37");
+  const MuMeasurement shifted = measure(j, "shifted");
+  ASSERT_EQ(base.draws.size(), shifted.draws.size());
+  EXPECT_GT(std::abs(base.mu), 1e-3);
+  for (size_t i = 0; i < base.draws.size(); ++i) {
+    ASSERT_EQ(base.draws[i].result.solver.cutbacks.size(), shifted.draws[i].result.solver.cutbacks.size());
+    EXPECT_NEAR(shifted.draws[i].result.mu, base.draws[i].result.mu, 1e-6 * std::abs(base.mu)) << "draw " << i;
+  }
+  EXPECT_NEAR(shifted.mu, base.mu, 1e-6 * std::abs(base.mu));
+  // Two phases are two different tool positions: they do differ (else the average would say nothing).
+  EXPECT_NE(base.draws[0].result.mu, base.draws[1].result.mu);
+}
+
+TEST(PressSlide, FlatToolGivesZeroMu) {
+  nlohmann::json j = small_press_slide();
+  j["geometry"]["tool_surface"] = {{"flat", true}, {"fit", {{"degree", 3}, {"control_points", 32}}}};
+  const MuMeasurement m = measure(j, "flat");
+  EXPECT_LT(std::abs(m.mu), 1e-12);
+  ASSERT_TRUE(m.std_error.has_value());
+  EXPECT_LT(*m.std_error, 1e-12);
+}
+
+TEST(PressSlide, ResultSaysHowMuWasObtained) {
+  nlohmann::json j = small_press_slide();
+  apply_override(j, "protocol.realisations=2");
+  const Scene scene = parse_scene(j, "json");
+  const MuMeasurement m = measure_mu(scene);
+  ASSERT_TRUE(m.completed) << m.reason;
+  const nlohmann::json r = m.to_json(scene);
+  EXPECT_EQ(r["protocol"]["name"], "press-slide");
+  EXPECT_EQ(r["protocol"]["draws"], 4);
+  EXPECT_EQ(r["draws"].size(), 4u);
+  EXPECT_EQ(r["draws"][2]["tool_seed"], scene.tool_surface.synthetic.seed + 1);
+  EXPECT_DOUBLE_EQ(r["draws"][1]["tool_shift_fraction"].get<double>(), 0.5);
+  EXPECT_EQ(r["draws"][0]["block_means"].size(), 4u);
+  double sum = 0.0;
+  for (const auto& d : r["draws"]) sum += d["mu"].get<double>();
+  EXPECT_NEAR(r["mu"].get<double>(), sum / 4.0, 1e-15);
+  EXPECT_GT(r["mu_std_error"].get<double>(), 0.0);
+  // The slide starts after the pressing phase, and the window is measured in distance.
+  const auto& history = r["draws"][0]["history"];
+  EXPECT_EQ(history.front()["sliding_distance_m"].get<double>(), 0.0);
+  EXPECT_NEAR(history.back()["sliding_distance_m"].get<double>(), 0.75e-6, 1e-12);
+  // Realisations need a synthetic tool.
+  nlohmann::json csv = small_press_slide();
+  apply_override(csv, "protocol.realisations=2");
+  csv["geometry"]["tool_surface"] = {{"flat", true}, {"fit", {{"degree", 3}, {"control_points", 32}}}};
+  EXPECT_THROW(parse_scene(csv, "flat realisations"), Error);
+}
+
+// The seed-000 protocol is the run mufric made before press-slide existed, to the last digit: the
+// default scene gave 0.180576145017611 with commit 50c7495 on this machine (bench/RESULTS.md).
+TEST(PressSlide, SeedZeroProtocolReproducesTheEarlierDefaultScene) {
+  nlohmann::json j = default_scene_json();
+  apply_override(j, "protocol.name=\"seed-000\"");
+  const MuMeasurement m = measure(j, "seed 000");
+  ASSERT_EQ(m.draws.size(), 1u);
+  EXPECT_FALSE(m.std_error.has_value());
+  EXPECT_NEAR(m.mu, 0.180576145017611, 1e-13);
 }
 
 }  // namespace
