@@ -74,6 +74,7 @@ struct RunCommandOptions {
   double tolerance = 0.007;
   int max_levels = 4;
   std::string direction = "both";  // converge: which element counts each level doubles
+  std::string parameter = "mesh";  // converge: what each level refines
 };
 
 scene::Scene load_scene(const RunCommandOptions& o) { return scene::load_scene(o.scene_path, o.overrides); }
@@ -184,20 +185,53 @@ int run_command(const RunCommandOptions& o) {
   return m.completed ? 0 : 3;
 }
 
+// What a level of `micro converge` refines, and how the table names it.
+std::string level_setting(const scene::Scene& sc, const std::string& parameter) {
+  char text[64];
+  if (parameter == "step") {
+    std::snprintf(text, sizeof text, "%.4g nm", sc.protocol.step_distance * 1e9);
+  } else if (parameter == "window") {
+    std::snprintf(text, sizeof text, "%.4g um", sc.protocol.window * 1e6);
+  } else if (parameter == "phases") {
+    std::snprintf(text, sizeof text, "%d x %d", sc.protocol.phases, sc.protocol.realisations);
+  } else {
+    std::snprintf(text, sizeof text, "%d x %d", sc.elements_x, sc.elements_y);
+  }
+  return text;
+}
+
+void refine(scene::Scene& sc, const RunCommandOptions& o) {
+  if (o.parameter == "step") {
+    sc.protocol.step_distance *= 0.5;
+  } else if (o.parameter == "window") {
+    sc.protocol.window *= 2.0;
+  } else if (o.parameter == "phases") {
+    sc.protocol.phases *= 2;
+  } else {
+    if (o.direction != "y") sc.elements_x *= 2;
+    if (o.direction != "x") sc.elements_y *= 2;
+  }
+}
+
 int converge_command(const RunCommandOptions& o) {
   scene::Scene sc = load_scene(o);
-  std::printf("| level | elements | dofs | mu | std error | change | wall [s] |\n|---|---|---|---|---|---|---|\n");
+  if (o.parameter != "mesh" && sc.protocol.name == scene::Protocol::seed000) {
+    throw Error("--parameter " + o.parameter + " refines the press-slide protocol; this scene uses seed-000's");
+  }
+  const char* what = o.parameter == "mesh" ? "elements" : o.parameter == "step" ? "sliding step"
+                     : o.parameter == "window" ? "window" : "phases x realisations";
+  std::printf("| level | %s | dofs | mu | std error | change | wall [s] |\n|---|---|---|---|---|---|---|\n", what);
   std::optional<double> previous;
   for (int level = 0; level <= o.max_levels; ++level) {
     const scene::MuMeasurement m = scene::measure_mu(sc);
     const auto& r = m.draws.front().result;
     if (!m.completed) {
-      std::printf("| %d | %d | %d | failed | | | %.2f |\n", level, r.elements, r.dofs, m.wall_seconds);
+      std::printf("| %d | %s | %d | failed | | | %.2f |\n", level, level_setting(sc, o.parameter).c_str(), r.dofs, m.wall_seconds);
       std::printf("level %d did not complete: %s\n", level, m.reason.c_str());
       return 3;
     }
     const double change = previous ? std::abs(m.mu - *previous) / std::max(std::abs(m.mu), 1e-12) : 0.0;
-    std::printf("| %d | %d | %d | %.5f | %s | %s | %.2f |\n", level, r.elements, r.dofs, m.mu,
+    std::printf("| %d | %s | %d | %.5f | %s | %s | %.2f |\n", level, level_setting(sc, o.parameter).c_str(), r.dofs, m.mu,
                 m.std_error ? relative_percent(*m.std_error, m.mu).c_str() : "",
                 previous ? (std::to_string(100.0 * change).substr(0, 5) + " %").c_str() : "", m.wall_seconds);
     std::fflush(stdout);
@@ -207,8 +241,7 @@ int converge_command(const RunCommandOptions& o) {
       return 0;
     }
     previous = m.mu;
-    if (o.direction != "y") sc.elements_x *= 2;
-    if (o.direction != "x") sc.elements_y *= 2;
+    refine(sc, o);
   }
   std::printf("not converged within %d refinements (tolerance %.2f %%)\n", o.max_levels, 100.0 * o.tolerance);
   return 3;
@@ -261,12 +294,18 @@ void add_micro_commands(CLI::App& app) {
 
   auto c = std::make_shared<RunCommandOptions>();
   auto* converge = micro->add_subcommand(
-      "converge", "Refine the chip mesh uniformly until mu changes by less than the tolerance between levels");
+      "converge", "Refine the mesh (or the sliding step, the window, the number of tool phases) until mu changes by\n"
+                  "less than the tolerance between levels; a table of mu, its standard error and the wall time");
   converge->add_option("scene", c->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
   converge->add_option("--set", c->overrides, "Override a scene value (repeatable)");
   converge->add_option("--tolerance", c->tolerance, "Relative change of mu that counts as converged")
       ->capture_default_str()->check(CLI::Range(1e-6, 1.0));
-  converge->add_option("--max-levels", c->max_levels, "Most refinements (each doubles elements_x and elements_y)")
+  converge->add_option("--parameter", c->parameter,
+                       "What each level refines: mesh (doubles the elements, see --direction), step (halves\n"
+                       "protocol.step_distance), window (doubles protocol.window) or phases (doubles\n"
+                       "protocol.phases)")
+      ->capture_default_str()->check(CLI::IsMember({"mesh", "step", "window", "phases"}));
+  converge->add_option("--max-levels", c->max_levels, "Most refinements")
       ->capture_default_str()->check(CLI::Range(1, 8));
   converge->add_option("--direction", c->direction,
                        "Which element counts a level doubles: both, x (along the contact) or y (through the\n"
@@ -274,7 +313,10 @@ void add_micro_commands(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"both", "x", "y"}));
   converge->footer("The paper refined the region near the contact until mu changed by less than 0.7 %. Doubling one\n"
                    "direction at a time shows which one the error comes from (bench/RESULTS.md: mostly y for the\n"
-                   "default scene). Exit code 0 when converged, 3 when not or when a level failed.");
+                   "default scene). --parameter step / window / phases converge the press-slide protocol's own\n"
+                   "choices the same way; every level prints mu with its standard error over the draws, and a change\n"
+                   "below that error is noise, not convergence. Exit code 0 when converged, 3 when not or when a\n"
+                   "level failed.");
   converge->callback([c] {
     const int code = converge_command(*c);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Held-out error of the GP against the number of micro-model runs: random vs Sobol' plans vs active
 # learning (dataset refine), on a coarse dry scene that fits a 2-core machine (32 × 6 quadratic
-# elements, 100 ns, μ over [50, 100] ns: 3–9 s per run). Writes OUT/strategies.csv and
+# elements, deploy/coarse_scene.sh, the default press-slide protocol). Writes OUT/strategies.csv and
 # OUT/strategies.png and prints a markdown table.
 # Usage: bash bench/dataset_strategies.sh [build-dir] [out-dir] [max-runs]
 set -euo pipefail
@@ -9,11 +9,10 @@ build=${1:-build}
 out=${2:-dataset-strategies}
 max=${3:-128}
 mufric=$(realpath "$build/app/mufric")
+source "$(dirname "$(realpath "$0")")/../deploy/coarse_scene.sh"
 mkdir -p "$out"
 cd "$out"
-scene=(--set geometry.chip_surface.fit.control_points=32 --set geometry.tool_surface.fit.control_points=32
-       --set discretisation.elements_x=32 --set discretisation.elements_y=6 --set time.duration=100ns
-       --set time.average_from=50ns)
+scene=("${coarse_scene[@]}")
 run=(--jobs 2 --threads 1)
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; max runs $max" >&2
 echo "strategy,runs,converged,mean_relative_error,max_relative_error,coverage95" > strategies.csv

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# The speed goal of issue 5: the default dry scene at its converged resolution (128 x 24 elements,
-# bench/RESULTS.md) on one core, run by two builds at the same time, one core each, so that their
-# ratio is meaningful on a shared machine. With one build, the peer is the same build on the default
-# 64 x 12 mesh. Prints a markdown table; every run's result.json is kept in the output directory.
+# The micro-model's speed goal: one well-defined mu of the default dry scene (every tool draw of the
+# press-slide protocol) at the converged 128 x 24 mesh on one core, run by two builds at the same
+# time, one core each, so that their ratio is meaningful on a shared machine. With one build, the
+# peer is the same build with seed 000's protocol (one draw, 250 ns) on the same mesh. Prints a
+# markdown table; every run's result.json is kept in the output directory.
 # Usage: bash bench/micro_speed.sh BUILD [PEER_BUILD] [OUT_DIR] [extra --set overrides...]
 set -uo pipefail
 if [[ $# -lt 1 || $1 == -h || $1 == --help ]]; then
-  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'
   exit 2
 fi
 build=$1
@@ -27,11 +28,11 @@ if [[ -n $peer ]]; then
   run "$build, 128 x 24" "$build" a "${converged[@]}" "$@" &
   run "$peer, 128 x 24" "$peer" b "${converged[@]}" "$@" &
 else
-  run "$build, 128 x 24" "$build" a "${converged[@]}" "$@" &
-  run "$build, 64 x 12 (default mesh)" "$build" b "$@" &
+  run "$build, 128 x 24, press-slide" "$build" a "${converged[@]}" "$@" &
+  run "$build, 128 x 24, seed 000's protocol" "$build" b "${converged[@]}" --set protocol.name=seed-000 "$@" &
 fi
 wait
-printf '| run | dofs | Newton | assemblies | cut-backs | mu | wall [s] |\n|---|---|---|---|---|---|---|\n'
+printf '| run | dofs | draws | Newton | cut-backs | mu | wall [s] |\n|---|---|---|---|---|---|---|\n'
 /usr/bin/python3 - "$out" <<'PY'
 import json, sys, pathlib
 out = pathlib.Path(sys.argv[1])
@@ -46,7 +47,9 @@ for name in ("a", "b"):
     g = r["diagnostics"]
     rows.append(g["wall_seconds"])
     mu = f'{r["mu"]:.5f}' if r["completed"] else "not completed"
-    print(f'| {(d / "label").read_text().strip()} | {g["dofs"]} | {g["newton_iterations"]} | {g["assemblies"]} | '
+    if r["completed"] and r.get("mu_std_error"):
+        mu += f' ± {r["mu_std_error"]:.5f}'
+    print(f'| {(d / "label").read_text().strip()} | {g["dofs"]} | {len(r["draws"])} | {g["newton_iterations"]} | '
           f'{g["cutbacks"]} | {mu} | {g["wall_seconds"]:.1f} |')
 if len(rows) == 2:
     print(f"ratio first / second: {rows[0] / rows[1]:.2f}")

@@ -26,6 +26,10 @@ run() {
 import json, sys
 r = json.load(open(sys.argv[1])); d = r["diagnostics"]
 mu = f'{r["mu"]:.4f}' if r["completed"] else "failed: " + r.get("reason", "")[:60]
+if r["completed"] and r.get("mu_std_error"):
+    mu += f' ± {r["mu_std_error"]:.4f}'
+if r.get("warnings"):
+    mu += " (molten)" if any("melting" in w for w in r["warnings"]) else " (warning)"
 print(f'| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {mu} | {100*d["contact_area_fraction"]:.1f} % | '
       f'{d["max_contact_pressure_pa"]/1e6:.0f} | {d["max_plastic_strain"]:.3f} | {d["max_temperature_k"]-273.15:.0f} | '
       f'{d["newton_iterations"]} | {d["cutbacks"]} | {d["wall_seconds"]:.1f} |')

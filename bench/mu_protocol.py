@@ -6,7 +6,9 @@ micro run` of the default scene with overrides; prints markdown tables.
 
 Studies: ramp (pressing ramp and hold x4, paired per draw), window (block means over a long slide),
 step (sliding step 12.5/25/50 nm), heat (adiabatic / conduction / isothermal, paired), draws
-(variance of mu over tool phases and realisations), seed000 (the paper's protocol beside). Extra
+(variance of mu over tool phases and realisations), seed000 (the paper's protocol beside), trends
+(mu(p), mu(v), mu(T) through the box centre, both protocols). The first five ran with the scene's
+protocol set to 4 tool phases, 0.5 um run-in (the values before the study chose the default). Extra
 --set overrides apply to every run (e.g. the mesh). Every result.json is kept in OUT_DIR.
 """
 import json
@@ -142,8 +144,32 @@ def study_seed000(m, out, extra):
     table(rows, ["ramp", "mu", "wall [s]"])
 
 
+def study_trends(m, out, extra):
+    print("### Trends through the box centre (800 MPa, 111.25 m/min, 462.5 C), both protocols\n")
+    centre = {"p": "800MPa", "v": "111.25m/min", "T": "462.5C"}
+    keys = {"p": "load.pressure", "v": "load.velocity", "T": "load.temperature"}
+    values = {"p": ["300MPa", "800MPa", "1300MPa"], "v": ["22.5m/min", "111.25m/min", "200m/min"],
+              "T": ["25C", "462.5C", "900C"]}
+    cache = {}
+    rows = []
+    for axis in ("p", "v", "T"):
+        for value in values[axis]:
+            point = dict(centre, **{axis: value})
+            key = tuple(sorted(point.items()))
+            if key not in cache:
+                sets = [f"{keys[k]}={point[k]}" for k in ("p", "v", "T")]
+                tag = "-".join(point[k].replace("/", "_") for k in ("p", "v", "T"))
+                ps = run(m, out, "trend-ps-" + tag, extra + sets)
+                s0 = run(m, out, "trend-s0-" + tag, extra + sets + ["protocol.name=seed-000"])
+                cache[key] = (ps, s0)
+            ps, s0 = cache[key]
+            molten = " (molten)" if any("melting" in w for w in ps.get("warnings", [])) else ""
+            rows.append((axis, value, fmt(ps) + molten, fmt(s0), f'{ps["_wall"]:.0f}'))
+    table(rows, ["varied", "value", "press-slide mu ± s.e.", "seed 000 protocol mu", "press-slide wall [s]"])
+
+
 STUDIES = {"ramp": study_ramp, "window": study_window, "step": study_step, "heat": study_heat,
-           "draws": study_draws, "seed000": study_seed000}
+           "draws": study_draws, "seed000": study_seed000, "trends": study_trends}
 
 
 def main():

@@ -2,7 +2,7 @@
 # The main job on a fresh Debian 12 machine: installs dependencies, builds mufric, and runs
 #   1. μ for a few contact states from the empirical laws of seed 001 (Seward et al. 2022);
 #   2. the whole chain: a Sobol' plan over seed 000's box → the dry micro-model at every point (a
-#      coarse scene that fits a laptop: 32 × 6 elements, 100 ns) → a Gaussian-process surrogate →
+#      coarse scene that fits a laptop: 32 × 6 elements, deploy/coarse_scene.sh) → a Gaussian-process surrogate →
 #      `mufric serve` on loopback → a meso-trace client (Python, gRPC) asking μ with its 95 % interval
 #      per contact Gauss point → a short table and a plot of μ over the box with its band.
 # Files go to ${MUFRIC_OUT:-mufric-out}/. MUFRIC_SAMPLES sets the plan size (default 32).
@@ -29,9 +29,8 @@ for state in "20MPa 2m/min 0deg" "80MPa 10m/min 45deg" "150MPa 15m/min 90deg" "8
 done
 
 echo; echo "== 2. Micro-model dataset -> GP surrogate -> service -> meso-trace client"
-scene=(--set geometry.chip_surface.fit.control_points=32 --set geometry.tool_surface.fit.control_points=32
-       --set discretisation.elements_x=32 --set discretisation.elements_y=6 --set time.duration=100ns
-       --set time.average_from=50ns)
+source deploy/coarse_scene.sh  # (the working directory is the repository)
+scene=("${coarse_scene[@]}")
 rm -f "$out/db.h5"  # a fresh database for this plan (dataset run would resume one of the same plan)
 $mufric dataset plan --out "$out/plan.h5" --samples "${MUFRIC_SAMPLES:-32}" --design sobol "${scene[@]}"
 $mufric dataset run --plan "$out/plan.h5" --db "$out/db.h5" --jobs "$jobs" --threads 1

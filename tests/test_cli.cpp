@@ -199,10 +199,13 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   const std::string small =
       " --set discretisation.elements_x=32 --set discretisation.elements_y=4"
       " --set geometry.chip_surface.fit.control_points=32 --set geometry.tool_surface.fit.control_points=32"
-      " --set time.duration=12ns --set time.average_from=8ns --set load.ramp=8ns --quiet";
+      " --set load.ramp=8ns --set protocol.press_hold=4ns --set protocol.run_in=0.05um --set protocol.window=0.1um"
+      " --set protocol.step_distance=25nm --set protocol.phases=2 --quiet";
   CommandResult r = run("micro run --out " + path("run") + small);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mu = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(standard error"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 2 | 0.500 |"), std::string::npos) << r.output;  // the second tool phase's row
   for (const char* file : {"result.json", "chip.vtu", "tool.vtu"}) {
     EXPECT_TRUE(std::filesystem::exists(path("run") + "/" + file)) << file;
   }
@@ -210,6 +213,13 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   std::string json, line;
   while (std::getline(in, line)) json += line;
   EXPECT_NE(json.find("\"history\""), std::string::npos);
+  EXPECT_NE(json.find("\"mu_std_error\""), std::string::npos);
+  EXPECT_NE(json.find("\"block_means\""), std::string::npos);
+  // Seed 000's protocol by name: one draw, no error bar.
+  r = run("micro run --out " + path("run1") + small + " --set protocol.name=seed-000 --set time.duration=12ns"
+          " --set time.average_from=8ns");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("seed 000 protocol: one draw"), std::string::npos) << r.output;
   EXPECT_NE(json.find("\"contact_area_fraction\""), std::string::npos);
   r = run("micro run --out " + path("run2") + " --set load.presure=1GPa");
   EXPECT_EQ(r.exit_code, 2);
@@ -219,25 +229,31 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   EXPECT_NE(r.output.find("physics"), std::string::npos) << r.output;
 }
 
-// A scene small enough that a sample takes a fraction of a second.
+// A scene small enough that a sample takes a fraction of a second: press-slide with two tool
+// phases, pressed 3 + 3 ns, slid 0.15 um.
 const std::string kTinyScene =
     " --set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16"
-    " --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set time.duration=6ns"
-    " --set time.average_from=3ns --set load.ramp=3ns";
+    " --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set load.ramp=3ns"
+    " --set protocol.press_hold=3ns --set protocol.run_in=0.05um --set protocol.window=0.1um"
+    " --set protocol.step_distance=50nm --set protocol.phases=2";
 
 TEST_F(Cli, MicroConvergeDoublesTheRequestedDirection) {
   // Tolerance 1: the first refinement converges, so the table has two levels.
   CommandResult r = run("micro converge --direction y --max-levels 1 --tolerance 1" + kTinyScene);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // 16 × 4 elements, then 16 × 8 (degree 2: (16) × (4 + 2) and (16) × (8 + 2) control points, 2 dofs each).
-  EXPECT_NE(r.output.find("| 0 | 64 | 192 |"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("| 1 | 128 | 320 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 0 | 16 x 4 | 192 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 1 | 16 x 8 | 320 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("converged at level 1"), std::string::npos) << r.output;
   // A tolerance no change can meet: not converged, exit code 3.
   r = run("micro converge --direction x --max-levels 1 --tolerance 1e-6" + kTinyScene);
   EXPECT_EQ(r.exit_code, 3) << r.output;
-  EXPECT_NE(r.output.find("| 1 | 128 | 384 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 1 | 32 x 4 | 384 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("not converged within 1 refinements"), std::string::npos) << r.output;
+  // The protocol's own choices converge the same way: halving the sliding step.
+  r = run("micro converge --parameter step --max-levels 1 --tolerance 1" + kTinyScene);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("| 1 | 25 nm |"), std::string::npos) << r.output;
   r = run("micro converge --direction z" + kTinyScene);
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--direction"), std::string::npos) << r.output;
@@ -267,7 +283,7 @@ TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
   EXPECT_NE(r.output.find("9 samples read, 3 duplicates removed -> 6 samples"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("0 of 6 plan rows not yet run"), std::string::npos) << r.output;
   r = run("dataset status " + path("all.h5"));
-  EXPECT_NE(r.output.find("samples: 6 (6 converged, 0 failed); 0 of 6 plan points not yet run"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("samples: 6 (6 converged, 0 outside the model, 0 failed); 0 of 6 plan points not yet run"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("design latin-hypercube (seed 4)"), std::string::npos) << r.output;
   r = run("dataset status " + path("s1.h5"));  // one shard: the other rows are not run (in this file)
   EXPECT_NE(r.output.find("3 of 6 plan points not yet run"), std::string::npos) << r.output;
@@ -315,7 +331,7 @@ TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
 // kill -9 in the middle of a run loses at most the samples in flight: the database stays readable
 // and a second run completes the plan with every row once.
 TEST_F(Cli, DatasetRunSurvivesKillNine) {
-  const std::string slower = kTinyScene + " --set time.duration=12ns --set time.average_from=6ns";
+  const std::string slower = kTinyScene + " --set protocol.window=0.3um";
   ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 6 --design sobol" + slower).exit_code, 0);
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
