@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <algorithm>
 #include <numbers>
 #include <sstream>
 
@@ -303,6 +304,71 @@ TEST(PressSlide, SeedZeroProtocolReproducesTheEarlierDefaultScene) {
   ASSERT_EQ(m.draws.size(), 1u);
   EXPECT_FALSE(m.std_error.has_value());
   EXPECT_NEAR(m.mu, 0.180576145017611, 1e-13);
+}
+
+// ---- the pressing phase against Westergaard ----------------------------------------------------
+
+// A rigid sinusoidal tool h = −Δ cos(2πx/λ) pressed with a mean pressure p̄ onto a flat elastic chip
+// one wavelength high (a half-space to 0.2 %): Westergaard's solution (Johnson, Contact Mechanics,
+// 1985, §13.2) gives p̄ = p* sin²(πa/λ) with p* = πE*Δ/λ, and the pressure
+// p(x) = 2p̄ cos(πx/λ) √(sin²(πa/λ) − sin²(πx/λ)) / sin²(πa/λ), so p(0) = 2√(p̄ p*) and
+// p(x)/p(0) = cos(πx/λ) √(1 − sin²(πx/λ)/sin²(πa/λ)) gives sin²(πa/λ) from any point inside. Both are
+// read in the interior of the contact, away from the edge that the mortar pressure smooths over a
+// control point's support.
+TEST(Pressing, SinusoidalToolOnAnElasticChipFollowsWestergaard) {
+  const double lambda = 10e-6, delta = 50e-9, e = 205e9, nu = 0.29;
+  const double e_star = e / (1.0 - nu * nu), p_star = std::numbers::pi * e_star * delta / lambda;
+  const auto dir = std::filesystem::temp_directory_path() / ("mufric_westergaard_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "tool.csv");
+    out << "x[um],height[nm]\n" << std::setprecision(17);
+    for (int k = 0; k < 1024; ++k) {
+      const double x = lambda * k / 1024;
+      out << x * 1e6 << "," << -delta * 1e9 * std::cos(2 * std::numbers::pi * x / lambda) << "\n";
+    }
+  }
+  for (const double fraction : {0.1, 0.3, 0.6}) {
+    const double p_mean = fraction * p_star;
+    nlohmann::json j = default_scene_json();
+    j["geometry"]["chip_surface"] = {{"flat", true}, {"fit", {{"degree", 2}, {"control_points", 64}}}};
+    j["geometry"]["tool_surface"] = {{"csv", (dir / "tool.csv").string()}, {"fit", {{"degree", 3}, {"control_points", 64}}}};
+    for (const std::string s : {"geometry.interval=\"10um\"", "geometry.chip_height=\"10um\"",
+                                "discretisation.elements_x=128", "discretisation.elements_y=24",
+                                "discretisation.grading=2.5", "material.a=\"100GPa\"", "material.b=\"0GPa\"",
+                                "material.heat_fraction=0", "contact.penalty=1e20", "protocol.name=\"seed-000\"",
+                                "load.velocity=\"0m/s\"", "load.ramp=\"60ns\"", "time.duration=\"160ns\"",
+                                "time.average_from=\"120ns\""}) {
+      apply_override(j, s);
+    }
+    apply_override(j, "load.pressure=\"" + std::to_string(p_mean / 1e6) + "MPa\"");
+    const MicroResult r = run_micro(parse_scene(j, "westergaard"));
+    ASSERT_TRUE(r.completed) << r.reason;
+    const auto& c = r.final_contact;
+    // Distance of each surface point from the contact's centre (x = 0 ≡ λ), and its pressure.
+    std::vector<std::pair<double, double>> profile;
+    for (size_t q = 0; q < c.point_x.size(); ++q) {
+      const double x = std::fmod(std::fmod(c.point_x[q], lambda) + lambda, lambda);
+      profile.emplace_back(std::min(x, lambda - x), c.point_pressure[q]);
+    }
+    std::sort(profile.begin(), profile.end());
+    const double peak = profile.front().second;
+    EXPECT_NEAR(peak, 2.0 * std::sqrt(p_mean * p_star), 0.02 * 2.0 * std::sqrt(p_mean * p_star)) << "p/p* = " << fraction;
+    // sin²(πa/λ) from each interior point's pressure relative to the peak, averaged over the points
+    // between 25 % and 90 % of the peak (inside the contact, clear of its smoothed edge).
+    double sum = 0.0;
+    int count = 0;
+    for (const auto& [x, p] : profile) {
+      const double ratio = p / peak, c = std::cos(std::numbers::pi * x / lambda);
+      if (ratio < 0.25 || ratio > 0.9) continue;
+      sum += std::pow(std::sin(std::numbers::pi * x / lambda), 2) / (1.0 - std::pow(ratio / c, 2));
+      ++count;
+    }
+    ASSERT_GT(count, 5);
+    const double sin2_a = sum / count;
+    EXPECT_NEAR(p_star * sin2_a, p_mean, 0.02 * p_mean) << "p/p* = " << fraction;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -328,6 +328,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   result.contact_fraction = last.surface_length > 0.0 ? last.contact_length / last.surface_length : 0.0;
   result.max_contact_pressure = last.max_pressure;
+  result.final_contact = last;
   int molten = 0;
   for (const auto& s : problem.states()) {
     result.max_plastic_strain = std::max(result.max_plastic_strain, s.equivalent_plastic_strain);

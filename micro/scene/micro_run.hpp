@@ -40,6 +40,7 @@ struct MicroResult {
   std::vector<MicroStep> history;
   double contact_fraction = 0.0, max_contact_pressure = 0.0;  // at the end
   double max_plastic_strain = 0.0, max_temperature = 0.0;     // over the chip, at the end
+  contact::ContactState final_contact;  // at the end: per surface point pressure (for verification)
   // A completed run whose result lies outside what the model describes (the chip reached its
   // melting temperature, where Johnson–Cook leaves it no strength), one sentence each.
   std::vector<std::string> warnings;
