@@ -366,6 +366,9 @@ TEST(Pressing, SinusoidalToolOnAnElasticChipFollowsWestergaard) {
     }
     ASSERT_GT(count, 5);
     const double sin2_a = sum / count;
+    std::printf("p/p* %.2f: peak %+.3f %%, mean pressure from the contact width %+.3f %%; %zu steps, %d Newton, %.1f s\n",
+                fraction, 100 * (peak / (2.0 * std::sqrt(p_mean * p_star)) - 1), 100 * (p_star * sin2_a / p_mean - 1),
+                r.history.size(), r.solver.newton_iterations, r.wall_seconds);
     EXPECT_NEAR(p_star * sin2_a, p_mean, 0.02 * p_mean) << "p/p* = " << fraction;
   }
   std::filesystem::remove_all(dir);
