@@ -303,6 +303,7 @@ TEST_F(Cli, DatasetErrorsNameTheFlag) {
   EXPECT_NE(r.output.find("design 'halton'"), std::string::npos) << r.output;
   r = run("dataset plan --out " + path("p.h5") + " --set load.vertical_displacement=\\\"-1nm\\\" --set load.pressure=null");
   EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("load.vertical_displacement"), std::string::npos) << r.output;  // null removed the pressure
   ASSERT_EQ(run("dataset plan --out " + path("p.h5") + " --samples 2" + kTinyScene).exit_code, 0);
   r = run("dataset run --plan " + path("p.h5") + " --db " + path("d.h5") + " --shard 2/2");
   EXPECT_NE(r.exit_code, 0);

@@ -153,7 +153,11 @@ void apply_override(nlohmann::json& scene, const std::string& assignment) {
     const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
     if (key.empty()) throw Error("--set '" + assignment + "': empty key in '" + path + "'");
     if (dot == std::string::npos) {
-      (*node)[key] = value;
+      if (value.is_null()) {
+        node->erase(key);  // "key=null" removes the key (e.g. load.pressure, to give vertical_displacement)
+      } else {
+        (*node)[key] = value;
+      }
       return;
     }
     if (!node->contains(key)) (*node)[key] = json::object();
@@ -251,9 +255,9 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     q.blocks = p.integer("blocks", q.blocks, 1, 100);
     if (q.name == Protocol::press_slide) {
       if (s.velocity == 0.0) p.fail("name", "press-slide averages over a sliding distance: load.velocity must not be zero");
-      if (s.scheme != solid::TimeScheme::generalized_alpha) {
-        p.fail("name", "press-slide presses dynamically (the chip's inertia holds it until the contact closes): "
-                       "time.scheme must be generalized-alpha");
+      if (s.scheme != solid::TimeScheme::generalized_alpha && s.pressure_controlled) {
+        p.fail("name", "press-slide under a pressure presses dynamically (the chip's inertia holds it until the contact "
+                       "closes): time.scheme must be generalized-alpha, or load the chip by vertical_displacement");
       }
       if (q.realisations > 1 && (!s.tool_surface.csv.empty() || s.tool_surface.flat)) {
         p.fail("realisations", "realisations redraw a synthetic tool with other seeds; this tool is " +

@@ -99,7 +99,8 @@ struct Scene {
 // Reads a scene file (JSON); relative CSV paths are relative to the file. Throws Error naming the
 // file and key.
 nlohmann::json read_scene_json(const std::string& path);
-// Applies "a.b.c=value": value parsed as JSON if it is valid JSON, else taken as a string.
+// Applies "a.b.c=value": value parsed as JSON if it is valid JSON, else taken as a string; "a.b.c=null"
+// removes the key.
 void apply_override(nlohmann::json& scene, const std::string& assignment);
 Scene parse_scene(const nlohmann::json& json, const std::string& source, const std::string& base_directory = ".");
 
