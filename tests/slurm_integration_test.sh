@@ -69,7 +69,7 @@ sinfo -h -o %T | grep -qE '^(idle|mixed)' || { echo "FAIL: the node did not come
 tiny=(--set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16
       --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set load.ramp=4ns
       --set protocol.press_hold=4ns --set protocol.run_in=0.05um --set protocol.window=0.1um
-      --set protocol.step_distance=50nm --set protocol.phases=2)
+      --set protocol.step_distance=50nm --set protocol.phases=2 --set protocol.realisations=1)
 "$mufric" dataset plan --out "$S/plan.h5" --samples 7 --design sobol "${tiny[@]}"
 submitted=$(MUFRIC="$mufric" "$repo/deploy/slurm/submit-dataset.sh" "$S/plan.h5" "$S/out" 3)
 echo "$submitted"

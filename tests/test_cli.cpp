@@ -200,7 +200,7 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
       " --set discretisation.elements_x=32 --set discretisation.elements_y=4"
       " --set geometry.chip_surface.fit.control_points=32 --set geometry.tool_surface.fit.control_points=32"
       " --set load.ramp=8ns --set protocol.press_hold=4ns --set protocol.run_in=0.05um --set protocol.window=0.1um"
-      " --set protocol.step_distance=25nm --set protocol.phases=2 --quiet";
+      " --set protocol.step_distance=25nm --set protocol.phases=2 --set protocol.realisations=1 --quiet";
   CommandResult r = run("micro run --out " + path("run") + small);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mu = "), std::string::npos) << r.output;
@@ -229,13 +229,13 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   EXPECT_NE(r.output.find("physics"), std::string::npos) << r.output;
 }
 
-// A scene small enough that a sample takes a fraction of a second: press-slide with two tool
+// A scene small enough that a sample takes a fraction of a second: press-slide with one tool at two
 // phases, pressed 3 + 3 ns, slid 0.15 um.
 const std::string kTinyScene =
     " --set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16"
     " --set discretisation.elements_x=16 --set discretisation.elements_y=4 --set load.ramp=3ns"
     " --set protocol.press_hold=3ns --set protocol.run_in=0.05um --set protocol.window=0.1um"
-    " --set protocol.step_distance=50nm --set protocol.phases=2";
+    " --set protocol.step_distance=50nm --set protocol.phases=2 --set protocol.realisations=1";
 
 TEST_F(Cli, MicroConvergeDoublesTheRequestedDirection) {
   // Tolerance 1: the first refinement converges, so the table has two levels.

@@ -90,6 +90,25 @@ TEST(GpVerification, GradientMatchesCentralFiniteDifferences) {
   }
 }
 
+// Mean and std of `gp` at 25 queries against the textbook posterior (R&W eq. 2.25–2.26) with a dense
+// inverse of the full covariance k; prior_variance is the query's own variance before conditioning.
+void expect_dense_posterior(const GaussianProcess& gp, const TrainingSet& data, const Eigen::MatrixXd& k,
+                            const Eigen::Vector3d& lengths, double prior_variance, unsigned seed, double mean_tolerance,
+                            double std_tolerance, double ci_level) {
+  const auto& s = gp.state();
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  const Eigen::MatrixXd k_inv = k.fullPivLu().inverse();
+  const Eigen::VectorXd y = (data.mu.array() - s.y_mean) / s.y_scale;
+  const TrainingSet queries = test::smooth_training_set(25, seed);
+  const Evaluation e = gp.evaluate(queries.x, {.std = true, .ci_level = ci_level, .gradient = false});
+  const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
+  for (Eigen::Index q = 0; q < uq.rows(); ++q) {
+    const Eigen::VectorXd kq = dense_kernel_vector(uq.row(q), u, lengths, s.hyper.signal_variance);
+    EXPECT_NEAR(e.mu(q), s.y_mean + s.y_scale * kq.dot(k_inv * y), mean_tolerance);
+    EXPECT_NEAR(e.std(q), s.y_scale * std::sqrt(prior_variance - kq.dot(k_inv * kq)), std_tolerance);
+  }
+}
+
 TEST(GpVerification, PredictionMatchesDenseFormulaWithExplicitInverse) {
   const TrainingSet data = test::smooth_training_set(40, 11);
   const Eigen::Vector3d lengths(0.8, 0.5, 0.9);
@@ -97,21 +116,11 @@ TEST(GpVerification, PredictionMatchesDenseFormulaWithExplicitInverse) {
   const auto& s = gp.state();
   const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
   const Eigen::MatrixXd k = dense_covariance(u, s.hyper, s.hyper.noise_variance + s.jitter);
-  const Eigen::MatrixXd k_inv = k.fullPivLu().inverse();
-  const Eigen::VectorXd y = (data.mu.array() - s.y_mean) / s.y_scale;
-
+  expect_dense_posterior(gp, data, k, lengths, 3.0 + 1e-4, 99, 1e-9, 1e-8, 0.9);
   const TrainingSet queries = test::smooth_training_set(25, 99);
   const Evaluation e = gp.evaluate(queries.x, {.std = true, .ci_level = 0.9, .gradient = false});
-  const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
-  for (Eigen::Index q = 0; q < uq.rows(); ++q) {
-    const Eigen::VectorXd kq = dense_kernel_vector(uq.row(q), u, lengths, 3.0);
-    const double mean = s.y_mean + s.y_scale * kq.dot(k_inv * y);
-    const double var = 3.0 + 1e-4 - kq.dot(k_inv * kq);
-    EXPECT_NEAR(e.mu(q), mean, 1e-9);
-    EXPECT_NEAR(e.std(q), s.y_scale * std::sqrt(var), 1e-8);
-    const double z90 = 1.6448536269514722;
-    EXPECT_NEAR(e.hi(q) - e.lo(q), 2 * z90 * e.std(q), 1e-12);
-  }
+  const double z90 = 1.6448536269514722;
+  for (Eigen::Index q = 0; q < e.mu.size(); ++q) EXPECT_NEAR(e.hi(q) - e.lo(q), 2 * z90 * e.std(q), 1e-12);
 }
 
 // Known per-sample noise (R&W eq. 2.20 with diag(s_i²) added to K, scikit-learn's `alpha` array) and
@@ -131,7 +140,6 @@ TEST(GpVerification, KnownPerSampleNoiseMatchesDensePosterior) {
   const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
   Eigen::MatrixXd k = dense_covariance(u, s.hyper, s.hyper.noise_variance + s.jitter);
   for (Eigen::Index i = 0; i < k.rows(); ++i) k(i, i) += std::pow(data.mu_std(i) / s.y_scale, 2);
-  const Eigen::MatrixXd k_inv = k.fullPivLu().inverse();
   const Eigen::VectorXd y = (data.mu.array() - s.y_mean) / s.y_scale;
   // The LML with the known noise, too.
   LogMarginalLikelihood lml(u, y, true, s.known_noise);
@@ -140,16 +148,7 @@ TEST(GpVerification, KnownPerSampleNoiseMatchesDensePosterior) {
                        0.5 * static_cast<double>(y.size()) * std::log(2 * std::numbers::pi);
   EXPECT_NEAR(lml(s.hyper.to_log(), false).lml, dense, 1e-8 * std::abs(dense));
 
-  const TrainingSet queries = test::smooth_training_set(25, 98);
-  const Evaluation e = gp.evaluate(queries.x, {.std = true, .ci_level = 0.95, .gradient = false});
-  const Eigen::MatrixXd uq = to_unit_box(queries.x, data.inputs);
-  for (Eigen::Index q = 0; q < uq.rows(); ++q) {
-    const Eigen::VectorXd kq = dense_kernel_vector(uq.row(q), u, lengths, 2.0);
-    const double mean = s.y_mean + s.y_scale * kq.dot(k_inv * y);
-    const double var = 2.0 + 1e-4 + std::pow(micro / s.y_scale, 2) - kq.dot(k_inv * kq);
-    EXPECT_NEAR(e.mu(q), mean, 1e-10);
-    EXPECT_NEAR(e.std(q), s.y_scale * std::sqrt(var), 1e-10);
-  }
+  expect_dense_posterior(gp, data, k, lengths, 2.0 + 1e-4 + std::pow(micro / s.y_scale, 2), 98, 1e-10, 1e-10, 0.95);
   // Without --sample-noise the diagonal carries only the learned noise, and the scatter stays in std.
   const GaussianProcess plain = train_gaussian_process(data, fixed(2.0, lengths, 1e-4));
   EXPECT_EQ(plain.state().known_noise.size(), 0);

@@ -98,15 +98,28 @@ SceneGeometry build_geometry(const Scene& scene) {
   return {chip, tool};
 }
 
-nlohmann::json MicroResult::to_json(const Scene& scene) const {
+namespace {
+
+// What every result file starts with: provenance (for a file of its own), the outcome and μ.
+nlohmann::json result_head(const Scene& scene, bool provenance, bool completed, const std::string& reason,
+                           const std::vector<std::string>& warnings, double mu) {
   nlohmann::json j;
-  j["code_version"] = code_version();
-  j["created_utc"] = utc_timestamp();
-  j["scene"] = scene.effective;
+  if (provenance) {
+    j["code_version"] = code_version();
+    j["created_utc"] = utc_timestamp();
+    j["scene"] = scene.effective;
+  }
   j["completed"] = completed;
   if (!completed) j["reason"] = reason;
   j["warnings"] = warnings;
   j["mu"] = completed ? nlohmann::json(mu) : nlohmann::json(nullptr);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
+  nlohmann::json j = result_head(scene, provenance, completed, reason, warnings, mu);
   if (scene.protocol.name == Protocol::seed000) {
     j["mu_window_s"] = {scene.average_from, scene.duration};
   } else {
@@ -458,14 +471,7 @@ MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
 }
 
 nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
-  nlohmann::json j;
-  j["code_version"] = code_version();
-  j["created_utc"] = utc_timestamp();
-  j["scene"] = scene.effective;
-  j["completed"] = completed;
-  if (!completed) j["reason"] = reason;
-  j["warnings"] = warnings;
-  j["mu"] = completed ? nlohmann::json(mu) : nlohmann::json(nullptr);
+  nlohmann::json j = result_head(scene, true, completed, reason, warnings, mu);
   j["mu_std_error"] = completed && std_error ? nlohmann::json(*std_error) : nlohmann::json(nullptr);
   const ProtocolSpec& q = scene.protocol;
   nlohmann::json& p = j["protocol"];
@@ -517,10 +523,7 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
   j["diagnostics"] = diagnostics;
   auto& list = j["draws"] = nlohmann::json::array();
   for (const auto& d : draws) {
-    nlohmann::json one = d.result.to_json(scene);
-    one.erase("scene");
-    one.erase("code_version");
-    one.erase("created_utc");
+    nlohmann::json one = d.result.to_json(scene, false);
     one["phase"] = d.phase;
     one["realisation"] = d.realisation;
     one["tool_shift_fraction"] = d.shift_fraction;

@@ -47,7 +47,8 @@ struct MicroResult {
   int dofs = 0, elements = 0;
   solid::IntegrationReport solver;  // the time integration's own record: Newton work, cut-backs, seconds
   double wall_seconds = 0.0;
-  nlohmann::json to_json(const Scene& scene) const;
+  // provenance: code version, time and scene (false for a draw inside a measurement's file)
+  nlohmann::json to_json(const Scene& scene, bool provenance = true) const;
 };
 
 struct RunOptions {
