@@ -190,5 +190,48 @@ TEST(DatasetGeneration, ShardTextIsChecked) {
   for (const char* bad : {"5/5", "-1/3", "1", "a/b", "1/0", "1/2x"}) EXPECT_THROW(parse_shard(bad), Error) << bad;
 }
 
+// A run that completes with a warning (a molten chip) is kept with its μ and standard error, as
+// outside the model: training leaves it out, --retry-failed does not rerun it, merging keeps it so.
+TEST(DatasetGeneration, SamplesOutsideTheModelAreKeptFlaggedAndNeverTrainedOn) {
+  const Dataset plan = small_plan(4);
+  const std::string db = temp_path("molten.h5");
+  std::filesystem::remove(db);
+  std::atomic<int> calls{0};
+  const auto molten_last = [&](const Eigen::VectorXd& x) {
+    ++calls;
+    SampleOutcome o;
+    o.converged = true;
+    o.mu = exact_mu(x);
+    o.mu_std = 0.01 * o.mu;
+    if (x(0) > 325e6) o.warnings = {"the chip reached its melting temperature (1500 C)"};
+    return o;
+  };
+  generate_dataset(plan, db, molten_last, {});
+  const Dataset d = read_dataset(db);
+  ASSERT_EQ(d.size(), 4);
+  for (Eigen::Index i = 0; i < 4; ++i) {
+    const bool molten = d.x(i, 0) > 325e6;
+    EXPECT_EQ(d.outside_model(i), molten) << i;
+    EXPECT_DOUBLE_EQ(d.mu(i), exact_mu(d.x.row(i).transpose()));  // kept, for inspection
+    EXPECT_DOUBLE_EQ(d.mu_std(i), 0.01 * d.mu(i));
+    if (molten) EXPECT_NE(d.failure_reason[static_cast<size_t>(i)].find("melting"), std::string::npos);
+  }
+  const TrainingSet t = training_set(d, db);
+  EXPECT_EQ(t.x.rows(), 3);
+  EXPECT_EQ(t.outside_model, 1);
+  GenerationOptions retry;
+  retry.retry_failed = true;
+  const int before = calls;
+  generate_dataset(plan, db, molten_last, retry);
+  EXPECT_EQ(calls, before);  // nothing failed, so nothing reran
+  MergeReport report;
+  const Dataset merged = merge_datasets({db}, false, report);
+  EXPECT_EQ(report.converged + report.failed, 4);
+  long long outside = 0;
+  for (Eigen::Index i = 0; i < merged.size(); ++i) outside += merged.outside_model(i);
+  EXPECT_EQ(outside, 1);
+  EXPECT_EQ(merged.mu_std, d.mu_std);
+}
+
 }  // namespace
 }  // namespace mufric
