@@ -158,11 +158,12 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
               100.0 * r.contact_fraction, format_human(r.max_contact_pressure, QuantityKind::pressure).c_str(),
               r.max_plastic_strain, format_human(r.max_temperature, QuantityKind::temperature).c_str());
   std::printf("%d elements, %d dofs; first draw: %zu steps, %d Newton iterations (%d assemblies, %d line-search "
-              "reductions), %zu cut-backs, %.2f s (assembly %.2f s of which contact %.2f s, solve %.2f s); all %zu "
-              "draws on %d thread(s): %.2f s\n",
+              "reductions), %zu cut-backs, %.2f s (assembly %.2f s of which contact %.2f s, solve %.2f s, heat "
+              "conduction %.2f s); all %zu draws on %d thread(s): %.2f s\n",
               r.elements, r.dofs, r.history.size(), r.solver.newton_iterations, r.solver.assemblies,
               r.solver.line_search_reductions, r.solver.cutbacks.size(), r.wall_seconds, r.solver.seconds_assembly,
-              r.solver.seconds_contact, r.solver.seconds_solve, m.draws.size(), m.threads, m.wall_seconds);
+              r.solver.seconds_contact, r.solver.seconds_solve, r.solver.seconds_after_step, m.draws.size(), m.threads,
+              m.wall_seconds);
   for (size_t i = 0; i < m.draws.size(); ++i) {
     for (const auto& c : m.draws[i].result.solver.cutbacks) {
       std::printf("  draw %zu: cut-back at %.2f ns (dt %.3g s): %s\n", i + 1, c.time * 1e9, c.dt_failed, c.reason.c_str());

@@ -7,7 +7,8 @@ micro run` of the default scene with overrides; prints markdown tables.
 Studies: ramp (pressing ramp and hold x4, paired per draw), window (block means over a long slide),
 step (sliding step 12.5/25/50 nm), heat (adiabatic / conduction / isothermal, paired), draws
 (variance of mu over tool phases and realisations), seed000 (the paper's protocol beside), trends
-(mu(p), mu(v), mu(T) through the box centre, both protocols). The first five ran with the scene's
+(mu(p), mu(v), mu(T) through the box centre, both protocols), mesh (32 x 6 to 128 x 24, paired over
+8 tools, with the one-core cost of each). The first five ran with the scene's
 protocol set to 4 tool phases, 0.5 um run-in (the values before the study chose the default). Extra
 --set overrides apply to every run (e.g. the mesh). Every result.json is kept in OUT_DIR.
 """
@@ -168,8 +169,22 @@ def study_trends(m, out, extra):
     table(rows, ["varied", "value", "press-slide mu ± s.e.", "seed 000 protocol mu", "press-slide wall [s]"])
 
 
+def study_mesh(m, out, extra):
+    print("### Mesh, paired over 8 tools (the default protocol otherwise)\n")
+    finest = run(m, out, "mesh-128x24", extra + ["protocol.realisations=8", "discretisation.elements_x=128",
+                                                   "discretisation.elements_y=24"])
+    rows = []
+    for nx, ny in ((32, 6), (64, 12), (96, 18)):
+        r = run(m, out, f"mesh-{nx}x{ny}", extra + ["protocol.realisations=8", f"discretisation.elements_x={nx}",
+                                                      f"discretisation.elements_y={ny}"])
+        rows.append((f"{nx} x {ny}", fmt(r), paired(finest, r), f'{r["diagnostics"]["draw_seconds_sum"]:.0f}'))
+    rows.append(("128 x 24", fmt(finest), "", f'{finest["diagnostics"]["draw_seconds_sum"]:.0f}'))
+    table(rows, ["mesh", "mu ± s.e.", "paired change vs 128 x 24", "one-core seconds (sum over draws)"])
+
+
 STUDIES = {"ramp": study_ramp, "window": study_window, "step": study_step, "heat": study_heat,
-           "draws": study_draws, "seed000": study_seed000, "trends": study_trends}
+           "draws": study_draws, "seed000": study_seed000, "trends": study_trends,
+           "mesh": study_mesh}
 
 
 def main():

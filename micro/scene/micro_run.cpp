@@ -142,7 +142,8 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                       {"lu_fallbacks", solver.lu_fallbacks},
                       {"assembly_seconds", solver.seconds_assembly},
                       {"contact_seconds", solver.seconds_contact},
-                      {"solve_seconds", solver.seconds_solve}};
+                      {"solve_seconds", solver.seconds_solve},
+                      {"heat_conduction_seconds", solver.seconds_after_step}};
   auto& cuts = j["cutbacks"] = nlohmann::json::array();
   for (const auto& c : solver.cutbacks) cuts.push_back({{"time_s", c.time}, {"dt_failed_s", c.dt_failed}, {"reason", c.reason}});
   auto& h = j["history"] = nlohmann::json::array();

@@ -293,7 +293,10 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     report_.line_search_reductions += at.record.line_search_reductions;
     if (options_.after_step) {
       std::string reason;
-      if (!options_.after_step(t, this_dt, u_, reason)) {
+      const auto start = std::chrono::steady_clock::now();
+      const bool ok = options_.after_step(t, this_dt, u_, reason);
+      report_.seconds_after_step += seconds_since(start);
+      if (!ok) {
         record_solver_counts();
         report_.reason = "after the step to t = " + std::to_string(t) + " s: " + reason;
         return report_;

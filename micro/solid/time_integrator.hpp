@@ -85,6 +85,7 @@ struct IntegrationReport {
   int unpredicted_convergence = 0;  // trials expected to converge that did not (evaluated twice)
   double seconds_assembly = 0.0, seconds_solve = 0.0;
   double seconds_contact = 0.0;    // part of seconds_assembly spent in boundary interactions
+  double seconds_after_step = 0.0; // in options.after_step (a staggered field: heat conduction)
 };
 
 // The fields at the end of an accepted step, for callers that watch the run.
