@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The micro-model's speed goal: one well-defined mu of the default dry scene (every tool draw of the
-# press-slide protocol) at the converged 128 x 24 mesh on one core, run by two builds at the same
+# press-slide protocol) at its converged 96 x 18 mesh on one core, run by two builds at the same
 # time, one core each, so that their ratio is meaningful on a shared machine. With one build, the
 # peer is the same build with seed 000's protocol (one draw, 250 ns) on the same mesh. Prints a
 # markdown table; every run's result.json is kept in the output directory.
@@ -15,7 +15,7 @@ peer=${2:-}
 out=${3:-micro-speed}
 shift $(( $# < 3 ? $# : 3 ))
 mkdir -p "$out"
-converged=(--set discretisation.elements_x=128 --set discretisation.elements_y=24)
+converged=(--set discretisation.elements_x=96 --set discretisation.elements_y=18)  # press-slide: converged at 96 x 18
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc --all) cores; one core per run"
 run() {  # label build dir overrides...
   local label=$1 bin=$2/app/mufric dir=$out/$3
@@ -25,11 +25,11 @@ run() {  # label build dir overrides...
   echo "$label" > "$dir/label"
 }
 if [[ -n $peer ]]; then
-  run "$build, 128 x 24" "$build" a "${converged[@]}" "$@" &
-  run "$peer, 128 x 24" "$peer" b "${converged[@]}" "$@" &
+  run "$build, 96 x 18" "$build" a "${converged[@]}" "$@" &
+  run "$peer, 96 x 18" "$peer" b "${converged[@]}" "$@" &
 else
-  run "$build, 128 x 24, press-slide" "$build" a "${converged[@]}" "$@" &
-  run "$build, 128 x 24, seed 000's protocol" "$build" b "${converged[@]}" --set protocol.name=seed-000 "$@" &
+  run "$build, 96 x 18, press-slide" "$build" a "${converged[@]}" "$@" &
+  run "$build, 96 x 18, seed 000's protocol" "$build" b "${converged[@]}" --set protocol.name=seed-000 "$@" &
 fi
 wait
 printf '| run | dofs | draws | Newton | cut-backs | mu | wall [s] |\n|---|---|---|---|---|---|---|\n'
