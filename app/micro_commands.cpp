@@ -90,13 +90,14 @@ std::string mu_text(const std::optional<double>& mu) {
 // draw and second at most, and every line says which draw it is).
 class Progress {
  public:
-  explicit Progress(size_t draws) : last_(draws, std::chrono::steady_clock::time_point{}), draws_(draws) {}
+  explicit Progress(size_t draws) : last_(draws, std::chrono::steady_clock::time_point{}) {}
   void operator()(int draw, const scene::MicroStep& s, const scene::Scene& sc) {
     const auto now = std::chrono::steady_clock::now();
     auto& last = last_[static_cast<size_t>(draw)];
-    if (draws_ > 1 && now - last < std::chrono::seconds(1)) return;
+    const size_t draws = last_.size();
+    if (draws > 1 && now - last < std::chrono::seconds(1)) return;
     last = now;
-    const std::string who = draws_ > 1 ? "draw " + std::to_string(draw + 1) + "/" + std::to_string(draws_) + "  " : "";
+    const std::string who = draws > 1 ? "draw " + std::to_string(draw + 1) + "/" + std::to_string(draws) + "  " : "";
     if (sc.protocol.name == scene::Protocol::seed000) {
       std::fprintf(stderr, "%st %7.1f ns / %.1f ns  mu %s  contact %5.1f %%  max p %8.1f MPa\n", who.c_str(),
                    s.time * 1e9, sc.duration * 1e9, mu_text(s.mu).c_str(), 100.0 * s.contact_fraction, s.max_pressure / 1e6);
@@ -109,8 +110,7 @@ class Progress {
   }
 
  private:
-  std::vector<std::chrono::steady_clock::time_point> last_;
-  size_t draws_;
+  std::vector<std::chrono::steady_clock::time_point> last_;  // per draw: when it last printed
 };
 
 std::string relative_percent(double value, double mu) {

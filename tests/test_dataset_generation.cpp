@@ -214,7 +214,9 @@ TEST(DatasetGeneration, SamplesOutsideTheModelAreKeptFlaggedAndNeverTrainedOn) {
     EXPECT_EQ(d.outside_model(i), molten) << i;
     EXPECT_DOUBLE_EQ(d.mu(i), exact_mu(d.x.row(i).transpose()));  // kept, for inspection
     EXPECT_DOUBLE_EQ(d.mu_std(i), 0.01 * d.mu(i));
-    if (molten) EXPECT_NE(d.failure_reason[static_cast<size_t>(i)].find("melting"), std::string::npos);
+    if (molten) {
+      EXPECT_NE(d.failure_reason[static_cast<size_t>(i)].find("melting"), std::string::npos);
+    }
   }
   const TrainingSet t = training_set(d, db);
   EXPECT_EQ(t.x.rows(), 3);

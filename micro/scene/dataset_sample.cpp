@@ -47,14 +47,14 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     o.mu_std = m.std_error.value_or(std::numeric_limits<double>::quiet_NaN());
     o.failure_reason = m.reason;
     o.warnings = m.warnings;
-    const nlohmann::json d = m.to_json(s)["diagnostics"];
-    o.diagnostics = {{"contact_area_fraction", d["contact_area_fraction"].get<double>()},
-                     {"max_contact_pressure_pa", d["max_contact_pressure_pa"].get<double>()},
-                     {"max_plastic_strain", d["max_plastic_strain"].get<double>()},
-                     {"max_temperature_k", d["max_temperature_k"].get<double>()},
-                     {"newton_iterations", d["newton_iterations"].get<double>()},
-                     {"cutbacks", d["cutbacks"].get<double>()},
-                     {"dofs", d["dofs"].get<double>()},
+    const MeasurementTotals t = m.totals();
+    o.diagnostics = {{"contact_area_fraction", t.contact_fraction},
+                     {"max_contact_pressure_pa", t.max_contact_pressure},
+                     {"max_plastic_strain", t.max_plastic_strain},
+                     {"max_temperature_k", t.max_temperature},
+                     {"newton_iterations", t.newton_iterations},
+                     {"cutbacks", t.cutbacks},
+                     {"dofs", m.draws.empty() ? 0 : m.draws.front().result.dofs},
                      {"draws", static_cast<double>(m.draws.size())},
                      {"max_abs_drift", m.max_abs_drift()},
                      {"micro_wall_seconds", m.wall_seconds}};

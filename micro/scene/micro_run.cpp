@@ -173,8 +173,8 @@ class BottomMotion {
     acceleration_time_ = 2.0 * kAccelerationShareOfRunIn * q.run_in / speed;
     end_time_ = slide_start_ + 0.5 * acceleration_time_ + (q.run_in + q.window) / speed;
   }
-  // Horizontal displacement of Γ_B at t: v t (seed 000), or held during pressing, then a linear
-  // rise of the velocity to v over acceleration_time_, then v.
+  // Horizontal displacement of Γ_B at t: v t (seed 000: no pressing, no acceleration), or held
+  // during pressing, then a linear rise of the velocity to v over acceleration_time_, then v.
   double displacement(double t) const {
     const double s = t - slide_start_;
     if (s <= 0.0) return 0.0;
@@ -325,7 +325,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     last = contact->state(view.u);
     MicroStep step;
     step.time = view.time;
-    step.sliding_distance = seed000 ? std::abs(velocity) * view.time : motion.distance(view.time);
+    step.sliding_distance = motion.distance(view.time);
     step.force = last.force;
     if (last.force.y() != 0.0) step.mu = last.force.x() / last.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;
@@ -396,6 +396,20 @@ Scene draw_scene(const Scene& scene, const Draw& draw) {
   s.tool_surface.shift_fraction = shift - std::floor(shift);
   s.tool_surface.synthetic.seed = draw.seed;
   return s;
+}
+
+MeasurementTotals MuMeasurement::totals() const {
+  MeasurementTotals t;
+  for (const auto& d : draws) {
+    t.newton_iterations += d.result.solver.newton_iterations;
+    t.cutbacks += static_cast<int>(d.result.solver.cutbacks.size());
+    t.max_contact_pressure = std::max(t.max_contact_pressure, d.result.max_contact_pressure);
+    t.max_plastic_strain = std::max(t.max_plastic_strain, d.result.max_plastic_strain);
+    t.max_temperature = std::max(t.max_temperature, d.result.max_temperature);
+    t.contact_fraction += d.result.contact_fraction / static_cast<double>(draws.size());
+    t.draw_seconds_sum += d.result.wall_seconds;
+  }
+  return t;
 }
 
 double MuMeasurement::max_abs_drift() const {
@@ -499,29 +513,19 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
          {"draws", draws.size()},
          {"max_abs_drift", max_abs_drift()}};
   }
-  // Aggregates over the draws (sums of work, extremes of state), for scripts that read one run.
-  nlohmann::json diagnostics = {{"wall_seconds", wall_seconds}, {"threads", threads}};
-  int newton = 0, cutbacks = 0;
-  double max_p = 0.0, max_eps = 0.0, max_t = 0.0, area = 0.0, cpu = 0.0;
-  for (const auto& d : draws) {
-    newton += d.result.solver.newton_iterations;
-    cutbacks += static_cast<int>(d.result.solver.cutbacks.size());
-    max_p = std::max(max_p, d.result.max_contact_pressure);
-    max_eps = std::max(max_eps, d.result.max_plastic_strain);
-    max_t = std::max(max_t, d.result.max_temperature);
-    area += d.result.contact_fraction / static_cast<double>(draws.size());
-    cpu += d.result.wall_seconds;
-  }
-  diagnostics.update({{"newton_iterations", newton},
-                      {"cutbacks", cutbacks},
-                      {"max_contact_pressure_pa", max_p},
-                      {"max_plastic_strain", max_eps},
-                      {"max_temperature_k", max_t},
-                      {"contact_area_fraction", area},
-                      {"draw_seconds_sum", cpu},
+  // Aggregates over the draws, for scripts that read one run.
+  const MeasurementTotals t = totals();
+  j["diagnostics"] = {{"wall_seconds", wall_seconds},
+                      {"threads", threads},
+                      {"newton_iterations", t.newton_iterations},
+                      {"cutbacks", t.cutbacks},
+                      {"max_contact_pressure_pa", t.max_contact_pressure},
+                      {"max_plastic_strain", t.max_plastic_strain},
+                      {"max_temperature_k", t.max_temperature},
+                      {"contact_area_fraction", t.contact_fraction},
+                      {"draw_seconds_sum", t.draw_seconds_sum},
                       {"dofs", draws.empty() ? 0 : draws.front().result.dofs},
-                      {"elements", draws.empty() ? 0 : draws.front().result.elements}});
-  j["diagnostics"] = diagnostics;
+                      {"elements", draws.empty() ? 0 : draws.front().result.elements}};
   auto& list = j["draws"] = nlohmann::json::array();
   for (const auto& d : draws) {
     nlohmann::json one = d.result.to_json(scene, false);

@@ -65,6 +65,14 @@ struct Draw {
   MicroResult result;
 };
 
+// A measurement's work and state over all its draws: sums of work, extremes of state.
+struct MeasurementTotals {
+  int newton_iterations = 0, cutbacks = 0;
+  double max_contact_pressure = 0.0, max_plastic_strain = 0.0, max_temperature = 0.0;  // Pa, —, K
+  double contact_fraction = 0.0;   // mean over the draws, at their ends
+  double draw_seconds_sum = 0.0;   // one-core time of all draws together
+};
+
 // μ as a property of (p, v, T, roughness statistics): the mean over the draws, with the standard
 // error of that mean (sample standard deviation / √draws; none for a single draw).
 struct MuMeasurement {
@@ -77,6 +85,7 @@ struct MuMeasurement {
   double wall_seconds = 0.0;
   int threads = 1;  // draws run at once
   double max_abs_drift() const;
+  MeasurementTotals totals() const;
   nlohmann::json to_json(const Scene& scene) const;
 };
 
