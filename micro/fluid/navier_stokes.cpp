@@ -1,0 +1,277 @@
+#include "micro/fluid/navier_stokes.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "common/error.hpp"
+
+namespace mufric::fluid {
+
+namespace {
+
+// The velocity gradient ∇v (rows: component, columns: derivative), Laplacian and ∇(∇·v) at a point.
+struct VelocityDerivatives {
+  Eigen::Matrix2d gradient = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d laplacian = Eigen::Vector2d::Zero();
+  Eigen::Vector2d grad_div = Eigen::Vector2d::Zero();
+  Eigen::Vector2d pressure_gradient = Eigen::Vector2d::Zero();
+};
+
+Eigen::Matrix2d hessian(const PhysicalPoint& q, Eigen::Index a) {
+  Eigen::Matrix2d h;
+  h << q.hessians(0, a), q.hessians(1, a), q.hessians(1, a), q.hessians(2, a);
+  return h;
+}
+
+double parameter_along(const ParametricPoint& p, Side side) {
+  return (side == Side::bottom || side == Side::top) ? p.u : p.v;
+}
+
+}  // namespace
+
+NavierStokes::NavierStokes(FluidSpace space, NavierStokesOptions options)
+    : space_(std::move(space)), options_(std::move(options)) {
+  if (!(options_.fluid.density > 0.0) || !(options_.fluid.viscosity > 0.0)) {
+    throw Error("fluid: density and viscosity must be positive");
+  }
+  if (options_.pinned_pressure_node && (*options_.pinned_pressure_node < 0 || *options_.pinned_pressure_node >= space_.node_count())) {
+    throw Error("fluid: pinned_pressure_node is not a control point of the patch");
+  }
+  state_ = Eigen::VectorXd::Zero(3 * space_.node_count());
+  old_state_ = state_;
+  mesh_velocity_ = Eigen::VectorXd::Zero(2 * space_.node_count());
+}
+
+void NavierStokes::set_properties(const FluidProperties& fluid) {
+  if (!(fluid.density > 0.0) || !(fluid.viscosity > 0.0)) throw Error("fluid: density and viscosity must be positive");
+  options_.fluid = fluid;
+}
+
+void NavierStokes::set_mesh(const Eigen::VectorXd& displacement, const Eigen::VectorXd& mesh_velocity) {
+  if (mesh_velocity.size() != 2 * space_.node_count()) throw Error("fluid: mesh velocity has the wrong size");
+  space_.set_displacement(displacement);
+  mesh_velocity_ = mesh_velocity;
+}
+
+void NavierStokes::set_state(const Eigen::VectorXd& state) {
+  if (state.size() != state_.size()) throw Error("fluid: state has the wrong size");
+  state_ = state;
+}
+
+void NavierStokes::prescribed(std::vector<char>& fixed, Eigen::VectorXd& values) const {
+  fixed.assign(static_cast<size_t>(state_.size()), 0);
+  values = Eigen::VectorXd::Zero(state_.size());
+  for (const auto& c : conditions_) {
+    if (c.kind != SideConditionKind::velocity) continue;
+    if (!c.velocity) throw Error("fluid: a velocity side needs its velocity");
+    for (const auto& [node, value] : space_.interpolate_on_side(c.side, c.velocity)) {
+      for (int k = 0; k < 2; ++k) {
+        fixed[static_cast<size_t>(3 * node + k)] = 1;
+        values(3 * node + k) = value(k);
+      }
+    }
+  }
+  if (options_.pinned_pressure_node) {
+    fixed[static_cast<size_t>(3 * *options_.pinned_pressure_node + 2)] = 1;
+    values(3 * *options_.pinned_pressure_node + 2) = options_.pinned_pressure;
+  }
+}
+
+void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values,
+                            Eigen::VectorXd& residual, Eigen::SparseMatrix<double>& jacobian) const {
+  const double rho = options_.fluid.density, mu = options_.fluid.viscosity, nu = mu / rho;
+  const double inv_dt = dt > 0.0 ? 1.0 / dt : 0.0;
+  const Eigen::Vector2d body = options_.body_force;
+  residual = Eigen::VectorXd::Zero(state_.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  const auto add_local = [&](const std::vector<int>& nodes, const Eigen::VectorXd& r, const Eigen::MatrixXd& k) {
+    const auto n = static_cast<Eigen::Index>(nodes.size());
+    for (Eigen::Index a = 0; a < 3 * n; ++a) {
+      const int row = 3 * nodes[static_cast<size_t>(a / 3)] + static_cast<int>(a % 3);
+      if (fixed[static_cast<size_t>(row)]) continue;
+      residual(row) += r(a);
+      for (Eigen::Index b = 0; b < 3 * n; ++b) {
+        if (k(a, b) != 0.0) triplets.emplace_back(row, 3 * nodes[static_cast<size_t>(b / 3)] + static_cast<int>(b % 3), k(a, b));
+      }
+    }
+  };
+
+  for (int e = 0; e < space_.element_count(); ++e) {
+    const std::vector<int>& nodes = space_.element_nodes(e);
+    const auto n = static_cast<Eigen::Index>(nodes.size());
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
+    Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    for (const ParametricPoint& p : space_.element_points(e)) {
+      const PhysicalPoint q = space_.map(p);
+      const double wt = q.weight;
+      const Eigen::Vector2d v = velocity(p), v_old = FluidSpace::interpolate2(p, old_state_, 3, 0);
+      const Eigen::Vector2d w = FluidSpace::interpolate2(p, mesh_velocity_, 2, 0);
+      const double pressure_here = pressure(p);
+      VelocityDerivatives d;
+      for (Eigen::Index a = 0; a < n; ++a) {
+        const Eigen::Vector2d va = state_.segment<2>(3 * nodes[static_cast<size_t>(a)]);
+        const double pa = state_(3 * nodes[static_cast<size_t>(a)] + 2);
+        const Eigen::Matrix2d h = hessian(q, a);
+        d.gradient += va * q.gradients.col(a).transpose();
+        d.laplacian += (h(0, 0) + h(1, 1)) * va;
+        d.grad_div += h * va;
+        d.pressure_gradient += pa * q.gradients.col(a);
+      }
+      const Eigen::Vector2d c = v - w;  // convective velocity relative to the mesh
+      const double divergence = d.gradient.trace();
+      // τ_M = (4/Δt² + c·G c + C_I ν² G:G)^(−1/2), ν_C = 1/(τ_M tr G) (Bazilevs et al. 2007, eq. 63–65).
+      const double tau_m = 1.0 / std::sqrt(4.0 * inv_dt * inv_dt + c.dot(q.metric * c) +
+                                           kInverseEstimateConstant * nu * nu * q.metric.squaredNorm());
+      const double nu_c = 1.0 / (tau_m * q.metric.trace());
+      const Eigen::Vector2d inertia = rho * ((v - v_old) * inv_dt + d.gradient * c);
+      const Eigen::Vector2d strong = inertia + d.pressure_gradient - mu * (d.laplacian + d.grad_div) - rho * body;
+      const Eigen::Matrix2d sym = d.gradient + d.gradient.transpose();
+      Eigen::VectorXd advect(n);  // c·∇N_a
+      for (Eigen::Index a = 0; a < n; ++a) advect(a) = c.dot(q.gradients.col(a));
+
+      for (Eigen::Index a = 0; a < n; ++a) {
+        const double na = q.values(a);
+        const Eigen::Vector2d ga = q.gradients.col(a);
+        for (int i = 0; i < 2; ++i) {
+          r(3 * a + i) += wt * (na * (inertia(i) - rho * body(i)) + mu * sym.row(i).dot(ga) - pressure_here * ga(i) +
+                                tau_m * advect(a) * strong(i) + rho * nu_c * ga(i) * divergence);
+        }
+        r(3 * a + 2) += wt * (na * divergence + tau_m / rho * ga.dot(strong));
+        for (Eigen::Index b = 0; b < n; ++b) {
+          const double nb = q.values(b);
+          const Eigen::Vector2d gb = q.gradients.col(b);
+          const Eigen::Matrix2d hb = hessian(q, b);
+          // ∂(strong_i)/∂v_bk: ρ(δ_ik(N_b/Δt + c·∇N_b) + N_b ∂_k v_i) − μ(δ_ik ΔN_b + ∂_i∂_k N_b).
+          Eigen::Matrix2d dstrong = rho * nb * d.gradient - mu * hb;
+          dstrong.diagonal().array() += rho * (nb * inv_dt + advect(b)) - mu * (hb(0, 0) + hb(1, 1));
+          for (int i = 0; i < 2; ++i) {
+            for (int kk = 0; kk < 2; ++kk) {
+              const double galerkin = na * rho * ((i == kk ? nb * inv_dt + advect(b) : 0.0) + nb * d.gradient(i, kk)) +
+                                      mu * ((i == kk ? ga.dot(gb) : 0.0) + ga(kk) * gb(i));
+              const double supg = tau_m * (advect(a) * dstrong(i, kk) + nb * ga(kk) * strong(i));
+              k(3 * a + i, 3 * b + kk) += wt * (galerkin + supg + rho * nu_c * ga(i) * gb(kk));
+            }
+            k(3 * a + i, 3 * b + 2) += wt * (-nb * ga(i) + tau_m * advect(a) * gb(i));
+          }
+          for (int kk = 0; kk < 2; ++kk) {
+            k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(dstrong.col(kk)));
+          }
+          k(3 * a + 2, 3 * b + 2) += wt * tau_m / rho * ga.dot(gb);
+        }
+      }
+    }
+    add_local(nodes, r, k);
+  }
+
+  // Traction and Robin sides: −∫ N_a h and, for Robin, −∫ N_a α (g − v) (eq. 13 in weak form).
+  for (const auto& c : conditions_) {
+    if (c.kind == SideConditionKind::velocity) continue;
+    if (c.kind == SideConditionKind::robin && !c.velocity) throw Error("fluid: a Robin side needs its velocity");
+    const double alpha = c.kind == SideConditionKind::robin ? c.robin_weight : 0.0;
+    for (const ParametricPoint& p : space_.side_points(c.side)) {
+      const PhysicalPoint q = space_.map(p, &c.side);
+      const double t = parameter_along(p, c.side);
+      const Eigen::Vector2d h = c.traction ? c.traction(q.position, t) : Eigen::Vector2d::Zero();
+      Eigen::Vector2d load = h;
+      if (alpha != 0.0) load += alpha * (c.velocity(q.position, t) - velocity(p));
+      const auto n = static_cast<Eigen::Index>(p.nodes.size());
+      Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
+      Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+      for (Eigen::Index a = 0; a < n; ++a) {
+        for (int i = 0; i < 2; ++i) {
+          r(3 * a + i) -= q.weight * q.values(a) * load(i);
+          for (Eigen::Index b = 0; b < n; ++b) k(3 * a + i, 3 * b + i) += q.weight * alpha * q.values(a) * q.values(b);
+        }
+      }
+      add_local(p.nodes, r, k);
+    }
+  }
+
+  for (Eigen::Index row = 0; row < state_.size(); ++row) {
+    if (!fixed[static_cast<size_t>(row)]) continue;
+    residual(row) = state_(row) - values(row);
+    triplets.emplace_back(static_cast<int>(row), static_cast<int>(row), 1.0);
+  }
+  jacobian.resize(state_.size(), state_.size());
+  jacobian.setFromTriplets(triplets.begin(), triplets.end());
+}
+
+FluidStepReport NavierStokes::step(double dt) {
+  if (dt < 0.0) throw Error("fluid: the time step must not be negative");
+  FluidStepReport report;
+  report.min_relative_jacobian = space_.min_relative_jacobian();
+  if (!(report.min_relative_jacobian > 0.0)) {
+    report.reason = "the fluid mesh has folded (min relative det J = " + std::to_string(report.min_relative_jacobian) + ")";
+    return report;
+  }
+  const Eigen::VectorXd start = state_;
+  if (dt > 0.0) old_state_ = state_;
+  std::vector<char> fixed;
+  Eigen::VectorXd values;
+  prescribed(fixed, values);
+  for (Eigen::Index i = 0; i < state_.size(); ++i) {
+    if (fixed[static_cast<size_t>(i)]) state_(i) = values(i);
+  }
+  Eigen::VectorXd residual;
+  Eigen::SparseMatrix<double> jacobian;
+  double first = 0.0;
+  for (int it = 0; it <= options_.max_newton_iterations; ++it) {
+    assemble(dt, fixed, values, residual, jacobian);
+    const double norm = residual.norm();
+    report.residual_history.push_back(norm);
+    if (!std::isfinite(norm)) {
+      report.reason = "the fluid residual is not finite at Newton iterate " + std::to_string(it);
+      break;
+    }
+    if (it == 0) first = norm;
+    // Row by row against the size of the terms that make it up (|J||x|): a residual at round-off
+    // of its own terms is converged even when the first iterate was already (a uniform flow).
+    const Eigen::VectorXd term_size = jacobian.cwiseAbs() * state_.cwiseAbs();
+    const bool at_round_off = (residual.cwiseAbs().array() <= kNewtonResidualTolerance * term_size.array()).all();
+    if (norm == 0.0 || at_round_off || (it > 0 && norm <= kNewtonResidualTolerance * first)) {
+      report.converged = true;
+      break;
+    }
+    if (it == options_.max_newton_iterations) {
+      report.reason = "Newton did not converge in " + std::to_string(it) + " iterations (residual " +
+                      std::to_string(norm / first) + " of the first)";
+      break;
+    }
+    if (!solver_.factorize(jacobian)) {
+      report.reason = "the fluid tangent could not be factorised: " + solver_.reason();
+      break;
+    }
+    const Eigen::VectorXd delta = solver_.solve(-residual);
+    if (!delta.allFinite()) {
+      report.reason = "the fluid Newton correction is not finite";
+      break;
+    }
+    state_ += delta;
+    report.newton_iterations = it + 1;
+    if (delta.norm() <= kNewtonStepTolerance * std::max(state_.norm(), std::numeric_limits<double>::min())) {
+      report.converged = true;
+      assemble(dt, fixed, values, residual, jacobian);
+      report.residual_history.push_back(residual.norm());
+      break;
+    }
+  }
+  if (!report.converged) state_ = start;
+  return report;
+}
+
+std::vector<NavierStokes::TractionSample> NavierStokes::side_traction(Side side) const {
+  std::vector<TractionSample> out;
+  const double mu = options_.fluid.viscosity;
+  for (const ParametricPoint& p : space_.side_points(side)) {
+    const PhysicalPoint q = space_.map(p, &side);
+    Eigen::Matrix2d gradient = Eigen::Matrix2d::Zero();
+    for (size_t a = 0; a < p.nodes.size(); ++a) {
+      gradient += state_.segment<2>(3 * p.nodes[a]) * q.gradients.col(static_cast<Eigen::Index>(a)).transpose();
+    }
+    const Eigen::Matrix2d sigma = -pressure(p) * Eigen::Matrix2d::Identity() + mu * (gradient + gradient.transpose());
+    out.push_back({q.position, sigma * q.normal, q.normal, parameter_along(p, side), q.weight});
+  }
+  return out;
+}
+
+}  // namespace mufric::fluid

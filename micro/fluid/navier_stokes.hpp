@@ -1,0 +1,119 @@
+#pragma once
+// Incompressible Navier–Stokes in ALE form (seed 000 eq. 7–13) on a moving spline patch:
+//   ρ(∂v/∂t|_χ + (v − w)·∇v) − ∇·σ = ρ b,  ∇·v = 0,  σ = −p I + η(∇v + ∇vᵀ),
+// w the mesh velocity. Equal-order velocity and pressure, stabilised by SUPG/PSPG with grad-div
+// (LSIC) and the element metric tensor's τ (Tezduyar, Adv. Appl. Mech. 28, 1992; τ as Bazilevs et
+// al., CMAME 197, 2007, eq. 63–65), full strong residual including the viscous term, so the scheme
+// is consistent: an exact solution in the discrete space (Couette, Poiseuille) is reproduced exactly.
+// Implicit (backward) Euler in time as the paper, or steady; Newton with the stabilisation
+// parameters frozen at the current iterate; UMFPACK solves. Boundary conditions per side: velocity
+// (Dirichlet), traction (Neumann; none given = traction-free) and Robin α v + σn = h + α g (eq. 13).
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Sparse>
+
+#include "micro/fluid/fluid_space.hpp"
+#include "micro/solid/linear_solver.hpp"
+
+namespace mufric::fluid {
+
+struct FluidProperties {  // seed 000 Table 2
+  double density = 800.0;     // kg/m³
+  double viscosity = 0.032;   // Pa s (dynamic)
+};
+
+// Newton stops when the residual of the free equations falls below this fraction of the first
+// iterate's, or every equation's residual below this fraction of the size of its own terms (or the
+// correction below kNewtonStepTolerance of the solution's size).
+inline constexpr double kNewtonResidualTolerance = 1e-10;
+inline constexpr double kNewtonStepTolerance = 1e-12;
+// The inverse-estimate constant C_I of τ_M's viscous part for quadratic splines (Bazilevs et al.
+// 2007, after eq. 65: C_I from an element-wise inverse inequality; 36 for quadratics).
+inline constexpr double kInverseEstimateConstant = 36.0;
+
+struct NavierStokesOptions {
+  FluidProperties fluid;
+  Eigen::Vector2d body_force = Eigen::Vector2d::Zero();  // b, m/s² (per unit mass)
+  int max_newton_iterations = 25;
+  // An enclosed fluid with velocity given on its whole boundary has its pressure fixed only up to a
+  // constant: pin this control point's pressure (Pa). Empty: the boundary conditions fix it.
+  std::optional<int> pinned_pressure_node;
+  double pinned_pressure = 0.0;
+};
+
+enum class SideConditionKind { velocity, traction, robin };
+// A boundary value at a current position x on the side and its curve parameter t.
+using BoundaryField = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
+
+struct SideCondition {
+  Side side = Side::bottom;
+  SideConditionKind kind = SideConditionKind::velocity;
+  BoundaryField velocity;   // g: velocity and Robin
+  BoundaryField traction;   // h: traction and Robin (empty: zero)
+  double robin_weight = 0.0;  // α_R, Pa s/m
+};
+
+struct FluidStepReport {
+  bool converged = false;
+  std::string reason;                   // why not, when not converged
+  std::vector<double> residual_history; // |R| of the free equations per Newton iterate
+  int newton_iterations = 0;
+  double min_relative_jacobian = 1.0;   // of the mesh this step was solved on
+};
+
+class NavierStokes {
+ public:
+  NavierStokes(FluidSpace space, NavierStokesOptions options);
+
+  FluidSpace& space() { return space_; }
+  const FluidSpace& space() const { return space_; }
+  const NavierStokesOptions& options() const { return options_; }
+  // New fluid properties from the next step on (continuation in the Reynolds number).
+  void set_properties(const FluidProperties& fluid);
+  // Conditions are applied in order: where two velocity sides share a corner control point the
+  // later one sets it.
+  void set_conditions(std::vector<SideCondition> conditions) { conditions_ = std::move(conditions); }
+  // The mesh of the end of the next step: displacement from the reference net and mesh velocity,
+  // 2 per control point (ALE; zero for a fixed mesh).
+  void set_mesh(const Eigen::VectorXd& displacement, const Eigen::VectorXd& mesh_velocity);
+
+  // One backward-Euler step of length dt (s) from the current state, or the steady state (dt = 0).
+  FluidStepReport step(double dt);
+  FluidStepReport solve_steady() { return step(0.0); }
+
+  // Nodal unknowns, 3 per control point: v_x, v_y, p.
+  const Eigen::VectorXd& state() const { return state_; }
+  void set_state(const Eigen::VectorXd& state);
+  Eigen::Vector2d velocity(const ParametricPoint& p) const { return FluidSpace::interpolate2(p, state_, 3, 0); }
+  double pressure(const ParametricPoint& p) const { return FluidSpace::interpolate1(p, state_, 3, 2); }
+  Eigen::Vector2d velocity_at(double u, double v) const { return velocity(space_.at(u, v)); }
+  double pressure_at(double u, double v) const { return pressure(space_.at(u, v)); }
+
+  // At each Gauss point of a side: position, curve parameter, line-element weight, the fluid's
+  // outward normal n and the traction σn on the fluid there (the wall beyond the side is loaded
+  // by −σn: a pressure p pushes it along n).
+  struct TractionSample {
+    Eigen::Vector2d position, traction, normal;
+    double parameter = 0.0, weight = 0.0;
+  };
+  std::vector<TractionSample> side_traction(Side side) const;
+
+ private:
+  FluidSpace space_;
+  NavierStokesOptions options_;
+  std::vector<SideCondition> conditions_;
+  Eigen::VectorXd state_, old_state_, mesh_velocity_;
+  solid::LinearSolver solver_{solid::LinearSolverKind::lu};
+
+  // The prescribed dofs (velocity sides, pinned pressure) and their values.
+  void prescribed(std::vector<char>& fixed, Eigen::VectorXd& values) const;
+  // Residual and Jacobian of the discrete equations at state_; a prescribed row is u − ū with a unit
+  // diagonal.
+  void assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values, Eigen::VectorXd& residual,
+                Eigen::SparseMatrix<double>& jacobian) const;
+};
+
+}  // namespace mufric::fluid
