@@ -259,6 +259,23 @@ TEST_F(Cli, MicroConvergeDoublesTheRequestedDirection) {
   EXPECT_NE(r.output.find("--direction"), std::string::npos) << r.output;
 }
 
+TEST_F(Cli, FluidCheckCavityPrintsBothCentreLinesBesideGhia) {
+  CommandResult r = run("micro fluid-check cavity --reynolds 100 --elements 16");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("centre_line,x[L],y[L],velocity[U],ghia1982[U]"), std::string::npos) << r.output;
+  // Ghia's minimum of v on y = 1/2 (x = 103/128) and the lid row.
+  EXPECT_NE(r.output.find("v_on_y=0.5,0.804688,0.500000,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("u_on_x=0.5,0.500000,1.000000,1.000000,1.000000"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("largest |velocity - Ghia et al. 1982|"), std::string::npos) << r.output;
+  // Another Reynolds number: no reference column, still both lines.
+  r = run("micro fluid-check cavity --reynolds 10 --elements 8");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("u_on_x=0.5,0.500000,1.000000,1.000000,\n"), std::string::npos) << r.output;
+  r = run("micro fluid-check cavity --elements 2");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--elements"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, CorruptModelIsRefused) {
   std::ofstream(path("bad.h5")) << "not a model";
   const CommandResult r = run("predict --model " + path("bad.h5") + " --p 800MPa --v 100m/min --T 500C");
