@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "common/error.hpp"
 
@@ -196,7 +197,7 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
   jacobian.setFromTriplets(triplets.begin(), triplets.end());
 }
 
-FluidStepReport NavierStokes::step(double dt) {
+FluidStepReport NavierStokes::solve_step(double dt) {
   if (dt < 0.0) throw Error("fluid: the time step must not be negative");
   FluidStepReport report;
   report.min_relative_jacobian = space_.min_relative_jacobian();
@@ -205,12 +206,16 @@ FluidStepReport NavierStokes::step(double dt) {
     return report;
   }
   const Eigen::VectorXd start = state_;
-  if (dt > 0.0) old_state_ = state_;
   std::vector<char> fixed;
   Eigen::VectorXd values;
   prescribed(fixed, values);
   for (Eigen::Index i = 0; i < state_.size(); ++i) {
     if (fixed[static_cast<size_t>(i)]) state_(i) = values(i);
+  }
+  if (const std::string why = enclosed_flux_violation(); !why.empty()) {
+    report.reason = why;
+    state_ = start;
+    return report;
   }
   Eigen::VectorXd residual;
   Eigen::SparseMatrix<double> jacobian;
@@ -259,6 +264,30 @@ FluidStepReport NavierStokes::step(double dt) {
   return report;
 }
 
+std::string NavierStokes::enclosed_flux_violation() const {
+  std::vector<char> given(4, 0);
+  for (const auto& c : conditions_) {
+    if (c.kind != SideConditionKind::velocity) return {};  // a traction or Robin side lets the volume change
+    given[static_cast<size_t>(c.side)] = 1;
+  }
+  double flux = 0.0, size = 0.0;
+  for (Side side : {Side::bottom, Side::top, Side::left, Side::right}) {
+    if (!space_.has_side(side)) continue;
+    if (!given[static_cast<size_t>(side)]) return {};  // a side without a condition is traction-free
+    for (const ParametricPoint& p : space_.side_points(side)) {
+      const PhysicalPoint q = space_.map(p, &side);
+      const Eigen::Vector2d g = velocity(p);  // the boundary values are the prescribed ones here
+      flux += q.weight * g.dot(q.normal);
+      size += q.weight * g.norm();
+    }
+  }
+  if (std::abs(flux) <= kEnclosedFluxTolerance * size) return {};
+  std::ostringstream why;
+  why << "the velocity given on the whole boundary changes the enclosed volume at " << flux
+      << " m^2/s per unit depth: no incompressible flow satisfies it (an enclosed fluid needs a traction or Robin side)";
+  return why.str();
+}
+
 std::vector<NavierStokes::TractionSample> NavierStokes::side_traction(Side side) const {
   std::vector<TractionSample> out;
   const double mu = options_.fluid.viscosity;
@@ -270,6 +299,23 @@ std::vector<NavierStokes::TractionSample> NavierStokes::side_traction(Side side)
     }
     const Eigen::Matrix2d sigma = -pressure(p) * Eigen::Matrix2d::Identity() + mu * (gradient + gradient.transpose());
     out.push_back({q.position, sigma * q.normal, q.normal, parameter_along(p, side), q.weight});
+  }
+  return out;
+}
+
+std::vector<NavierStokes::TractionSample> NavierStokes::robin_traction(Side side) const {
+  const SideCondition* robin = nullptr;
+  for (const auto& c : conditions_) {
+    if (c.side == side && c.kind == SideConditionKind::robin) robin = &c;
+  }
+  if (robin == nullptr) throw Error("fluid: robin_traction asked of a side without a Robin condition");
+  std::vector<TractionSample> out;
+  for (const ParametricPoint& p : space_.side_points(side)) {
+    const PhysicalPoint q = space_.map(p, &side);
+    const double t = parameter_along(p, side);
+    Eigen::Vector2d traction = robin->traction ? robin->traction(q.position, t) : Eigen::Vector2d::Zero();
+    traction += robin->robin_weight * (robin->velocity(q.position, t) - velocity(p));
+    out.push_back({q.position, traction, q.normal, t, q.weight});
   }
   return out;
 }

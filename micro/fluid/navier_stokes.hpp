@@ -33,6 +33,10 @@ inline constexpr double kNewtonStepTolerance = 1e-12;
 // The inverse-estimate constant C_I of τ_M's viscous part for quadratic splines (Bazilevs et al.
 // 2007, after eq. 65: C_I from an element-wise inverse inequality; 36 for quadratics).
 inline constexpr double kInverseEstimateConstant = 36.0;
+// A fluid with velocity given on its whole boundary is incompressible only if that velocity keeps
+// its volume: a net boundary flux above this fraction of ∫|g| dΓ (far above what interpolating
+// smooth boundary data leaves) has no solution and is refused.
+inline constexpr double kEnclosedFluxTolerance = 1e-3;
 
 struct NavierStokesOptions {
   FluidProperties fluid;
@@ -81,8 +85,16 @@ class NavierStokes {
   void set_mesh(const Eigen::VectorXd& displacement, const Eigen::VectorXd& mesh_velocity);
 
   // One backward-Euler step of length dt (s) from the current state, or the steady state (dt = 0).
-  FluidStepReport step(double dt);
+  FluidStepReport step(double dt) {
+    begin_step();
+    return solve_step(dt);
+  }
   FluidStepReport solve_steady() { return step(0.0); }
+  // The same in two parts, for a partitioned coupling that solves one step several times: the
+  // current state becomes the start of the step, and each solve starts from the start of the step's
+  // state... (a failed solve leaves the state where it was).
+  void begin_step() { old_state_ = state_; }
+  FluidStepReport solve_step(double dt);
 
   // Nodal unknowns, 3 per control point: v_x, v_y, p.
   const Eigen::VectorXd& state() const { return state_; }
@@ -100,6 +112,10 @@ class NavierStokes {
     double parameter = 0.0, weight = 0.0;
   };
   std::vector<TractionSample> side_traction(Side side) const;
+  // On a Robin side, the traction its condition imposes weakly, σn = h + α(g − v): the interface
+  // load a Robin–Neumann coupling passes on (consistent with the fluid's weak equations, unlike the
+  // pointwise σn of side_traction). Throws Error when the side has no Robin condition.
+  std::vector<TractionSample> robin_traction(Side side) const;
 
  private:
   FluidSpace space_;
@@ -108,6 +124,9 @@ class NavierStokes {
   Eigen::VectorXd state_, old_state_, mesh_velocity_;
   solid::LinearSolver solver_{solid::LinearSolverKind::lu};
 
+  // Empty, or why the velocity given on an enclosed fluid's whole boundary admits no solution (its
+  // net flux does not vanish: the incompressibility dilemma of a Dirichlet–Neumann coupling).
+  std::string enclosed_flux_violation() const;
   // The prescribed dofs (velocity sides, pinned pressure) and their values.
   void prescribed(std::vector<char>& fixed, Eigen::VectorXd& values) const;
   // Residual and Jacobian of the discrete equations at state_; a prescribed row is u − ū with a unit
