@@ -4,12 +4,16 @@
 // its volume and its pressure equals the applied one.
 #include <cmath>
 #include <iostream>
+#include <numbers>
+#include <random>
 
 #include <gtest/gtest.h>
 
+#include "micro/coupling/chip_interface.hpp"
 #include "micro/coupling/partitioned.hpp"
 #include "micro/fluid/mesh_update.hpp"
 #include "micro/fluid/navier_stokes.hpp"
+#include "micro/solid/time_integrator.hpp"
 
 namespace mufric::coupling {
 namespace {
@@ -195,6 +199,152 @@ TEST(EnclosedPocket, QuasiNewtonNeedsFewerExchangesThanRelaxation) {
     EXPECT_NEAR(q.pressure / iqn.applied, 1.0, 1e-6);
     if (r.converged) EXPECT_LT(q.iterations, r.iterations) << "alpha_R x " << factor;
   }
+}
+
+// A periodic curve over [0, L) through (Greville x, f(x)): a smooth rough surface for the tests.
+spline::SplineCurve periodic_curve(int degree, int n, double length, const std::function<double(double)>& f) {
+  const spline::SplineBasis b = spline::SplineBasis::periodic_uniform(degree, n, 0.0, length);
+  spline::Points2 p(n, 2);
+  for (int i = 0; i < n; ++i) {
+    double x = 0.0;
+    for (int j = 1; j <= degree; ++j) x += b.knot(i + j);
+    x /= degree;
+    p.row(i) = Eigen::RowVector2d(x, f(x));
+  }
+  return spline::SplineCurve(b, p, {}, Eigen::Vector2d(length, 0.0));
+}
+
+constexpr double kInterval = 10e-6;
+double chip_height(double x) { return 0.2e-6 * std::sin(2 * std::numbers::pi * x / kInterval) + 0.05e-6 * std::cos(6 * std::numbers::pi * x / kInterval); }
+double tool_height(double x) { return 0.22e-6 + 0.1e-6 * std::sin(4 * std::numbers::pi * x / kInterval + 0.3); }
+
+TEST(ChipInterface, GraphParameterIsFoundAcrossPeriods) {
+  const spline::SplineCurve c = periodic_curve(3, 24, kInterval, chip_height);
+  const PeriodicGraph g([&](double t) { return c.point(t); }, 0.0, kInterval, 64);
+  for (double x : {-13.1e-6, -0.2e-6, 0.0, 3.7e-6, 9.99e-6, 25.3e-6}) {
+    const double t = g.parameter_at(x);
+    EXPECT_NEAR(c.point(t).x(), x, 1e-12 * kInterval) << x;
+  }
+}
+
+TEST(ChipInterface, LoadsMoveToTheChipConservatively) {
+  const spline::SplineCurve surface = periodic_curve(2, 32, kInterval, chip_height);
+  const solid::IgaSpace chip(solid::chip_patch(surface, {.degree = 2, .spans_x = 32, .spans_y = 4, .y_bottom = -2e-6}));
+  ChipSurface s(chip);
+  // The chip slid by 3.3 µm and deformed smoothly.
+  Eigen::VectorXd u(chip.dof_count());
+  for (int a = 0; a < chip.node_count(); ++a) {
+    const Eigen::Vector2d x = chip.node_position(a);
+    u.segment<2>(2 * a) = Eigen::Vector2d(3.3e-6 + 0.05e-6 * std::sin(2 * std::numbers::pi * x.x() / kInterval),
+                                          0.03e-6 * std::cos(2 * std::numbers::pi * x.x() / kInterval) * (x.y() + 2e-6) / 2e-6);
+  }
+  s.update(u, Eigen::VectorXd::Zero(chip.dof_count()));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<Eigen::Vector2d> positions, tractions;
+  std::vector<double> weights;
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (int q = 0; q < 200; ++q) {
+    const double x = -kInterval + 3 * kInterval * uniform(rng);
+    positions.emplace_back(x, 0.0);
+    tractions.emplace_back(1e8 * (uniform(rng) - 0.5), -1e9 * uniform(rng));
+    weights.push_back(1e-8 * uniform(rng));
+    total += weights.back() * tractions.back();
+    // The parameter found lies under the point: the chip surface passes through x there.
+    EXPECT_NEAR(s.position(s.parameter_at(x)).x(), x, 1e-12 * kInterval);
+  }
+  const Eigen::VectorXd f = s.nodal_forces(positions, tractions, weights);
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int a = 0; a < chip.node_count(); ++a) sum += f.segment<2>(2 * a);
+  EXPECT_LT((sum - total).norm(), 1e-14 * total.norm());
+  // Only the surface's control points are loaded.
+  const auto top = chip.side_nodes(solid::Side::top);
+  for (int a = 0; a < chip.node_count(); ++a) {
+    if (std::find(top.begin(), top.end(), a) == top.end()) EXPECT_EQ(f.segment<2>(2 * a).norm(), 0.0);
+  }
+}
+
+TEST(ChipInterface, FilmMeshFollowsTheChipAndKeepsItsMinimumThickness) {
+  const spline::SplineCurve chip_curve = periodic_curve(2, 32, kInterval, chip_height);
+  const spline::SplineCurve tool_curve = periodic_curve(3, 32, kInterval, tool_height);
+  const PeriodicGraph chip([&](double t) { return chip_curve.point(t); }, 0.0, kInterval, 256);
+  const PeriodicGraph tool([&](double t) { return tool_curve.point(t); }, 0.0, kInterval, 256);
+  GapMeshOptions o;
+  o.elements_x = 48;
+  o.min_film = 5e-9;
+  const spline::SplineSurface patch = gap_patch(chip, tool, 0.0, o);
+  // The bottom row interpolates the chip at the columns.
+  const Eigen::MatrixX2d rows = gap_boundary_rows(patch, chip, tool, o);
+  const int nu = patch.u_basis().count();
+  for (int i = 0; i < nu; ++i) {
+    const double x = rows(i, 0);
+    EXPECT_NEAR(patch.point(x, 0.0).y(), chip.height_at(x), 1e-15);
+    EXPECT_NEAR(rows(i, 1), patch.points()(i, 1), 1e-18);
+  }
+  // Between the columns it stays close to the chip; the film never thins below min_film; the
+  // parameterisation is x(u, ·) = u.
+  double worst = 0.0, thinnest = 1.0;
+  for (int k = 0; k < 1000; ++k) {
+    const double x = kInterval * (k + 0.5) / 1000;
+    worst = std::max(worst, std::abs(patch.point(x, 0.0).y() - chip.height_at(x)));
+    thinnest = std::min(thinnest, patch.point(x, 1.0).y() - patch.point(x, 0.0).y());
+    EXPECT_NEAR(patch.point(x, 0.5).x(), x, 1e-15);
+  }
+  std::cout << "film mesh: largest distance to the chip between columns " << worst << " m, thinnest film " << thinnest << " m\n";
+  EXPECT_LT(worst, 2e-9);
+  EXPECT_GE(thinnest, o.min_film * (1 - 1e-12));
+  EXPECT_LT(thinnest, 2 * o.min_film);  // the tool dips into the chip here: the film is at its minimum
+}
+
+// A coupled step may solve the chip several times with different interface loads; the last trial is
+// what the step accepts, exactly as if that load had been the only one (dynamic, three steps).
+TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
+  const spline::SplineCurve surface = periodic_curve(2, 16, kInterval, chip_height);
+  const auto build = [&] {
+    auto problem = std::make_unique<solid::SolidProblem>(
+        solid::IgaSpace(solid::chip_patch(surface, {.degree = 2, .spans_x = 16, .spans_y = 3, .y_bottom = -2e-6})),
+        std::make_shared<solid::LinearElastic>(205e9, 0.29, 7800.0));
+    problem->fix_side(solid::Side::bottom, 0);
+    problem->fix_side(solid::Side::bottom, 1);
+    return problem;
+  };
+  const auto load = [&](const solid::SolidProblem& p, double scale) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(p.dof_count());
+    for (int node : p.space().side_nodes(solid::Side::top)) f.segment<2>(2 * node) = scale * Eigen::Vector2d(0.1, -1.0);
+    return f;
+  };
+  solid::TimeIntegrationOptions o;
+  o.dt = 1e-9;
+  o.end_time = 3e-9;
+  // Plain: the load 2 N/m per control point throughout.
+  auto plain_problem = build();
+  auto plain_load = std::make_shared<NodalLoad>(plain_problem->dof_count());
+  plain_load->set(load(*plain_problem, 2.0));
+  plain_problem->add_interaction(plain_load);
+  solid::TimeIntegrator plain(*plain_problem, o);
+  ASSERT_TRUE(plain.run().completed);
+  // Coupled: each step first tries 1 N/m, then 2 N/m.
+  auto coupled_problem = build();
+  auto coupled_load = std::make_shared<NodalLoad>(coupled_problem->dof_count());
+  coupled_problem->add_interaction(coupled_load);
+  solid::TimeIntegrator* integrator = nullptr;
+  int trials = 0;
+  o.coupled_step = [&](double t0, double dt, std::string& reason) {
+    for (double scale : {1.0, 2.0}) {
+      coupled_load->set(load(*coupled_problem, scale));
+      if (!integrator->solve_trial(t0, dt, reason)) return false;
+      ++trials;
+    }
+    return true;
+  };
+  coupled_load->set(load(*coupled_problem, 2.0));  // the same load at t = 0 as the plain run (the α-average uses it)
+  solid::TimeIntegrator coupled(*coupled_problem, o);
+  integrator = &coupled;
+  const solid::IntegrationReport report = coupled.run();
+  ASSERT_TRUE(report.completed) << report.reason;
+  EXPECT_EQ(trials, 6);
+  EXPECT_LT((coupled.u() - plain.u()).norm(), 1e-9 * plain.u().norm());
+  EXPECT_LT((coupled.v() - plain.v()).norm(), 1e-9 * plain.v().norm());
 }
 
 }  // namespace

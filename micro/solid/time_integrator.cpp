@@ -77,9 +77,64 @@ void TimeIntegrator::set_initial(const Eigen::VectorXd& u, const Eigen::VectorXd
 }
 
 TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
+  trial_.valid = false;
+  trial_.newton_iterations = trial_.line_search_reductions = 0;
+  Attempt at;
+  if (options_.coupled_step) {
+    if (!options_.coupled_step(t0, dt, at.reason)) return at;
+    if (!trial_.valid || trial_.t0 != t0 || trial_.dt != dt) {
+      at.reason = "the coupled step ended without a solved trial of this step";
+      return at;
+    }
+    at.record.newton_iterations = trial_.newton_iterations;
+    at.record.line_search_reductions = trial_.line_search_reductions;
+    at.record.residual = trial_.residual_norm;
+  } else {
+    at = solve(t0, dt);
+    if (!at.ok) return at;
+  }
+  accept();
+  at.ok = true;
+  at.record.time = t0 + dt;
+  at.record.dt = dt;
+  return at;
+}
+
+bool TimeIntegrator::solve_trial(double t0, double dt, std::string& reason) {
+  const Attempt at = solve(t0, dt);
+  reason = at.reason;
+  return at.ok;
+}
+
+Eigen::VectorXd TimeIntegrator::trial_v() const {
+  if (options_.scheme != TimeScheme::generalized_alpha) return (trial_.u - u_) / trial_.dt;
+  return v_ + trial_.dt * ((1.0 - gamma()) * a_ + gamma() * trial_.a);
+}
+
+void TimeIntegrator::accept() {
+  const bool dynamic = options_.scheme == TimeScheme::generalized_alpha;
+  problem_.commit(std::move(trial_.states));
+  stresses_ = std::move(trial_.stresses);
+  if (dynamic) {
+    v_ += trial_.dt * ((1.0 - gamma()) * a_ + gamma() * trial_.a);
+    a_ = trial_.a;
+  }
+  last_increment_ = trial_.u - u_;
+  last_dt_ = trial_.dt;
+  u_ = trial_.u;
+  f_int_ = trial_.internal;
+  reactions_.setZero(u_.size());
+  const auto& constrained = problem_.constrained();
+  for (Eigen::Index i = 0; i < u_.size(); ++i) {
+    if (constrained[static_cast<size_t>(i)]) reactions_(i) = trial_.residual(i);
+  }
+  trial_.valid = false;
+}
+
+TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
   Attempt at;
   const bool dynamic = options_.scheme == TimeScheme::generalized_alpha;
-  const double am = alpha_m(), af = alpha_f(), b = beta(), g = gamma();
+  const double am = alpha_m(), af = alpha_f(), b = beta();
   const double t1 = t0 + dt;
   const auto& constrained = problem_.constrained();
   // Predictor: the last accepted increment scaled to this step (linear extrapolation, as
@@ -87,9 +142,12 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   // or the last state (quasi-static). In the pressure ramp of the default scene this cut the Newton
   // iterations of the first 60 ns from 910 to 533 against constant velocity (generalized-α's
   // velocity oscillates about the sliding velocity; the increment is what the chip actually did).
-  Eigen::VectorXd u1 = last_dt_ > 0.0 ? Eigen::VectorXd(u_ + (dt / last_dt_) * last_increment_)
-                       : dynamic      ? Eigen::VectorXd(u_ + dt * v_)
-                                      : u_;
+  // A repeated trial of the same step (a coupled step) starts from the last trial's solution.
+  const bool repeat = trial_.valid && trial_.t0 == t0 && trial_.dt == dt;
+  Eigen::VectorXd u1 = repeat           ? trial_.u
+                       : last_dt_ > 0.0 ? Eigen::VectorXd(u_ + (dt / last_dt_) * last_increment_)
+                       : dynamic        ? Eigen::VectorXd(u_ + dt * v_)
+                                        : u_;
   problem_.apply_dirichlet(t1, u1);
   const Eigen::VectorXd f_ext1 = problem_.external(t1), f_ext0 = problem_.external(t0);
   const SparseMatrix* mass = dynamic ? &problem_.mass() : nullptr;
@@ -226,21 +284,19 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
       break;
     }
   }
-  // Accept.
-  problem_.commit(std::move(current.assembly.states));
-  stresses_ = std::move(current.assembly.stresses);
-  if (dynamic) {
-    v_ += dt * ((1.0 - g) * a_ + g * current.a1);
-    a_ = current.a1;
-  }
-  last_increment_ = u1 - u_;
-  last_dt_ = dt;
-  u_ = u1;
-  f_int_ = current.assembly.internal;
-  reactions_.setZero(u_.size());
-  for (Eigen::Index i = 0; i < u_.size(); ++i) {
-    if (constrained[static_cast<size_t>(i)]) reactions_(i) = current.residual(i);
-  }
+  // The solved trial, accepted by accept().
+  trial_.t0 = t0;
+  trial_.dt = dt;
+  trial_.valid = true;
+  trial_.u = std::move(u1);
+  trial_.a = std::move(current.a1);
+  trial_.internal = std::move(current.assembly.internal);
+  trial_.residual = std::move(current.residual);
+  trial_.states = std::move(current.assembly.states);
+  trial_.stresses = std::move(current.assembly.stresses);
+  trial_.newton_iterations += at.record.newton_iterations;
+  trial_.line_search_reductions += at.record.line_search_reductions;
+  trial_.residual_norm = at.record.residual;
   at.ok = true;
   at.record.time = t1;
   at.record.dt = dt;

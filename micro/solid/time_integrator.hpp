@@ -53,6 +53,12 @@ struct TimeIntegrationOptions {
   // field solved staggered with the mechanics, e.g. heat conduction updating the committed states.
   // false (with a reason) ends the run as not completed.
   std::function<bool(double t, double dt, const Eigen::VectorXd& u, std::string& reason)> after_step;
+  // When set, a step coupled with another field (the lubricant): called instead of one Newton solve
+  // of the step from t0 over dt. It may call TimeIntegrator::solve_trial(t0, dt, …) any number of
+  // times (each from the step's start, with whatever loads it set in between) and returns false with
+  // a reason when the coupled step fails (cut back like any failed step); on true, the last trial is
+  // accepted.
+  std::function<bool(double t0, double dt, std::string& reason)> coupled_step;
   double end_time = 1e-7;        // s
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
@@ -111,13 +117,33 @@ class TimeIntegrator {
   const Eigen::VectorXd& v() const { return v_; }
   const std::vector<Eigen::Matrix2d>& stresses() const { return stresses_; }  // of the last accepted step
 
+  // For options.coupled_step: solves the step from t0 over dt with the current loads, from the last
+  // accepted state, without accepting it. The trial's displacement and velocity are trial_u() and
+  // trial_v(); false with a reason when Newton fails.
+  bool solve_trial(double t0, double dt, std::string& reason);
+  const Eigen::VectorXd& trial_u() const { return trial_.u; }
+  Eigen::VectorXd trial_v() const;
+
  private:
   struct Attempt {
     bool ok = false;
     std::string reason;
     StepRecord record;
   };
-  Attempt step(double t0, double dt);
+  // A solved step not yet accepted.
+  struct Trial {
+    double t0 = 0.0, dt = 0.0;
+    bool valid = false;
+    Eigen::VectorXd u, a, internal, residual;
+    std::vector<MaterialState> states;
+    std::vector<Eigen::Matrix2d> stresses;
+    int newton_iterations = 0, line_search_reductions = 0;  // summed over the trials of one step
+    double residual_norm = 0.0;
+  };
+  Attempt solve(double t0, double dt);  // into trial_
+  void accept();                        // trial_ becomes the state
+  Attempt step(double t0, double dt);   // solve + accept, or the coupled step
+  Trial trial_;
   double next_step(double t, double dt, int newton_iterations) const;
   void record_solver_counts();  // the linear solver's counters into report_
   double alpha_m() const, alpha_f() const, beta() const, gamma() const;

@@ -1,0 +1,188 @@
+#include "micro/coupling/chip_interface.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace mufric::coupling {
+
+PeriodicGraph::PeriodicGraph(std::function<Eigen::Vector2d(double)> point, double lo, double period, int samples)
+    : point_(std::move(point)), lo_(lo), period_(period) {
+  if (!(period_ > 0.0) || samples < 4) throw Error("periodic graph: needs a positive period and at least 4 samples");
+  for (int k = 0; k <= samples; ++k) {
+    const double t = lo_ + period_ * k / samples;
+    t_.push_back(t);
+    x_.push_back(point_(t).x());
+  }
+  interval_ = x_.back() - x_.front();
+  if (!(interval_ > 0.0)) throw Error("periodic graph: the curve does not advance in x over a period");
+  for (size_t k = 1; k < x_.size(); ++k) {
+    if (!(x_[k] > x_[k - 1])) throw Error("periodic graph: the curve is not a graph over x (it turns back near x = " +
+                                          std::to_string(x_[k]) + " m)");
+  }
+}
+
+double PeriodicGraph::parameter_at(double x) const {
+  const double periods = std::floor((x - x_.front()) / interval_);
+  const double xr = x - periods * interval_;
+  auto it = std::upper_bound(x_.begin(), x_.end(), xr);
+  const auto j = static_cast<size_t>(std::clamp<std::ptrdiff_t>(it - x_.begin() - 1, 0, static_cast<std::ptrdiff_t>(x_.size()) - 2));
+  double a = t_[j], b = t_[j + 1];
+  double fa = x_[j] - xr, fb = x_[j + 1] - xr;
+  const double tolerance = kGraphParameterTolerance * period_;
+  // Illinois: regula falsi that halves the retained end's value when the same end stays twice.
+  int side = 0;
+  double t = a;
+  for (int k = 0; k < 100 && b - a > tolerance; ++k) {
+    if (fa == 0.0) return a + periods * period_;
+    if (fb == 0.0) return b + periods * period_;
+    t = (a * fb - b * fa) / (fb - fa);
+    if (!(t > a && t < b)) t = 0.5 * (a + b);
+    const double ft = point_(t).x() - xr;
+    if (std::abs(ft) <= kGraphParameterTolerance * interval_) break;
+    if ((ft < 0.0) == (fa < 0.0)) {
+      a = t, fa = ft;
+      if (side == -1) fb *= 0.5;
+      side = -1;
+    } else {
+      b = t, fb = ft;
+      if (side == 1) fa *= 0.5;
+      side = 1;
+    }
+  }
+  return t + periods * period_;
+}
+
+ChipSurface::ChipSurface(const solid::IgaSpace& chip)
+    : chip_(chip),
+      u_(Eigen::VectorXd::Zero(chip.dof_count())),
+      v_(Eigen::VectorXd::Zero(chip.dof_count())),
+      graph_([this](double t) { return position(t); }, chip.patch().u_basis().lo(), chip.patch().u_basis().period(),
+             8 * chip.patch().u_basis().count()) {
+  if (!chip_.patch().u_basis().is_periodic()) throw Error("chip surface: the chip patch must be periodic along x");
+}
+
+void ChipSurface::update(const Eigen::VectorXd& u, const Eigen::VectorXd& v) {
+  if (u.size() != chip_.dof_count() || v.size() != chip_.dof_count()) throw Error("chip surface: wrong field size");
+  u_ = u;
+  v_ = v;
+  const auto& b = chip_.patch().u_basis();
+  graph_ = PeriodicGraph([this](double t) { return position(t); }, b.lo(), b.period(), 8 * b.count());
+}
+
+Eigen::Vector2d ChipSurface::position(double t) const {
+  const double top = chip_.patch().v_basis().hi();
+  return chip_.patch().point(t, top) + chip_.displacement(u_, t, top);
+}
+
+Eigen::Vector2d ChipSurface::velocity(double t) const { return chip_.displacement(v_, t, chip_.patch().v_basis().hi()); }
+
+Eigen::VectorXd ChipSurface::nodal_forces(const std::vector<Eigen::Vector2d>& positions,
+                                          const std::vector<Eigen::Vector2d>& tractions,
+                                          const std::vector<double>& weights) const {
+  if (positions.size() != tractions.size() || positions.size() != weights.size()) {
+    throw Error("chip surface: positions, tractions and weights differ in number");
+  }
+  Eigen::VectorXd forces = Eigen::VectorXd::Zero(chip_.dof_count());
+  const double top = chip_.patch().v_basis().hi();
+  for (size_t q = 0; q < positions.size(); ++q) {
+    const spline::RationalBasis b = chip_.patch().basis_at(parameter_at(positions[q].x()), top);
+    for (size_t a = 0; a < b.nodes.size(); ++a) {
+      forces.segment<2>(2 * b.nodes[a]) += b.r(static_cast<Eigen::Index>(a)) * weights[q] * tractions[q];
+    }
+  }
+  return forces;
+}
+
+void NodalLoad::set(const Eigen::VectorXd& forces) {
+  if (forces.size() != forces_.size()) throw Error("nodal load: wrong size");
+  forces_ = forces;
+}
+
+bool NodalLoad::add(const Eigen::VectorXd&, Eigen::VectorXd& force, solid::TangentAccumulator*, std::string&) const {
+  force -= forces_;  // an applied load enters the residual f_int + f − f_ext as f = −F
+  return true;
+}
+
+namespace {
+
+// The column positions (unreduced Greville abscissae) of a periodic basis and its collocation there.
+struct Columns {
+  std::vector<double> x;
+  Eigen::PartialPivLU<Eigen::MatrixXd> collocation;
+};
+
+Columns columns_of(const spline::SplineBasis& basis) {
+  const int n = basis.count();
+  Columns c;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    double sum = 0.0;
+    for (int j = 1; j <= basis.degree(); ++j) sum += basis.knot(i + j);
+    c.x.push_back(sum / basis.degree());
+    const auto loc = basis.locate(c.x.back());
+    const Eigen::VectorXd values = basis.values(loc.span, loc.u);
+    for (int j = 0; j <= basis.degree(); ++j) a(i, basis.function_index(loc.span, j)) += values(j);
+  }
+  c.collocation = a.partialPivLu();
+  return c;
+}
+
+// Bottom and top control heights over the columns: the chip's and the tool's heights interpolated,
+// the top raised where needed so that every top control point is min_film above its bottom one
+// (the film, a combination of those differences with non-negative weights, is then ≥ min_film).
+std::pair<Eigen::VectorXd, Eigen::VectorXd> boundary_heights(const Columns& c, const PeriodicGraph& chip,
+                                                             const PeriodicGraph& tool, double min_film) {
+  const auto n = static_cast<Eigen::Index>(c.x.size());
+  Eigen::VectorXd chip_h(n), tool_h(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    chip_h(i) = chip.height_at(c.x[static_cast<size_t>(i)]);
+    tool_h(i) = tool.height_at(c.x[static_cast<size_t>(i)]);
+  }
+  const Eigen::VectorXd bottom = c.collocation.solve(chip_h);
+  const Eigen::VectorXd tool_interpolant = c.collocation.solve(tool_h);
+  const Eigen::VectorXd top = tool_interpolant.array().max(bottom.array() + min_film).matrix();
+  return {bottom, top};
+}
+
+}  // namespace
+
+spline::SplineSurface gap_patch(const PeriodicGraph& chip, const PeriodicGraph& tool, double x0, const GapMeshOptions& o) {
+  if (o.degree < 1 || o.elements_x < 2 || o.elements_y < 1 || !(o.min_film > 0.0)) {
+    throw Error("gap mesh: needs degree >= 1, elements_x >= 2, elements_y >= 1 and a positive min_film");
+  }
+  if (std::abs(chip.interval() - tool.interval()) > 1e-9 * chip.interval()) {
+    throw Error("gap mesh: the chip and the tool repeat over different intervals");
+  }
+  const spline::SplineBasis bu = spline::SplineBasis::periodic_uniform(o.degree, o.elements_x, x0, x0 + chip.interval());
+  const spline::SplineBasis bv = spline::SplineBasis::open_uniform(o.degree, o.elements_y, 0.0, 1.0);
+  const Columns c = columns_of(bu);
+  const auto [bottom, top] = boundary_heights(c, chip, tool, o.min_film);
+  const int nu = bu.count(), nv = bv.count();
+  spline::Points2 points(nu * nv, 2);
+  for (int j = 0; j < nv; ++j) {
+    double s = 0.0;  // the row's Greville fraction across the film: 0 at the chip, 1 at the tool
+    for (int k = 1; k <= o.degree; ++k) s += bv.knot(j + k);
+    s /= o.degree;
+    for (int i = 0; i < nu; ++i) {
+      points.row(i + nu * j) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], bottom(i) + s * (top(i) - bottom(i)));
+    }
+  }
+  return spline::SplineSurface(bu, bv, std::move(points), {}, Eigen::Vector2d(chip.interval(), 0.0));
+}
+
+Eigen::MatrixX2d gap_boundary_rows(const spline::SplineSurface& patch, const PeriodicGraph& chip, const PeriodicGraph& tool,
+                                   const GapMeshOptions& o) {
+  const Columns c = columns_of(patch.u_basis());
+  const auto [bottom, top] = boundary_heights(c, chip, tool, o.min_film);
+  const auto n = static_cast<Eigen::Index>(c.x.size());
+  Eigen::MatrixX2d rows(2 * n, 2);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    rows.row(i) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], bottom(i));
+    rows.row(n + i) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], top(i));
+  }
+  return rows;
+}
+
+}  // namespace mufric::coupling
