@@ -224,7 +224,7 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   r = run("micro run --out " + path("run2") + " --set load.presure=1GPa");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("load.presure: unknown key"), std::string::npos) << r.output;
-  r = run("micro run --out " + path("run3") + " --set physics=lubricated");
+  r = run("micro run --out " + path("run3") + " --set physics=wet");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("physics"), std::string::npos) << r.output;
 }

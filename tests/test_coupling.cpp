@@ -197,7 +197,9 @@ TEST(EnclosedPocket, QuasiNewtonNeedsFewerExchangesThanRelaxation) {
               << (r.converged ? std::to_string(r.iterations) : "failed: " + r.reason) << ", Aitken "
               << (a.converged ? std::to_string(a.iterations) : "failed: " + a.reason) << ", IQN-ILS " << q.iterations << "\n";
     EXPECT_NEAR(q.pressure / iqn.applied, 1.0, 1e-6);
-    if (r.converged) EXPECT_LT(q.iterations, r.iterations) << "alpha_R x " << factor;
+    if (r.converged) {
+      EXPECT_LT(q.iterations, r.iterations) << "alpha_R x " << factor;
+    }
   }
 }
 
@@ -260,7 +262,9 @@ TEST(ChipInterface, LoadsMoveToTheChipConservatively) {
   // Only the surface's control points are loaded.
   const auto top = chip.side_nodes(solid::Side::top);
   for (int a = 0; a < chip.node_count(); ++a) {
-    if (std::find(top.begin(), top.end(), a) == top.end()) EXPECT_EQ(f.segment<2>(2 * a).norm(), 0.0);
+    if (std::find(top.begin(), top.end(), a) == top.end()) {
+      EXPECT_EQ(f.segment<2>(2 * a).norm(), 0.0);
+    }
   }
 }
 

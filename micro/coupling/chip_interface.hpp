@@ -47,6 +47,7 @@ class ChipSurface {
   ChipSurface& operator=(const ChipSurface&) = delete;
   void update(const Eigen::VectorXd& u, const Eigen::VectorXd& v);
   double parameter_at(double x) const { return graph_.parameter_at(x); }
+  const PeriodicGraph& graph() const { return graph_; }
   Eigen::Vector2d position(double t) const;  // current
   Eigen::Vector2d velocity(double t) const;
   // The nodal forces (2 per chip control point) of tractions t_q on the chip at current positions x_q

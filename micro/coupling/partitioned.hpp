@@ -42,6 +42,8 @@ class InterfaceAccelerator {
   // The next iterate from the iterate x and its image x̃.
   Eigen::VectorXd next(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde);
   void end_step();  // a converged step: its secant pairs join the reuse store
+  // Drops the past steps' pairs: the map they sampled is not this step's (another step length).
+  void forget_past_steps() { reused_.clear(); }
   int columns_used() const { return columns_used_; }  // IQN-ILS: secant pairs in the last update
 
  private:

@@ -14,6 +14,7 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
+#include "micro/coupling/lubricated_chip.hpp"
 #include "micro/scene/vtu.hpp"
 #include "micro/solid/heat_conduction.hpp"
 
@@ -144,6 +145,15 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                       {"contact_seconds", solver.seconds_contact},
                       {"solve_seconds", solver.seconds_solve},
                       {"heat_conduction_seconds", solver.seconds_after_step}};
+  if (lubricant) {
+    j["lubricant"] = {{"coupling_iterations", lubricant->coupling_iterations},
+                      {"max_coupling_iterations_per_step", lubricant->max_coupling_iterations},
+                      {"fluid_newton_iterations", lubricant->fluid_newton_iterations},
+                      {"min_relative_jacobian", lubricant->min_relative_jacobian},
+                      {"film_area_m2_per_m", {lubricant->initial_film_area, lubricant->final_film_area}},
+                      {"final_pocket_areas_m2_per_m", lubricant->final_pocket_areas},
+                      {"fluid_dofs", lubricant->fluid_dofs}};
+  }
   auto& cuts = j["cutbacks"] = nlohmann::json::array();
   for (const auto& c : solver.cutbacks) cuts.push_back({{"time_s", c.time}, {"dt_failed_s", c.dt_failed}, {"reason", c.reason}});
   auto& h = j["history"] = nlohmann::json::array();
@@ -153,6 +163,9 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"mu", s.mu ? nlohmann::json(*s.mu) : nlohmann::json(nullptr)},
                  {"force_x_n_per_m", s.force.x()},
                  {"force_y_n_per_m", s.force.y()},
+                 {"fluid_force_x_n_per_m", s.fluid_force.x()},
+                 {"fluid_force_y_n_per_m", s.fluid_force.y()},
+                 {"coupling_iterations", s.coupling_iterations},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
                  {"newton_iterations", s.newton_iterations}});
@@ -226,6 +239,33 @@ class WindowAverage {
   int steps_ = 0;
   std::vector<double> sums_;
 };
+
+}  // namespace
+
+namespace {
+
+coupling::LubricantOptions lubricant_options(const Scene& scene) {
+  const LubricantSpec& l = scene.lubricant;
+  coupling::LubricantOptions o;
+  o.fluid = {l.density, l.viscosity};
+  o.mesh.degree = 2;  // equal-order quadratic velocity and pressure
+  o.mesh.elements_x = l.elements_x > 0 ? l.elements_x : scene.elements_x;
+  o.mesh.elements_y = l.elements_y;
+  o.mesh.min_film = l.min_film;
+  o.mesh_update.stiffening_exponent = l.mesh_stiffening;
+  o.robin_weight = l.robin_weight;
+  o.chip_mass_per_area = scene.material.density * scene.chip_height;
+  o.reference_step = scene.dt;
+  o.coupling.acceleration = l.acceleration == "aitken"       ? coupling::Acceleration::aitken
+                            : l.acceleration == "relaxation" ? coupling::Acceleration::constant_relaxation
+                                                             : coupling::Acceleration::iqn_ils;
+  o.coupling.relaxation = l.relaxation;
+  o.coupling.reuse_steps = l.reuse_steps;
+  o.coupling.qr_filter = l.qr_filter;
+  o.coupling.relative_tolerance = l.coupling_tolerance;
+  o.coupling.max_iterations = l.max_coupling_iterations;
+  return o;
+}
 
 }  // namespace
 
@@ -305,7 +345,20 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       return true;
     };
   }
+  // The lubricant: its load joins the chip's boundary interactions before the integrator assembles.
+  std::unique_ptr<coupling::LubricatedChip> lubricant;
+  solid::TimeIntegrator* integrator_of_step = nullptr;
+  if (scene.physics == "lubricated") {
+    lubricant = std::make_unique<coupling::LubricatedChip>(problem, geometry.tool_surface, lubricant_options(scene));
+    o.coupled_step = [&lubricant, &integrator_of_step](double t0, double dt, std::string& reason) {
+      return lubricant->step(*integrator_of_step, t0, dt, reason);
+    };
+    result.lubricant.emplace();
+    result.lubricant->initial_film_area = lubricant->fluid().space().area();
+    result.lubricant->fluid_dofs = 3 * lubricant->fluid().space().node_count();
+  }
   solid::TimeIntegrator integrator(problem, o);
+  integrator_of_step = &integrator;
   if (seed000 && scene.scheme == solid::TimeScheme::generalized_alpha) {
     // The chip starts moving with Γ_B: a rigid translation at the sliding velocity.
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(problem.dof_count());
@@ -327,7 +380,13 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     step.time = view.time;
     step.sliding_distance = motion.distance(view.time);
     step.force = last.force;
-    if (last.force.y() != 0.0) step.mu = last.force.x() / last.force.y();  // eq. (17)
+    if (lubricant && !lubricant->history().empty()) {
+      const coupling::LubricatedStep& l = lubricant->history().back();
+      step.fluid_force = l.fluid_force;
+      step.force += l.fluid_force;  // eq. (17) over the whole chip boundary: contact and fluid traction
+      step.coupling_iterations = l.coupling_iterations;
+    }
+    if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;
     step.max_pressure = last.max_pressure;
     result.history.push_back(step);
@@ -339,6 +398,19 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   const solid::IntegrationReport& report = result.solver;
   for (size_t k = 0; k < report.steps.size() && k < result.history.size(); ++k) {
     result.history[k].newton_iterations = report.steps[k].newton_iterations;
+  }
+  if (lubricant) {
+    auto& l = *result.lubricant;
+    for (const auto& h : lubricant->history()) {
+      l.coupling_iterations += h.coupling_iterations;
+      l.max_coupling_iterations = std::max(l.max_coupling_iterations, h.coupling_iterations);
+      l.fluid_newton_iterations += h.fluid_newton_iterations;
+      l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);
+    }
+    if (!lubricant->history().empty()) {
+      l.final_film_area = lubricant->history().back().film_area;
+      l.final_pocket_areas = lubricant->history().back().pocket_areas;
+    }
   }
   result.contact_fraction = last.surface_length > 0.0 ? last.contact_length / last.surface_length : 0.0;
   result.max_contact_pressure = last.max_pressure;

@@ -21,7 +21,9 @@ struct MicroStep {
   double time = 0.0;
   double sliding_distance = 0.0;                    // m, of Γ_B since sliding started
   std::optional<double> mu;                         // ∫Tx/∫Ty; none while nothing touches
-  Eigen::Vector2d force = Eigen::Vector2d::Zero();  // contact resultant on the chip, N/m
+  Eigen::Vector2d force = Eigen::Vector2d::Zero();  // resultant on the chip (contact + lubricant), N/m
+  Eigen::Vector2d fluid_force = Eigen::Vector2d::Zero();  // the lubricant's part of it, N/m
+  int coupling_iterations = 0;                      // lubricated: fluid–structure exchanges in the step
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;
@@ -45,6 +47,16 @@ struct MicroResult {
   // melting temperature, where Johnson–Cook leaves it no strength), one sentence each.
   std::vector<std::string> warnings;
   int dofs = 0, elements = 0;
+  // Lubricated runs: the film's record (coupling work, mesh quality, the lubricant's area and its
+  // pockets at the end).
+  struct Lubricant {
+    int coupling_iterations = 0, max_coupling_iterations = 0, fluid_newton_iterations = 0;
+    double min_relative_jacobian = 1.0;
+    double initial_film_area = 0.0, final_film_area = 0.0;  // m² per unit depth
+    std::vector<double> final_pocket_areas;                  // m² per unit depth
+    int fluid_dofs = 0;
+  };
+  std::optional<Lubricant> lubricant;
   solid::IntegrationReport solver;  // the time integration's own record: Newton work, cut-backs, seconds
   double wall_seconds = 0.0;
   // provenance: code version, time and scene (false for a draw inside a measurement's file)

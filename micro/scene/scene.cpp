@@ -173,9 +173,6 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   s.effective = j;
   Section root(j, "", source);
   s.physics = root.text("physics", "dry", {"dry", "lubricated"});
-  if (s.physics == "lubricated") {
-    root.fail("physics", "lubricated contact (the fluid in the pockets) is not implemented yet; use \"dry\"");
-  }
   {
     Section g = root.child("geometry");
     s.interval = g.quantity("interval", QuantityKind::length, s.interval, 1e-9, 1e-2);
@@ -274,6 +271,24 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     s.heat_conduction = h.text("model", fallback, {"adiabatic", "conduction"}) == "conduction";
     s.conductivity = h.number("conductivity", s.conductivity, 0.0, 1e4);
     h.finish();
+  }
+  {
+    Section f = root.child("lubricant");
+    auto& l = s.lubricant;
+    l.density = f.number("density", l.density, 1.0, 1e5);
+    l.viscosity = f.number("viscosity", l.viscosity, 1e-6, 1e6);
+    l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
+    l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
+    l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
+    l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
+    l.mesh_stiffening = f.number("mesh_stiffening", l.mesh_stiffening, 0.0, 5.0);
+    l.acceleration = f.text("acceleration", l.acceleration, {"iqn-ils", "aitken", "relaxation"});
+    l.relaxation = f.number("relaxation", l.relaxation, 1e-6, 1.0);
+    l.reuse_steps = f.integer("reuse_steps", l.reuse_steps, 0, 100);
+    l.qr_filter = f.number("qr_filter", l.qr_filter, 0.0, 0.999);
+    l.coupling_tolerance = f.number("coupling_tolerance", l.coupling_tolerance, 1e-14, 1e-1);
+    l.max_coupling_iterations = f.integer("max_coupling_iterations", l.max_coupling_iterations, 1, 10000);
+    f.finish();
   }
   {
     Section c = root.child("contact");

@@ -47,6 +47,25 @@ struct ProtocolSpec {
 };
 inline constexpr double kAccelerationShareOfRunIn = 0.25;
 
+// The lubricant in the pockets (physics "lubricated"; ignored by a dry run, so one scene serves both).
+struct LubricantSpec {
+  double density = 800.0;      // kg/m³ (seed 000 Table 2)
+  double viscosity = 0.032;    // Pa s (seed 000 Table 2)
+  int elements_x = 0;          // film columns; 0: the chip's discretisation.elements_x
+  int elements_y = 4;          // elements across the film
+  double min_film = 5e-9;      // m, the film where the chip touches the tool
+  double robin_weight = 0.0;   // α_R, Pa s/m; 0: ρ_chip h_chip / time.step
+  double mesh_stiffening = 1.0;  // χ of the Jacobian-based stiffening of the film's mesh
+  std::string acceleration = "iqn-ils";  // iqn-ils, aitken or relaxation
+  double relaxation = 0.5;
+  int reuse_steps = 8;
+  double qr_filter = 1e-8;
+  // Relative, of the interface load and displacement. The chip's own Newton tolerance, amplified by α_R/Δt,
+  // leaves the load a noise floor near 1e-4 of its size once the chip yields (bench/RESULTS.md).
+  double coupling_tolerance = 1e-3;
+  int max_coupling_iterations = 50;
+};
+
 struct Scene {
   std::string source;  // file name, for messages
   std::string physics = "dry";
@@ -85,6 +104,7 @@ struct Scene {
   // protocol: conduction for press-slide, adiabatic for seed 000 (bench/RESULTS.md, the heat study).
   bool heat_conduction = true;
   double conductivity = 50.0;  // W/(m K), plain carbon steel near room temperature (AISI 1045: ~50)
+  LubricantSpec lubricant;
   // contact
   double penalty = 2e18;              // Pa/m
   // solver

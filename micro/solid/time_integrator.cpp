@@ -295,6 +295,7 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
   trial_.states = std::move(current.assembly.states);
   trial_.stresses = std::move(current.assembly.stresses);
   trial_.newton_iterations += at.record.newton_iterations;
+  last_trial_newton_iterations_ = at.record.newton_iterations;
   trial_.line_search_reductions += at.record.line_search_reductions;
   trial_.residual_norm = at.record.residual;
   at.ok = true;
@@ -359,7 +360,9 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
       }
     }
     if (on_step) on_step(StepView{t, u_, v_, a_, reactions_, stresses_, problem_});
-    dt = next_step(t, this_dt, at.record.newton_iterations);
+    // A coupled step's record sums the Newton iterations of its trials; the step size follows the
+    // last trial's, the one that measures how hard this step length is for the chip.
+    dt = next_step(t, this_dt, options_.coupled_step ? last_trial_newton_iterations_ : at.record.newton_iterations);
   }
   report_.completed = true;
   record_solver_counts();

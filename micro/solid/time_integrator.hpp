@@ -144,6 +144,7 @@ class TimeIntegrator {
   void accept();                        // trial_ becomes the state
   Attempt step(double t0, double dt);   // solve + accept, or the coupled step
   Trial trial_;
+  int last_trial_newton_iterations_ = 0;
   double next_step(double t, double dt, int newton_iterations) const;
   void record_solver_counts();  // the linear solver's counters into report_
   double alpha_m() const, alpha_f() const, beta() const, gamma() const;

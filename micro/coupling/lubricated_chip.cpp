@@ -1,0 +1,199 @@
+#include "micro/coupling/lubricated_chip.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "common/error.hpp"
+
+namespace mufric::coupling {
+
+using fluid::Side;
+
+namespace {
+
+// MUFRIC_TRACE_COUPLING=1 prints every coupled step's interface residuals to stderr (diagnosing a run).
+bool trace_coupling() {
+  static const bool on = [] {
+    const char* v = std::getenv("MUFRIC_TRACE_COUPLING");
+    return v != nullptr && *v != '\0' && *v != '0';
+  }();
+  return on;
+}
+
+}  // namespace
+
+LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::SplineCurve& tool, LubricantOptions options)
+    : problem_(problem), tool_curve_(tool), options_(std::move(options)), mesh_update_(options_.mesh_update),
+      accelerator_(options_.coupling) {
+  if (!(options_.robin_weight > 0.0) && !(options_.chip_mass_per_area > 0.0 && options_.reference_step > 0.0)) {
+    throw Error("lubricant: give a Robin weight, or the chip's mass per area and a reference step for the automatic one");
+  }
+  surface_ = std::make_unique<ChipSurface>(problem_.space());
+  const auto& tb = tool_curve_.basis();
+  tool_ = std::make_unique<PeriodicGraph>([this](double t) { return tool_curve_.point(t); }, tb.lo(), tb.period(),
+                                          8 * tb.count());
+  load_ = std::make_shared<NodalLoad>(problem_.dof_count());
+  problem_.add_interaction(load_);
+  fluid::NavierStokesOptions ns;
+  ns.fluid = options_.fluid;
+  fluid_ = std::make_unique<fluid::NavierStokes>(fluid::FluidSpace(gap_patch(surface_->graph(), *tool_, 0.0, options_.mesh)), ns);
+  bottom_nodes_ = fluid_->space().side_nodes(Side::bottom);
+  top_nodes_ = fluid_->space().side_nodes(Side::top);
+  for (const auto& p : fluid_->space().side_points(Side::bottom)) bottom_parameters_.push_back(p.u);
+  traction_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(bottom_parameters_.size()));
+}
+
+Eigen::VectorXd LubricatedChip::transfer(const Eigen::VectorXd& traction) const {
+  const fluid::FluidSpace& space = fluid_->space();
+  const auto& points = space.side_points(Side::bottom);
+  const double top = space.patch().v_basis().hi();
+  std::vector<Eigen::Vector2d> positions, loads;
+  std::vector<double> weights;
+  for (size_t q = 0; q < points.size(); ++q) {
+    const Side bottom = Side::bottom;
+    const fluid::PhysicalPoint at = space.map(points[q], &bottom);
+    const double film = space.map(space.at(points[q].u, top)).position.y() - at.position.y();
+    // At a contact spot (the film at its minimum) the contact carries the chip; the fluid's share
+    // fades out linearly between kContactFilmFactor and one minimum film, so that the transferred
+    // load is continuous in the chip's position (a switch would make the coupling's map jump).
+    const double h = options_.mesh.min_film;
+    const double share = std::clamp((film - h) / ((kContactFilmFactor - 1.0) * h), 0.0, 1.0);
+    if (share == 0.0) continue;
+    positions.push_back(at.position);
+    loads.push_back(-share * traction.segment<2>(2 * static_cast<Eigen::Index>(q)));  // the chip receives −σn
+    weights.push_back(at.weight);
+  }
+  return surface_->nodal_forces(positions, loads, weights);
+}
+
+bool LubricatedChip::structure(solid::TimeIntegrator& integrator, double t0, double dt, const Eigen::VectorXd& traction,
+                               Eigen::VectorXd& displacement, std::string& reason) {
+  load_->set(transfer(traction));
+  if (!integrator.solve_trial(t0, dt, reason)) return false;
+  const Eigen::VectorXd& u = integrator.trial_u();
+  surface_->update(u, integrator.trial_v());
+  const std::vector<int> chip_top = problem_.space().side_nodes(Side::top);
+  displacement.resize(2 * static_cast<Eigen::Index>(chip_top.size()));
+  for (size_t i = 0; i < chip_top.size(); ++i) displacement.segment<2>(2 * static_cast<Eigen::Index>(i)) = u.segment<2>(2 * chip_top[i]);
+  return true;
+}
+
+bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& traction, double dt, Eigen::VectorXd& new_traction,
+                          std::string& reason) {
+  fluid::FluidSpace& space = fluid_->space();
+  space.set_displacement(mesh_start_);
+  const Eigen::MatrixX2d rows = gap_boundary_rows(space.patch(), surface_->graph(), *tool_, options_.mesh);
+  std::vector<std::pair<int, Eigen::Vector2d>> prescribed;
+  const auto n = static_cast<Eigen::Index>(bottom_nodes_.size());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int b = bottom_nodes_[static_cast<size_t>(i)], t = top_nodes_[static_cast<size_t>(i)];
+    prescribed.emplace_back(b, rows.row(i).transpose() - space.node_position(b));
+    prescribed.emplace_back(t, rows.row(n + i).transpose() - space.node_position(t));
+  }
+  const fluid::MeshMoveReport moved = mesh_update_.move(space, prescribed);
+  if (!moved.ok) {
+    reason = moved.reason;
+    return false;
+  }
+  fluid_->set_mesh(space.displacement(), (space.displacement() - mesh_start_) / dt);
+  const double alpha = options_.robin_weight > 0.0 ? options_.robin_weight : options_.chip_mass_per_area / options_.reference_step;
+  const ChipSurface* chip = surface_.get();
+  const fluid::BoundaryField chip_velocity = [chip](const Eigen::Vector2d& x, double) {
+    return chip->velocity(chip->parameter_at(x.x()));
+  };
+  const std::vector<double>& parameters = bottom_parameters_;
+  const fluid::BoundaryField previous = [&traction, &parameters](const Eigen::Vector2d&, double t) {
+    const auto it = std::lower_bound(parameters.begin(), parameters.end(), t - 1e-12 * (parameters.back() - parameters.front()));
+    const auto i = std::min<std::ptrdiff_t>(it - parameters.begin(), static_cast<std::ptrdiff_t>(parameters.size()) - 1);
+    return Eigen::Vector2d(traction.segment<2>(2 * static_cast<Eigen::Index>(i)));
+  };
+  const fluid::BoundaryField tool_velocity = [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); };
+  fluid_->set_conditions({{Side::top, fluid::SideConditionKind::velocity, tool_velocity, {}, 0.0},
+                          {Side::bottom, fluid::SideConditionKind::robin, chip_velocity, previous, alpha}});
+  const fluid::FluidStepReport r = fluid_->solve_step(dt);
+  current_.fluid_newton_iterations += r.newton_iterations;
+  current_.min_relative_jacobian = std::min(current_.min_relative_jacobian, r.min_relative_jacobian);
+  if (!r.converged) {
+    reason = "lubricant: " + r.reason;
+    return false;
+  }
+  const auto samples = fluid_->robin_traction(Side::bottom);
+  new_traction.resize(2 * static_cast<Eigen::Index>(samples.size()));
+  for (size_t q = 0; q < samples.size(); ++q) new_traction.segment<2>(2 * static_cast<Eigen::Index>(q)) = samples[q].traction;
+  return true;
+}
+
+bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double dt, std::string& reason) {
+  current_ = LubricatedStep();
+  // The fixed-point map depends on the step length (the chip's inertia per step): secant pairs of
+  // steps of another length would mislead IQN-ILS.
+  if (dt != last_accepted_dt_) accelerator_.forget_past_steps();
+  fluid_->begin_step();
+  const Eigen::VectorXd fluid_start = fluid_->state();
+  mesh_start_ = fluid_->space().displacement();
+  const PartitionedSolvers solvers{
+      [&](const Eigen::VectorXd& traction, Eigen::VectorXd& d, std::string& why) {
+        return structure(integrator, t0, dt, traction, d, why);
+      },
+      [&](const Eigen::VectorXd& d, const Eigen::VectorXd& traction, Eigen::VectorXd& next, std::string& why) {
+        return film(d, traction, dt, next, why);
+      }};
+  Eigen::VectorXd traction = traction_, displacement;
+  const CouplingStepReport report = coupled_step(solvers, traction, displacement, accelerator_, options_.coupling);
+  current_.coupling_iterations = report.iterations;
+  if (trace_coupling()) {
+    std::fprintf(stderr, "coupling t %.4g dt %.3g: %s after %d (fluid Newton %d)\n", t0 + dt, dt,
+                 report.converged ? "converged" : "failed", report.iterations, current_.fluid_newton_iterations);
+    for (size_t k = 0; k < report.load_residuals.size(); ++k) {
+      std::fprintf(stderr, "  |dlambda| %.4e Pa  |dd| %.4e m\n", report.load_residuals[k], report.displacement_changes[k]);
+    }
+  }
+  if (!report.converged) {
+    // Back to the start of the step for the cut-back's retry.
+    fluid_->set_state(fluid_start);
+    fluid_->set_mesh(mesh_start_, Eigen::VectorXd::Zero(mesh_start_.size()));
+    reason = "lubricant coupling: " + report.reason;
+    return false;
+  }
+  traction_ = traction;
+  last_accepted_dt_ = dt;
+  const Eigen::VectorXd& f = load_->forces();
+  for (Eigen::Index a = 0; a < f.size(); a += 2) current_.fluid_force += f.segment<2>(a);
+  current_.film_area = fluid_->space().area();
+  current_.pocket_areas = pocket_areas();
+  history_.push_back(current_);
+  return true;
+}
+
+std::vector<double> LubricatedChip::pocket_areas() const {
+  // Film thickness × dx at the bottom side's Gauss points (x = u: the columns do not move along x),
+  // summed between contact spots; the interval is periodic, so the last pocket continues the first.
+  const fluid::FluidSpace& space = fluid_->space();
+  const auto& points = space.side_points(Side::bottom);
+  const double top = space.patch().v_basis().hi();
+  std::vector<double> pockets;
+  double open = 0.0, before_first_spot = 0.0;
+  bool seen_spot = false;
+  for (const auto& p : points) {
+    const double bottom_y = space.map(p).position.y();
+    const double film = space.map(space.at(p.u, top)).position.y() - bottom_y;
+    if (film < kContactFilmFactor * options_.mesh.min_film) {
+      if (!seen_spot) {
+        before_first_spot = open;
+      } else if (open > 0.0) {
+        pockets.push_back(open);
+      }
+      seen_spot = true;
+      open = 0.0;
+      continue;
+    }
+    open += film * p.weight;
+  }
+  if (!seen_spot) return {};
+  if (open + before_first_spot > 0.0) pockets.push_back(open + before_first_spot);
+  return pockets;
+}
+
+}  // namespace mufric::coupling

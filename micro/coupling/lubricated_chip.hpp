@@ -1,0 +1,89 @@
+#pragma once
+// The lubricated chip: the chip's time steps coupled, Robin–Neumann and strongly, with the lubricant
+// film between it and the rigid tool (seed 000 sec. 2.2–2.3). Per step the coupling iterates on the
+// film's traction on the chip: the chip is solved under it (a trial of the step), the film's mesh
+// follows the chip's new surface (EMUM), and the fluid, with the Robin condition built from the
+// chip's surface velocity and that traction, returns a new traction; IQN-ILS accelerates it.
+// Where the film is at its minimum thickness the chip touches the tool: there the chip boundary
+// carries contact, and the fluid's traction is not passed on (one interaction per location).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "micro/coupling/chip_interface.hpp"
+#include "micro/coupling/partitioned.hpp"
+#include "micro/fluid/mesh_update.hpp"
+#include "micro/fluid/navier_stokes.hpp"
+#include "micro/solid/time_integrator.hpp"
+
+namespace mufric::coupling {
+
+// A fluid point whose film is thinner than this many minimum films is (partly) a contact spot: its
+// traction reaches the chip scaled from 1 here down to 0 at one minimum film.
+inline constexpr double kContactFilmFactor = 2.0;
+
+struct LubricantOptions {
+  fluid::FluidProperties fluid;      // seed 000 Table 2
+  GapMeshOptions mesh;
+  fluid::MeshUpdateOptions mesh_update;
+  CouplingOptions coupling;
+  // α_R of the Robin condition (Pa s/m); 0: the chip's mass per unit surface over the reference
+  // step, ρ_chip h_chip / Δt_ref — the weight that makes the iteration exact for a rigid chip (the
+  // piston test). One α_R for the whole run, so that the secant pairs IQN-ILS keeps from past steps
+  // stay pairs of the same map when the step length changes.
+  double robin_weight = 0.0;
+  double chip_mass_per_area = 0.0;   // kg/m², for the automatic α_R
+  double reference_step = 0.0;       // s, for the automatic α_R
+};
+
+// What one accepted step did at the interface.
+struct LubricatedStep {
+  int coupling_iterations = 0;
+  int fluid_newton_iterations = 0;     // summed over the coupling iterations
+  double min_relative_jacobian = 1.0;  // of the film's mesh
+  Eigen::Vector2d fluid_force = Eigen::Vector2d::Zero();  // on the chip, N per unit depth
+  double film_area = 0.0;              // m² per unit depth: the lubricant's volume
+  std::vector<double> pocket_areas;    // m² per unit depth, between contact spots (empty: no contact spot)
+};
+
+class LubricatedChip {
+ public:
+  // Adds the film's load to `problem` (a NodalLoad interaction) and builds the film between the
+  // chip's initial surface and the tool (a periodic curve over the same interval, a graph over x).
+  LubricatedChip(solid::SolidProblem& problem, const spline::SplineCurve& tool, LubricantOptions options);
+
+  // The coupled step for TimeIntegrationOptions::coupled_step.
+  bool step(solid::TimeIntegrator& integrator, double t0, double dt, std::string& reason);
+
+  const std::vector<LubricatedStep>& history() const { return history_; }
+  const fluid::NavierStokes& fluid() const { return *fluid_; }
+  // The film's traction on the chip transferred in the last accepted step, as nodal forces.
+  const Eigen::VectorXd& nodal_forces() const { return load_->forces(); }
+
+ private:
+  bool structure(solid::TimeIntegrator& integrator, double t0, double dt, const Eigen::VectorXd& traction,
+                 Eigen::VectorXd& displacement, std::string& reason);
+  bool film(const Eigen::VectorXd& displacement, const Eigen::VectorXd& traction, double dt, Eigen::VectorXd& new_traction,
+            std::string& reason);
+  Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
+  std::vector<double> pocket_areas() const;
+
+  solid::SolidProblem& problem_;
+  spline::SplineCurve tool_curve_;
+  LubricantOptions options_;
+  std::unique_ptr<ChipSurface> surface_;
+  std::unique_ptr<PeriodicGraph> tool_;
+  std::shared_ptr<NodalLoad> load_;
+  std::unique_ptr<fluid::NavierStokes> fluid_;
+  fluid::MeshUpdate mesh_update_;
+  InterfaceAccelerator accelerator_;
+  std::vector<int> bottom_nodes_, top_nodes_;  // of the film's patch
+  std::vector<double> bottom_parameters_;      // of its bottom side's Gauss points (for the Robin traction)
+  Eigen::VectorXd traction_;                   // σn on the film's bottom side points (2 per point), last step
+  Eigen::VectorXd mesh_start_;                 // film mesh displacement at the start of the step
+  std::vector<LubricatedStep> history_;
+  LubricatedStep current_;
+  double last_accepted_dt_ = 0.0;
+};
+
+}  // namespace mufric::coupling
