@@ -308,7 +308,16 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   MicroResult dry = run_micro(parse_scene(j, "dry"));
   apply_override(j, "physics=\"lubricated\"");
   const Scene scene = parse_scene(j, "lubricated");
-  const MicroResult wet = run_micro(scene);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mufric_lubricated_vtu";
+  std::filesystem::create_directories(dir);
+  RunOptions options;
+  options.vtu_directory = dir.string();
+  const MicroResult wet = run_micro(scene, options);
+  std::ifstream film(dir / "film.vtu");
+  const std::string vtu((std::istreambuf_iterator<char>(film)), std::istreambuf_iterator<char>());
+  EXPECT_NE(vtu.find("Name=\"velocity\""), std::string::npos);
+  EXPECT_NE(vtu.find("Name=\"pressure\""), std::string::npos);
+  std::filesystem::remove_all(dir);
   ASSERT_TRUE(dry.completed) << dry.reason;
   ASSERT_TRUE(wet.completed) << wet.reason;
   ASSERT_TRUE(wet.lubricant.has_value());
