@@ -314,7 +314,9 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   options.vtu_directory = dir.string();
   const MicroResult wet = run_micro(scene, options);
   std::ifstream film(dir / "film.vtu");
-  const std::string vtu((std::istreambuf_iterator<char>(film)), std::istreambuf_iterator<char>());
+  std::ostringstream text;
+  text << film.rdbuf();
+  const std::string vtu = text.str();
   EXPECT_NE(vtu.find("Name=\"velocity\""), std::string::npos);
   EXPECT_NE(vtu.find("Name=\"pressure\""), std::string::npos);
   std::filesystem::remove_all(dir);
