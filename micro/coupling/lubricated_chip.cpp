@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
+#include "common/environment.hpp"
 #include "common/error.hpp"
 
 namespace mufric::coupling {
@@ -15,10 +15,7 @@ namespace {
 
 // MUFRIC_TRACE_COUPLING=1 prints every coupled step's interface residuals to stderr (diagnosing a run).
 bool trace_coupling() {
-  static const bool on = [] {
-    const char* v = std::getenv("MUFRIC_TRACE_COUPLING");
-    return v != nullptr && *v != '\0' && *v != '0';
-  }();
+  static const bool on = environment_flag("MUFRIC_TRACE_COUPLING");
   return on;
 }
 

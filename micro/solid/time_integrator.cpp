@@ -4,9 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 #include "common/blas_threads.hpp"
+#include "common/environment.hpp"
 #include "common/error.hpp"
 
 namespace mufric::solid {
@@ -14,10 +14,7 @@ namespace {
 
 // MUFRIC_TRACE_NEWTON=1 prints every Newton iteration's residual to stderr (diagnosing a run).
 bool trace_newton() {
-  static const bool on = [] {
-    const char* v = std::getenv("MUFRIC_TRACE_NEWTON");
-    return v != nullptr && *v != '\0' && *v != '0';
-  }();
+  static const bool on = environment_flag("MUFRIC_TRACE_NEWTON");
   return on;
 }
 
