@@ -53,6 +53,7 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
                      {"max_plastic_strain", t.max_plastic_strain},
                      {"max_temperature_k", t.max_temperature},
                      {"newton_iterations", t.newton_iterations},
+                     {"coupling_iterations", t.coupling_iterations},
                      {"cutbacks", t.cutbacks},
                      {"dofs", m.draws.empty() ? 0 : m.draws.front().result.dofs},
                      {"draws", static_cast<double>(m.draws.size())},

@@ -476,6 +476,7 @@ MeasurementTotals MuMeasurement::totals() const {
   for (const auto& d : draws) {
     t.newton_iterations += d.result.solver.newton_iterations;
     t.cutbacks += static_cast<int>(d.result.solver.cutbacks.size());
+    if (d.result.lubricant) t.coupling_iterations += d.result.lubricant->coupling_iterations;
     t.max_contact_pressure = std::max(t.max_contact_pressure, d.result.max_contact_pressure);
     t.max_plastic_strain = std::max(t.max_plastic_strain, d.result.max_plastic_strain);
     t.max_temperature = std::max(t.max_temperature, d.result.max_temperature);
@@ -591,6 +592,7 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
   j["diagnostics"] = {{"wall_seconds", wall_seconds},
                       {"threads", threads},
                       {"newton_iterations", t.newton_iterations},
+                      {"coupling_iterations", t.coupling_iterations},
                       {"cutbacks", t.cutbacks},
                       {"max_contact_pressure_pa", t.max_contact_pressure},
                       {"max_plastic_strain", t.max_plastic_strain},

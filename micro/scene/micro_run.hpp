@@ -80,6 +80,7 @@ struct Draw {
 // A measurement's work and state over all its draws: sums of work, extremes of state.
 struct MeasurementTotals {
   int newton_iterations = 0, cutbacks = 0;
+  int coupling_iterations = 0;     // lubricated: fluid–structure exchanges (0 dry)
   double max_contact_pressure = 0.0, max_plastic_strain = 0.0, max_temperature = 0.0;  // Pa, —, K
   double contact_fraction = 0.0;   // mean over the draws, at their ends
   double draw_seconds_sum = 0.0;   // one-core time of all draws together
