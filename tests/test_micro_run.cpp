@@ -58,6 +58,11 @@ TEST(Scene, ErrorsNameTheKey) {
     apply_override(bad, assignment);
     EXPECT_NE(error_of(bad).find(expected), std::string::npos) << assignment << ": " << error_of(bad);
   }
+  nlohmann::json drained = j;
+  apply_override(drained, "lubricant.fill=\"after-pressing\"");
+  EXPECT_NO_THROW(parse_scene(drained, "scene.json"));
+  apply_override(drained, "protocol.name=\"seed-000\"");
+  EXPECT_NE(error_of(drained).find("lubricant.fill"), std::string::npos) << error_of(drained);
   nlohmann::json kelvin = j;
   apply_override(kelvin, "load.temperature=500K");
   EXPECT_DOUBLE_EQ(parse_scene(kelvin, "s").temperature, 500.0);

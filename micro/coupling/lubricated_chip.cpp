@@ -33,10 +33,20 @@ LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::Splin
                                           8 * tb.count());
   load_ = std::make_shared<NodalLoad>(problem_.dof_count());
   problem_.add_interaction(load_);
+  form_film();
+  if (!(options_.film_from > 0.0)) {
+    film_formed_ = true;
+    formed_film_area_ = fluid_->space().area();
+  }
+}
+
+void LubricatedChip::form_film() {
   fluid::NavierStokesOptions ns;
   ns.fluid = options_.fluid;
   fluid_ = std::make_unique<fluid::NavierStokes>(fluid::FluidSpace(gap_patch(surface_->graph(), *tool_, 0.0, options_.mesh)), ns);
   bottom_nodes_ = fluid_->space().side_nodes(Side::bottom);
+  top_nodes_.clear();
+  bottom_parameters_.clear();
   top_nodes_ = fluid_->space().side_nodes(Side::top);
   for (const auto& p : fluid_->space().side_points(Side::bottom)) bottom_parameters_.push_back(p.u);
   traction_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(bottom_parameters_.size()));
@@ -123,6 +133,14 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
 }
 
 bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double dt, std::string& reason) {
+  if (t0 < options_.film_from * (1.0 - 1e-12)) return integrator.solve_trial(t0, dt, reason);  // dry until the film forms
+  if (!film_formed_) {
+    surface_->update(integrator.u(), integrator.v());
+    form_film();
+    accelerator_.forget_past_steps();
+    film_formed_ = true;
+    formed_film_area_ = fluid_->space().area();
+  }
   current_ = LubricatedStep();
   // The fixed-point map depends on the step length (the chip's inertia per step): secant pairs of
   // steps of another length would mislead IQN-ILS.
@@ -138,7 +156,15 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
         return film(d, traction, dt, next, why);
       }};
   Eigen::VectorXd traction = traction_, displacement;
-  const CouplingStepReport report = coupled_step(solvers, traction, displacement, accelerator_, options_.coupling);
+  CouplingStepReport report;
+  try {
+    report = coupled_step(solvers, traction, displacement, accelerator_, options_.coupling);
+  } catch (const Error& e) {
+    // A trial the interface cannot follow (e.g. a chip surface folded by a wild iterate) fails the
+    // step, which is then cut back, like any other failure inside it.
+    report.converged = false;
+    report.reason = e.what();
+  }
   current_.coupling_iterations = report.iterations;
   if (trace_coupling()) {
     std::fprintf(stderr, "coupling t %.4g dt %.3g: %s after %d (fluid Newton %d)\n", t0 + dt, dt,

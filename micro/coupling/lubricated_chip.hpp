@@ -34,6 +34,10 @@ struct LubricantOptions {
   double robin_weight = 0.0;
   double chip_mass_per_area = 0.0;   // kg/m², for the automatic α_R
   double reference_step = 0.0;       // s, for the automatic α_R
+  // When the film is formed: at t = 0 in the whole initial gap (0), or at this time from the gap the
+  // chip leaves then — e.g. the start of sliding, the lubricant having drained while the chip was
+  // pressed (the chip's steps before it are dry).
+  double film_from = 0.0;            // s
 };
 
 // What one accepted step did at the interface.
@@ -57,6 +61,8 @@ class LubricatedChip {
 
   const std::vector<LubricatedStep>& history() const { return history_; }
   const fluid::NavierStokes& fluid() const { return *fluid_; }
+  // The film's area (m² per unit depth) when it formed (0 before).
+  double formed_film_area() const { return formed_film_area_; }
   // The film's traction on the chip transferred in the last accepted step, as nodal forces.
   const Eigen::VectorXd& nodal_forces() const { return load_->forces(); }
 
@@ -67,6 +73,7 @@ class LubricatedChip {
             std::string& reason);
   Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
   std::vector<double> pocket_areas() const;
+  void form_film();  // the film in the gap the chip's surface (surface_) leaves now
 
   solid::SolidProblem& problem_;
   spline::SplineCurve tool_curve_;
@@ -84,6 +91,8 @@ class LubricatedChip {
   std::vector<LubricatedStep> history_;
   LubricatedStep current_;
   double last_accepted_dt_ = 0.0;
+  bool film_formed_ = false;
+  double formed_film_area_ = 0.0;
 };
 
 }  // namespace mufric::coupling

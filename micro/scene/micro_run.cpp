@@ -244,7 +244,7 @@ class WindowAverage {
 
 namespace {
 
-coupling::LubricantOptions lubricant_options(const Scene& scene) {
+coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_start) {
   const LubricantSpec& l = scene.lubricant;
   coupling::LubricantOptions o;
   o.fluid = {l.density, l.viscosity};
@@ -256,6 +256,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene) {
   o.robin_weight = l.robin_weight;
   o.chip_mass_per_area = scene.material.density * scene.chip_height;
   o.reference_step = scene.dt;
+  o.film_from = l.fill == "after-pressing" ? slide_start : 0.0;
   o.coupling.acceleration = l.acceleration == "aitken"       ? coupling::Acceleration::aitken
                             : l.acceleration == "relaxation" ? coupling::Acceleration::constant_relaxation
                                                              : coupling::Acceleration::iqn_ils;
@@ -349,12 +350,12 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   std::unique_ptr<coupling::LubricatedChip> lubricant;
   solid::TimeIntegrator* integrator_of_step = nullptr;
   if (scene.physics == "lubricated") {
-    lubricant = std::make_unique<coupling::LubricatedChip>(problem, geometry.tool_surface, lubricant_options(scene));
+    lubricant = std::make_unique<coupling::LubricatedChip>(problem, geometry.tool_surface,
+                                                           lubricant_options(scene, motion.slide_start()));
     o.coupled_step = [&lubricant, &integrator_of_step](double t0, double dt, std::string& reason) {
       return lubricant->step(*integrator_of_step, t0, dt, reason);
     };
     result.lubricant.emplace();
-    result.lubricant->initial_film_area = lubricant->fluid().space().area();
     result.lubricant->fluid_dofs = 3 * lubricant->fluid().space().node_count();
   }
   solid::TimeIntegrator integrator(problem, o);
@@ -407,6 +408,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       l.fluid_newton_iterations += h.fluid_newton_iterations;
       l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);
     }
+    l.initial_film_area = lubricant->formed_film_area();
     if (!lubricant->history().empty()) {
       l.final_film_area = lubricant->history().back().film_area;
       l.final_pocket_areas = lubricant->history().back().pocket_areas;

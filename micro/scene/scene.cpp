@@ -280,6 +280,10 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
     l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
     l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
+    l.fill = f.text("fill", l.fill, {"gap", "after-pressing"});
+    if (l.fill == "after-pressing" && s.protocol.name != Protocol::press_slide) {
+      f.fail("fill", "after-pressing needs the press-slide protocol (seed 000's presses while sliding)");
+    }
     l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
     l.mesh_stiffening = f.number("mesh_stiffening", l.mesh_stiffening, 0.0, 5.0);
     l.acceleration = f.text("acceleration", l.acceleration, {"iqn-ils", "aitken", "relaxation"});

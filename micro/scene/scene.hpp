@@ -54,6 +54,10 @@ struct LubricantSpec {
   int elements_x = 0;          // film columns; 0: the chip's discretisation.elements_x
   int elements_y = 4;          // elements across the film
   double min_film = 5e-9;      // m, the film where the chip touches the tool
+  // What the film holds: "gap", all the lubricant in the initial gap from t = 0; "after-pressing",
+  // the chip pressed dry (the lubricant drained) and the film formed in the gap it leaves when
+  // sliding starts (press-slide only).
+  std::string fill = "gap";
   double robin_weight = 0.0;   // α_R, Pa s/m; 0: ρ_chip h_chip / time.step
   double mesh_stiffening = 1.0;  // χ of the Jacobian-based stiffening of the film's mesh
   std::string acceleration = "iqn-ils";  // iqn-ils, aitken or relaxation
