@@ -166,6 +166,8 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"fluid_force_x_n_per_m", s.fluid_force.x()},
                  {"fluid_force_y_n_per_m", s.fluid_force.y()},
                  {"coupling_iterations", s.coupling_iterations},
+                 {"film_area_m2_per_m", s.film_area},
+                 {"pocket_areas_m2_per_m", s.pocket_areas},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
                  {"newton_iterations", s.newton_iterations}});
@@ -386,6 +388,8 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       step.fluid_force = l.fluid_force;
       step.force += l.fluid_force;  // eq. (17) over the whole chip boundary: contact and fluid traction
       step.coupling_iterations = l.coupling_iterations;
+      step.film_area = l.film_area;
+      step.pocket_areas = l.pocket_areas;
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;

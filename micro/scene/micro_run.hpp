@@ -24,6 +24,8 @@ struct MicroStep {
   Eigen::Vector2d force = Eigen::Vector2d::Zero();  // resultant on the chip (contact + lubricant), N/m
   Eigen::Vector2d fluid_force = Eigen::Vector2d::Zero();  // the lubricant's part of it, N/m
   int coupling_iterations = 0;                      // lubricated: fluid–structure exchanges in the step
+  double film_area = 0.0;                           // lubricated: the film's area, m² per unit depth
+  std::vector<double> pocket_areas;                 // lubricated: between contact spots, m² per unit depth
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;
