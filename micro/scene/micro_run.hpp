@@ -31,6 +31,17 @@ struct MicroStep {
   int newton_iterations = 0;
 };
 
+// A lubricated run's film record: coupling work, mesh quality, the lubricant's area and its pockets.
+// (At namespace scope: clang cannot default-construct a nested struct with member initialisers
+// inside std::optional while the enclosing class is incomplete.)
+struct LubricantRecord {
+  int coupling_iterations = 0, max_coupling_iterations = 0, fluid_newton_iterations = 0;
+  double min_relative_jacobian = 1.0;
+  double initial_film_area = 0.0, final_film_area = 0.0;  // m² per unit depth, when formed and at the end
+  std::vector<double> final_pocket_areas;                  // m² per unit depth
+  int fluid_dofs = 0;
+};
+
 struct MicroResult {
   bool completed = false;
   std::string reason;           // why not, if not
@@ -49,16 +60,7 @@ struct MicroResult {
   // melting temperature, where Johnson–Cook leaves it no strength), one sentence each.
   std::vector<std::string> warnings;
   int dofs = 0, elements = 0;
-  // Lubricated runs: the film's record (coupling work, mesh quality, the lubricant's area and its
-  // pockets at the end).
-  struct Lubricant {
-    int coupling_iterations = 0, max_coupling_iterations = 0, fluid_newton_iterations = 0;
-    double min_relative_jacobian = 1.0;
-    double initial_film_area = 0.0, final_film_area = 0.0;  // m² per unit depth
-    std::vector<double> final_pocket_areas;                  // m² per unit depth
-    int fluid_dofs = 0;
-  };
-  std::optional<Lubricant> lubricant;
+  std::optional<LubricantRecord> lubricant;  // lubricated runs
   solid::IntegrationReport solver;  // the time integration's own record: Newton work, cut-backs, seconds
   double wall_seconds = 0.0;
   // provenance: code version, time and scene (false for a draw inside a measurement's file)
