@@ -208,9 +208,7 @@ spline::SplineCurve periodic_curve(int degree, int n, double length, const std::
   const spline::SplineBasis b = spline::SplineBasis::periodic_uniform(degree, n, 0.0, length);
   spline::Points2 p(n, 2);
   for (int i = 0; i < n; ++i) {
-    double x = 0.0;
-    for (int j = 1; j <= degree; ++j) x += b.knot(i + j);
-    x /= degree;
+    const double x = b.greville_abscissa(i);
     p.row(i) = Eigen::RowVector2d(x, f(x));
   }
   return spline::SplineCurve(b, p, {}, Eigen::Vector2d(length, 0.0));

@@ -118,9 +118,7 @@ Columns columns_of(const spline::SplineBasis& basis) {
   Columns c;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
   for (int i = 0; i < n; ++i) {
-    double sum = 0.0;
-    for (int j = 1; j <= basis.degree(); ++j) sum += basis.knot(i + j);
-    c.x.push_back(sum / basis.degree());
+    c.x.push_back(basis.greville_abscissa(i));
     const auto loc = basis.locate(c.x.back());
     const Eigen::VectorXd values = basis.values(loc.span, loc.u);
     for (int j = 0; j <= basis.degree(); ++j) a(i, basis.function_index(loc.span, j)) += values(j);
@@ -162,9 +160,7 @@ spline::SplineSurface gap_patch(const PeriodicGraph& chip, const PeriodicGraph& 
   const int nu = bu.count(), nv = bv.count();
   spline::Points2 points(nu * nv, 2);
   for (int j = 0; j < nv; ++j) {
-    double s = 0.0;  // the row's Greville fraction across the film: 0 at the chip, 1 at the tool
-    for (int k = 1; k <= o.degree; ++k) s += bv.knot(j + k);
-    s /= o.degree;
+    const double s = bv.greville_abscissa(j);  // the row's fraction across the film: 0 at the chip, 1 at the tool
     for (int i = 0; i < nu; ++i) {
       points.row(i + nu * j) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], bottom(i) + s * (top(i) - bottom(i)));
     }

@@ -234,15 +234,10 @@ spline::SplineSurface rectangle_patch(int degree, int nx, int ny, const Eigen::V
   const spline::SplineBasis bu = periodic_x ? spline::SplineBasis::periodic_uniform(degree, nx, lo.x(), hi.x())
                                             : spline::SplineBasis::open_uniform(degree, nx, lo.x(), hi.x());
   const spline::SplineBasis bv = spline::SplineBasis::open_uniform(degree, ny, lo.y(), hi.y());
-  const auto unreduced_greville = [](const spline::SplineBasis& b, int i) {
-    double sum = 0.0;
-    for (int j = 1; j <= b.degree(); ++j) sum += b.knot(i + j);
-    return sum / b.degree();
-  };
   spline::Points2 points(bu.count() * bv.count(), 2);
   for (int j = 0; j < bv.count(); ++j) {
     for (int i = 0; i < bu.count(); ++i) {
-      points.row(i + bu.count() * j) = Eigen::RowVector2d(unreduced_greville(bu, i), unreduced_greville(bv, j));
+      points.row(i + bu.count() * j) = Eigen::RowVector2d(bu.greville_abscissa(i), bv.greville_abscissa(j));
     }
   }
   const Eigen::Vector2d shift = periodic_x ? Eigen::Vector2d(hi.x() - lo.x(), 0.0) : Eigen::Vector2d::Zero();

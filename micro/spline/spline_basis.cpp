@@ -204,19 +204,18 @@ BasisDerivatives SplineBasis::derivatives(int span, double u, int n) const {
 
 Eigen::VectorXd SplineBasis::values(int span, double u) const { return derivatives(span, u, 0).row(0).transpose(); }
 
+double SplineBasis::greville_abscissa(int i) const {
+  if (degree_ == 0) return 0.5 * (knot(i) + knot(i + 1));
+  double sum = 0.0;
+  for (int j = 1; j <= degree_; ++j) sum += knot(i + j);
+  return sum / degree_;
+}
+
 std::vector<double> SplineBasis::greville() const {
   std::vector<double> g(static_cast<size_t>(count()));
-  const int p = degree_;
   for (int i = 0; i < count(); ++i) {
-    double sum = 0.0;
-    if (p == 0) {
-      sum = 0.5 * (knot(i) + knot(i + 1));
-    } else {
-      for (int j = 1; j <= p; ++j) sum += knot(i + j);
-      sum /= p;
-    }
-    if (periodic_) sum = locate(sum).u;
-    g[static_cast<size_t>(i)] = sum;
+    const double u = greville_abscissa(i);
+    g[static_cast<size_t>(i)] = periodic_ ? locate(u).u : u;
   }
   return g;
 }

@@ -64,6 +64,8 @@ class SplineBasis {
 
   // Greville abscissae (knot averages), one per function; periodic ones reduced into [lo, hi).
   std::vector<double> greville() const;
+  // Function i's Greville abscissa, not reduced: increasing in i (control points of x(u) = u).
+  double greville_abscissa(int i) const;
   // The same space with one more knot at u (inside the domain).
   SplineBasis with_knot(double u) const;
   // Degree p + 1 with every knot's multiplicity raised by one: contains this basis's space.
