@@ -113,7 +113,7 @@ void TimeIntegrator::accept() {
   problem_.commit(std::move(trial_.states));
   stresses_ = std::move(trial_.stresses);
   if (dynamic) {
-    v_ += trial_.dt * ((1.0 - gamma()) * a_ + gamma() * trial_.a);
+    v_ = trial_v();
     a_ = trial_.a;
   }
   last_increment_ = trial_.u - u_;
@@ -292,7 +292,7 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
   trial_.states = std::move(current.assembly.states);
   trial_.stresses = std::move(current.assembly.stresses);
   trial_.newton_iterations += at.record.newton_iterations;
-  last_trial_newton_iterations_ = at.record.newton_iterations;
+  trial_.last_newton_iterations = at.record.newton_iterations;
   trial_.line_search_reductions += at.record.line_search_reductions;
   trial_.residual_norm = at.record.residual;
   at.ok = true;
@@ -359,7 +359,7 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     if (on_step) on_step(StepView{t, u_, v_, a_, reactions_, stresses_, problem_});
     // A coupled step's record sums the Newton iterations of its trials; the step size follows the
     // last trial's, the one that measures how hard this step length is for the chip.
-    dt = next_step(t, this_dt, options_.coupled_step ? last_trial_newton_iterations_ : at.record.newton_iterations);
+    dt = next_step(t, this_dt, options_.coupled_step ? trial_.last_newton_iterations : at.record.newton_iterations);
   }
   report_.completed = true;
   record_solver_counts();

@@ -138,13 +138,13 @@ class TimeIntegrator {
     std::vector<MaterialState> states;
     std::vector<Eigen::Matrix2d> stresses;
     int newton_iterations = 0, line_search_reductions = 0;  // summed over the trials of one step
+    int last_newton_iterations = 0;                          // of the last trial alone
     double residual_norm = 0.0;
   };
   Attempt solve(double t0, double dt);  // into trial_
   void accept();                        // trial_ becomes the state
   Attempt step(double t0, double dt);   // solve + accept, or the coupled step
   Trial trial_;
-  int last_trial_newton_iterations_ = 0;
   double next_step(double t, double dt, int newton_iterations) const;
   void record_solver_counts();  // the linear solver's counters into report_
   double alpha_m() const, alpha_f() const, beta() const, gamma() const;
