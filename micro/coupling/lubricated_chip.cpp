@@ -52,16 +52,22 @@ void LubricatedChip::form_film() {
   traction_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(bottom_parameters_.size()));
 }
 
+double LubricatedChip::film_thickness(const fluid::ParametricPoint& bottom_point) const {
+  // The film's columns do not move along x, so the top point above is at the same u.
+  const fluid::FluidSpace& space = fluid_->space();
+  const double top = space.patch().v_basis().hi();
+  return space.map(space.at(bottom_point.u, top)).position.y() - space.map(bottom_point).position.y();
+}
+
 Eigen::VectorXd LubricatedChip::transfer(const Eigen::VectorXd& traction) const {
   const fluid::FluidSpace& space = fluid_->space();
   const auto& points = space.side_points(Side::bottom);
-  const double top = space.patch().v_basis().hi();
   std::vector<Eigen::Vector2d> positions, loads;
   std::vector<double> weights;
   for (size_t q = 0; q < points.size(); ++q) {
     const Side bottom = Side::bottom;
     const fluid::PhysicalPoint at = space.map(points[q], &bottom);
-    const double film = space.map(space.at(points[q].u, top)).position.y() - at.position.y();
+    const double film = film_thickness(points[q]);
     // At a contact spot (the film at its minimum) the contact carries the chip; the fluid's share
     // fades out linearly between kContactFilmFactor and one minimum film, so that the transferred
     // load is continuous in the chip's position (a switch would make the coupling's map jump).
@@ -193,15 +199,12 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
 std::vector<double> LubricatedChip::pocket_areas() const {
   // Film thickness × dx at the bottom side's Gauss points (x = u: the columns do not move along x),
   // summed between contact spots; the interval is periodic, so the last pocket continues the first.
-  const fluid::FluidSpace& space = fluid_->space();
-  const auto& points = space.side_points(Side::bottom);
-  const double top = space.patch().v_basis().hi();
+  const auto& points = fluid_->space().side_points(Side::bottom);
   std::vector<double> pockets;
   double open = 0.0, before_first_spot = 0.0;
   bool seen_spot = false;
   for (const auto& p : points) {
-    const double bottom_y = space.map(p).position.y();
-    const double film = space.map(space.at(p.u, top)).position.y() - bottom_y;
+    const double film = film_thickness(p);
     if (film < kContactFilmFactor * options_.mesh.min_film) {
       if (!seen_spot) {
         before_first_spot = open;

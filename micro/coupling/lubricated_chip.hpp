@@ -73,6 +73,7 @@ class LubricatedChip {
             std::string& reason);
   Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
   std::vector<double> pocket_areas() const;
+  double film_thickness(const fluid::ParametricPoint& bottom_point) const;  // m, tool minus chip above it
   void form_film();  // the film in the gap the chip's surface (surface_) leaves now
 
   solid::SolidProblem& problem_;
