@@ -489,7 +489,19 @@ MeasurementTotals MuMeasurement::totals() const {
     t.contact_fraction += d.result.contact_fraction / static_cast<double>(draws.size());
     t.draw_seconds_sum += d.result.wall_seconds;
   }
+  if (!draws.empty()) t.dofs = draws.front().result.dofs;
   return t;
+}
+
+nlohmann::json MeasurementTotals::to_json() const {
+  return {{"newton_iterations", newton_iterations},
+          {"coupling_iterations", coupling_iterations},
+          {"cutbacks", cutbacks},
+          {"max_contact_pressure_pa", max_contact_pressure},
+          {"max_plastic_strain", max_plastic_strain},
+          {"max_temperature_k", max_temperature},
+          {"contact_area_fraction", contact_fraction},
+          {"dofs", dofs}};
 }
 
 double MuMeasurement::max_abs_drift() const {
@@ -595,18 +607,11 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
   }
   // Aggregates over the draws, for scripts that read one run.
   const MeasurementTotals t = totals();
-  j["diagnostics"] = {{"wall_seconds", wall_seconds},
-                      {"threads", threads},
-                      {"newton_iterations", t.newton_iterations},
-                      {"coupling_iterations", t.coupling_iterations},
-                      {"cutbacks", t.cutbacks},
-                      {"max_contact_pressure_pa", t.max_contact_pressure},
-                      {"max_plastic_strain", t.max_plastic_strain},
-                      {"max_temperature_k", t.max_temperature},
-                      {"contact_area_fraction", t.contact_fraction},
-                      {"draw_seconds_sum", t.draw_seconds_sum},
-                      {"dofs", draws.empty() ? 0 : draws.front().result.dofs},
-                      {"elements", draws.empty() ? 0 : draws.front().result.elements}};
+  nlohmann::json& diagnostics = j["diagnostics"] = t.to_json();
+  diagnostics["wall_seconds"] = wall_seconds;
+  diagnostics["threads"] = threads;
+  diagnostics["draw_seconds_sum"] = t.draw_seconds_sum;
+  diagnostics["elements"] = draws.empty() ? 0 : draws.front().result.elements;
   auto& list = j["draws"] = nlohmann::json::array();
   for (const auto& d : draws) {
     nlohmann::json one = d.result.to_json(scene, false);

@@ -88,6 +88,9 @@ struct MeasurementTotals {
   double max_contact_pressure = 0.0, max_plastic_strain = 0.0, max_temperature = 0.0;  // Pa, —, K
   double contact_fraction = 0.0;   // mean over the draws, at their ends
   double draw_seconds_sum = 0.0;   // one-core time of all draws together
+  int dofs = 0;                    // of the chip (every draw has the same mesh)
+  // The diagnostics both result.json and a dataset sample report, under the same keys.
+  nlohmann::json to_json() const;
 };
 
 // μ as a property of (p, v, T, roughness statistics): the mean over the draws, with the standard
