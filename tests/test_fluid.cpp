@@ -100,6 +100,21 @@ TEST(FluidChannel, CouetteFlowThroughTractionAndRobinSides) {
   }
 }
 
+TEST(FluidChannel, ARobinSideWithoutItsWeightIsATractionSide) {
+  // Where the Robin weight's share is 0 the wall velocity g no longer acts (a lubricant cavitated off
+  // the wall): a wrong g changes nothing, the traction alone drives the exact Couette flow.
+  const double lid = 2.0, shear = kOil.viscosity * lid / kHeight;
+  NavierStokes ns = channel(8, 4);
+  SideCondition top{Side::top, SideConditionKind::robin, constant(Eigen::Vector2d(5.0 * lid, 0.0)),
+                    constant(Eigen::Vector2d(shear, 0.0)), 1e6};
+  top.robin_share = [](const Eigen::Vector2d&, double) { return 0.0; };
+  ns.set_conditions({{Side::bottom, SideConditionKind::velocity, constant(Eigen::Vector2d::Zero()), {}, 0.0}, top});
+  const FluidStepReport r = ns.solve_steady();
+  ASSERT_TRUE(r.converged) << r.reason;
+  EXPECT_LT(max_profile_error(ns, [&](double y) { return lid * y / kHeight; }), 1e-9 * lid);
+  for (const auto& s : ns.robin_traction(Side::top)) EXPECT_NEAR(s.traction.x(), shear, 1e-12 * shear);
+}
+
 TEST(FluidChannel, PoiseuilleFlowIsExactAndWallsCarryTheBodyForce) {
   NavierStokesOptions o;
   o.pinned_pressure_node = 0;

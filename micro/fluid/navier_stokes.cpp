@@ -168,11 +168,12 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
   for (const auto& c : conditions_) {
     if (c.kind == SideConditionKind::velocity) continue;
     if (c.kind == SideConditionKind::robin && !c.velocity) throw Error("fluid: a Robin side needs its velocity");
-    const double alpha = c.kind == SideConditionKind::robin ? c.robin_weight : 0.0;
+    const double side_alpha = c.kind == SideConditionKind::robin ? c.robin_weight : 0.0;
     for (const ParametricPoint& p : space_.side_points(c.side)) {
       const PhysicalPoint q = space_.map(p, &c.side);
       const double t = parameter_along(p, c.side);
       const Eigen::Vector2d h = c.traction ? c.traction(q.position, t) : Eigen::Vector2d::Zero();
+      const double alpha = c.robin_share ? side_alpha * c.robin_share(q.position, t) : side_alpha;
       Eigen::Vector2d load = h;
       if (alpha != 0.0) load += alpha * (c.velocity(q.position, t) - velocity(p));
       const auto n = static_cast<Eigen::Index>(p.nodes.size());
@@ -298,7 +299,7 @@ std::vector<NavierStokes::TractionSample> NavierStokes::side_traction(Side side)
       gradient += state_.segment<2>(3 * p.nodes[a]) * q.gradients.col(static_cast<Eigen::Index>(a)).transpose();
     }
     const Eigen::Matrix2d sigma = -pressure(p) * Eigen::Matrix2d::Identity() + mu * (gradient + gradient.transpose());
-    out.push_back({q.position, sigma * q.normal, q.normal, parameter_along(p, side), q.weight});
+    out.push_back({q.position, sigma * q.normal, q.normal, parameter_along(p, side), q.weight, velocity(p)});
   }
   return out;
 }
@@ -314,8 +315,10 @@ std::vector<NavierStokes::TractionSample> NavierStokes::robin_traction(Side side
     const PhysicalPoint q = space_.map(p, &side);
     const double t = parameter_along(p, side);
     Eigen::Vector2d traction = robin->traction ? robin->traction(q.position, t) : Eigen::Vector2d::Zero();
-    traction += robin->robin_weight * (robin->velocity(q.position, t) - velocity(p));
-    out.push_back({q.position, traction, q.normal, t, q.weight});
+    const double alpha = robin->robin_weight * (robin->robin_share ? robin->robin_share(q.position, t) : 1.0);
+    const Eigen::Vector2d v = velocity(p);
+    traction += alpha * (robin->velocity(q.position, t) - v);
+    out.push_back({q.position, traction, q.normal, t, q.weight, v});
   }
   return out;
 }

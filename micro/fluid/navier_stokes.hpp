@@ -51,6 +51,7 @@ struct NavierStokesOptions {
 enum class SideConditionKind { velocity, traction, robin };
 // A boundary value at a current position x on the side and its curve parameter t.
 using BoundaryField = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
+using BoundaryScalar = std::function<double(const Eigen::Vector2d& x, double t)>;
 
 struct SideCondition {
   Side side = Side::bottom;
@@ -58,6 +59,9 @@ struct SideCondition {
   BoundaryField velocity;   // g: velocity and Robin
   BoundaryField traction;   // h: traction and Robin (empty: zero)
   double robin_weight = 0.0;  // α_R, Pa s/m
+  // Robin: the share of α_R in force at each point (empty: 1 everywhere); 0 makes the point a
+  // traction point, σn = h (e.g. where the lubricant has cavitated off the wall).
+  BoundaryScalar robin_share = {};
 };
 
 struct FluidStepReport {
@@ -110,6 +114,7 @@ class NavierStokes {
   struct TractionSample {
     Eigen::Vector2d position, traction, normal;
     double parameter = 0.0, weight = 0.0;
+    Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // the fluid's, at the point
   };
   std::vector<TractionSample> side_traction(Side side) const;
   // On a Robin side, the traction its condition imposes weakly, σn = h + α(g − v): the interface
