@@ -5,10 +5,12 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include <gtest/gtest.h>
 
+#include "micro/coupling/cavitation.hpp"
 #include "micro/coupling/chip_interface.hpp"
 #include "micro/coupling/partitioned.hpp"
 #include "micro/fluid/mesh_update.hpp"
@@ -28,6 +30,8 @@ struct PistonPocket {
   static constexpr double kWidth = 2e-6, kHeight = 1e-6, kPlateMassPerArea = 7800.0 * 1e-6;  // kg/m²
   double applied = 1e6;   // Pa
   double dt = 1e-9;       // s
+  std::optional<CavitatingFilm> cavitation;  // none: the liquid holds any tension
+  std::vector<double> normal_stress, opening_rate;  // the liquid's σn·n and (g − v)·n at the plate
   Scheme scheme;
   fluid::NavierStokes ns;
   fluid::MeshUpdate mesh;
@@ -81,12 +85,17 @@ struct PistonPocket {
       const Eigen::VectorXd h = previous;
       std::vector<double> parameters;
       for (const auto& p : ns.space().side_points(Side::top)) parameters.push_back(p.u);
-      const fluid::BoundaryField traction = [h, parameters](const Eigen::Vector2d&, double t) {
-        const auto it = std::lower_bound(parameters.begin(), parameters.end(), t - 1e-15);
-        const auto i = static_cast<Eigen::Index>(it - parameters.begin());
-        return Eigen::Vector2d(h.segment<2>(2 * i));
+      const auto index = [parameters](double t) {
+        return static_cast<size_t>(std::lower_bound(parameters.begin(), parameters.end(), t - 1e-15) - parameters.begin());
       };
-      conditions.push_back({Side::top, fluid::SideConditionKind::robin, piston, traction, robin_weight()});
+      const fluid::BoundaryField traction = [h, index](const Eigen::Vector2d&, double t) {
+        return Eigen::Vector2d(h.segment<2>(2 * static_cast<Eigen::Index>(index(t))));
+      };
+      const CavitatingFilm* cavities = cavitation ? &*cavitation : nullptr;
+      const fluid::BoundaryScalar follows = [cavities, index](const Eigen::Vector2d&, double t) {
+        return cavities != nullptr && cavities->cavitated(index(t)) ? 0.0 : 1.0;
+      };
+      conditions.push_back({Side::top, fluid::SideConditionKind::robin, piston, traction, robin_weight(), follows});
     }
     for (Side side : {Side::left, Side::right, Side::bottom}) conditions.push_back({side, fluid::SideConditionKind::velocity, wall, {}, 0.0});
     ns.set_conditions(conditions);
@@ -95,7 +104,14 @@ struct PistonPocket {
       reason = r.reason;
       return false;
     }
-    const auto samples = scheme == Scheme::robin_neumann ? ns.robin_traction(Side::top) : ns.side_traction(Side::top);
+    auto samples = scheme == Scheme::robin_neumann ? ns.robin_traction(Side::top) : ns.side_traction(Side::top);
+    normal_stress.resize(samples.size());
+    opening_rate.resize(samples.size());
+    for (size_t i = 0; i < samples.size(); ++i) {
+      normal_stress[i] = samples[i].traction.dot(samples[i].normal);
+      opening_rate[i] = (piston_velocity - samples[i].velocity).dot(samples[i].normal);
+      if (cavitation && cavitation->cavitated(i)) samples[i].traction = -cavitation->cavitation_pressure() * samples[i].normal;
+    }
     load.resize(2 * static_cast<Eigen::Index>(samples.size()));
     for (size_t i = 0; i < samples.size(); ++i) load.segment<2>(2 * static_cast<Eigen::Index>(i)) = samples[i].traction;
     return true;
@@ -149,6 +165,14 @@ struct PistonPocket {
       EXPECT_TRUE(fluid(delta, load, final_load, why)) << why;
       piston_velocity_start = (delta(0) - piston_start) / dt;
       piston_start = delta(0);
+      if (cavitation) {  // the film's state for the next step
+        std::vector<FilmSample> film;
+        for (size_t i = 0; i < normal_stress.size(); ++i) {
+          film.push_back({kHeight + piston_start, kWidth / static_cast<double>(normal_stress.size()), false, normal_stress[i],
+                          opening_rate[i]});
+        }
+        cavitation->update(film, dt);
+      }
     }
     out.piston = piston_start;
     out.pressure = ns.pressure_at(0.5 * kWidth, 0.5 * kHeight);
@@ -175,6 +199,100 @@ TEST(EnclosedPocket, RobinNeumannHoldsThePistonAtTheAppliedPressure) {
   EXPECT_NEAR(out.pressure / pocket.applied, 1.0, 1e-6);
   EXPECT_NEAR(out.area / area, 1.0, 1e-9);   // the pocket keeps its volume
   EXPECT_LT(std::abs(out.piston), 1e-9 * PistonPocket::kHeight);
+}
+
+TEST(EnclosedPocket, APulledPistonIsHeldByTensionUnlessTheFilmCavitates) {
+  // Without cavitation the liquid holds the plate at any tension. With it, the first step still
+  // holds (states change between steps), the film then cavitates, and the plate flies against the
+  // cavitation pressure alone: backward Euler from rest under the constant net force B (p_c − p_applied)
+  // gives δ_n = Δt² a (n − 1) n / 2 after n steps, a = B (p_c − p_applied)/m; the liquid stays at rest,
+  // so the cavity is B δ_n.
+  PistonPocket holding(Scheme::robin_neumann);
+  holding.applied = -1e6;
+  const auto held = holding.run(5, options(Acceleration::iqn_ils));
+  ASSERT_TRUE(held.converged) << held.reason;
+  EXPECT_NEAR(held.pressure / holding.applied, 1.0, 1e-6);
+  EXPECT_LT(std::abs(held.piston), 1e-9 * PistonPocket::kHeight);
+  for (double p_c : {0.0, -0.5e6}) {
+    PistonPocket pocket(Scheme::robin_neumann);
+    pocket.applied = -1e6;
+    pocket.cavitation.emplace(p_c);
+    const int steps = 5;
+    const auto out = pocket.run(steps, options(Acceleration::iqn_ils));
+    ASSERT_TRUE(out.converged) << out.reason;
+    const double mass = PistonPocket::kPlateMassPerArea * PistonPocket::kWidth;
+    const double a = PistonPocket::kWidth * (p_c - pocket.applied) / mass;
+    const double expected = pocket.dt * pocket.dt * a * (steps - 1) * steps / 2.0;
+    std::cout << "pulled plate, p_c = " << p_c << " Pa: " << out.iterations << " exchanges, moved " << out.piston
+              << " m (flight against p_c: " << expected << "), cavity " << pocket.cavitation->cavity_area() << " m^2/m\n";
+    EXPECT_NEAR(out.piston / expected, 1.0, 1e-6);
+    EXPECT_TRUE(pocket.cavitation->cavitated(0));
+    EXPECT_NEAR(pocket.cavitation->cavity_area() / (PistonPocket::kWidth * expected), 1.0, 1e-6);
+    EXPECT_NEAR(pocket.cavitation->cavitated_fraction(), 1.0, 1e-12);
+    if (p_c != 0.0) continue;
+    // Pushed back, the plate closes the cavity and the film refills once the plate is back at the
+    // liquid: from then on the liquid holds the plate again.
+    pocket.applied = 4e6;
+    const auto back = pocket.run(12, options(Acceleration::iqn_ils));
+    ASSERT_TRUE(back.converged) << back.reason;
+    EXPECT_FALSE(pocket.cavitation->cavitated(0));
+    EXPECT_EQ(pocket.cavitation->cavity_area(), 0.0);
+    const double refilled_at = back.piston;
+    const auto still = pocket.run(3, options(Acceleration::iqn_ils));
+    ASSERT_TRUE(still.converged) << still.reason;
+    std::cout << "pushed back: refilled at " << refilled_at << " m, then " << still.piston << " m, pocket pressure "
+              << still.pressure << " Pa\n";
+    EXPECT_LT(refilled_at, 0.0);  // the space shrank past the liquid's
+    EXPECT_NEAR(still.piston, refilled_at, 1e-9 * PistonPocket::kHeight);
+    EXPECT_NEAR(still.pressure / pocket.applied, 1.0, 1e-3);
+  }
+  // A pushed plate's film never cavitates.
+  PistonPocket pushed(Scheme::robin_neumann);
+  pushed.cavitation.emplace(0.0);
+  const auto out = pushed.run(5, options(Acceleration::iqn_ils));
+  ASSERT_TRUE(out.converged) << out.reason;
+  EXPECT_FALSE(pushed.cavitation->cavitated(0));
+  EXPECT_NEAR(out.pressure / pushed.applied, 1.0, 1e-6);
+  EXPECT_LT(std::abs(out.piston), 1e-9 * PistonPocket::kHeight);
+}
+
+TEST(Pockets, RunsBetweenSpotsWrapAroundThePeriod) {
+  // Spots at 2 and 5 of 7 samples: pockets {3, 4} and {6, 0, 1} (across the period's end).
+  std::vector<FilmSample> film(7, FilmSample{1e-7, 1e-6, false, 0.0, 0.0});
+  EXPECT_EQ(pocket_runs(film).size(), 1u);
+  film[2].spot = film[5].spot = true;
+  const auto runs = pocket_runs(film);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0], (std::vector<size_t>{3, 4}));
+  EXPECT_EQ(runs[1], (std::vector<size_t>{6, 0, 1}));
+}
+
+TEST(CavitatingFilm, ACavityOpensWhereTheLiquidPullsAndClosesWhenTheWallReturns) {
+  // Sample 0 pulls (σn·n = 0.1 MPa > −p_c = 0), sample 1 pushes; each stands for 1 µm.
+  std::vector<FilmSample> film{{1e-7, 1e-6, false, 1e5, 0.0}, {1e-7, 1e-6, false, -1e5, 0.0}};
+  CavitatingFilm cavitation(0.0);
+  cavitation.update(film, 1e-9);
+  EXPECT_TRUE(cavitation.cavitated(0));
+  EXPECT_FALSE(cavitation.cavitated(1));
+  EXPECT_EQ(cavitation.cavity_area(), 0.0);  // it opens from the next step on
+  EXPECT_NEAR(cavitation.cavitated_fraction(), 0.5, 1e-15);
+  // The wall leaves the liquid at 2 m/s for 3 ns, then comes back at 1 m/s: the cavity is 6 nm
+  // thick, then 5, 4, …, and the sample refills in the step that brings it to zero.
+  film[0].opening_rate = 2.0;
+  for (int k = 0; k < 3; ++k) cavitation.update(film, 1e-9);
+  EXPECT_NEAR(cavitation.cavity_area(), 6e-9 * 1e-6, 1e-24);
+  film[0].opening_rate = -1.0;
+  for (int k = 0; k < 5; ++k) cavitation.update(film, 1e-9);
+  EXPECT_TRUE(cavitation.cavitated(0));
+  EXPECT_NEAR(cavitation.cavity_area(), 1e-9 * 1e-6, 1e-24);
+  cavitation.update(film, 1e-9);
+  EXPECT_FALSE(cavitation.cavitated(0));
+  EXPECT_EQ(cavitation.cavity_area(), 0.0);
+  // A lower cavitation pressure (the liquid holds 0.2 MPa of tension) keeps both samples full.
+  CavitatingFilm strong(-2e5);
+  film[0].normal_stress = 1e5;
+  strong.update(film, 1e-9);
+  EXPECT_FALSE(strong.cavitated(0));
 }
 
 TEST(EnclosedPocket, DirichletNeumannFailsOnTheEnclosedPocket) {

@@ -24,6 +24,7 @@ bool trace_coupling() {
 LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::SplineCurve& tool, LubricantOptions options)
     : problem_(problem), tool_curve_(tool), options_(std::move(options)), mesh_update_(options_.mesh_update),
       accelerator_(options_.coupling) {
+  if (!(options_.contact_fade > 1.0)) throw Error("lubricant: the contact fade must span more than one minimum film");
   if (!(options_.robin_weight > 0.0) && !(options_.chip_mass_per_area > 0.0 && options_.reference_step > 0.0)) {
     throw Error("lubricant: give a Robin weight, or the chip's mass per area and a reference step for the automatic one");
   }
@@ -31,6 +32,7 @@ LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::Splin
   const auto& tb = tool_curve_.basis();
   tool_ = std::make_unique<PeriodicGraph>([this](double t) { return tool_curve_.point(t); }, tb.lo(), tb.period(),
                                           8 * tb.count());
+  if (options_.cavitation_pressure) cavitation_.emplace(*options_.cavitation_pressure);
   load_ = std::make_shared<NodalLoad>(problem_.dof_count());
   problem_.add_interaction(load_);
   form_film();
@@ -50,6 +52,28 @@ void LubricatedChip::form_film() {
   top_nodes_ = fluid_->space().side_nodes(Side::top);
   for (const auto& p : fluid_->space().side_points(Side::bottom)) bottom_parameters_.push_back(p.u);
   traction_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(bottom_parameters_.size()));
+  normal_stress_.assign(bottom_parameters_.size(), 0.0);
+  opening_rate_.assign(bottom_parameters_.size(), 0.0);
+  if (cavitation_) cavitation_->reset();  // a new film: full everywhere
+}
+
+size_t LubricatedChip::sample_at(double parameter) const {
+  const auto& p = bottom_parameters_;
+  const auto it = std::lower_bound(p.begin(), p.end(), parameter - 1e-12 * (p.back() - p.front()));
+  return static_cast<size_t>(std::min<std::ptrdiff_t>(it - p.begin(), static_cast<std::ptrdiff_t>(p.size()) - 1));
+}
+
+std::vector<FilmSample> LubricatedChip::film_samples() const {
+  const auto& points = fluid_->space().side_points(Side::bottom);
+  std::vector<FilmSample> samples;
+  samples.reserve(points.size());
+  for (size_t q = 0; q < points.size(); ++q) {
+    const double film = film_thickness(points[q]);
+    // The parametric weight is the length along x: the columns are at x = u.
+    samples.push_back({film, points[q].weight, film < options_.contact_fade * options_.mesh.min_film, normal_stress_[q],
+                       opening_rate_[q]});
+  }
+  return samples;
 }
 
 double LubricatedChip::film_thickness(const fluid::ParametricPoint& bottom_point) const {
@@ -69,10 +93,10 @@ Eigen::VectorXd LubricatedChip::transfer(const Eigen::VectorXd& traction) const 
     const fluid::PhysicalPoint at = space.map(points[q], &bottom);
     const double film = film_thickness(points[q]);
     // At a contact spot (the film at its minimum) the contact carries the chip; the fluid's share
-    // fades out linearly between kContactFilmFactor and one minimum film, so that the transferred
+    // fades out linearly between contact_fade and one minimum film, so that the transferred
     // load is continuous in the chip's position (a switch would make the coupling's map jump).
     const double h = options_.mesh.min_film;
-    const double share = std::clamp((film - h) / ((kContactFilmFactor - 1.0) * h), 0.0, 1.0);
+    const double share = std::clamp((film - h) / ((options_.contact_fade - 1.0) * h), 0.0, 1.0);
     if (share == 0.0) continue;
     positions.push_back(at.position);
     loads.push_back(-share * traction.segment<2>(2 * static_cast<Eigen::Index>(q)));  // the chip receives −σn
@@ -116,15 +140,16 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
   const fluid::BoundaryField chip_velocity = [chip](const Eigen::Vector2d& x, double) {
     return chip->velocity(chip->parameter_at(x.x()));
   };
-  const std::vector<double>& parameters = bottom_parameters_;
-  const fluid::BoundaryField previous = [&traction, &parameters](const Eigen::Vector2d&, double t) {
-    const auto it = std::lower_bound(parameters.begin(), parameters.end(), t - 1e-12 * (parameters.back() - parameters.front()));
-    const auto i = std::min<std::ptrdiff_t>(it - parameters.begin(), static_cast<std::ptrdiff_t>(parameters.size()) - 1);
-    return Eigen::Vector2d(traction.segment<2>(2 * static_cast<Eigen::Index>(i)));
+  const fluid::BoundaryField previous = [this, &traction](const Eigen::Vector2d&, double t) {
+    return Eigen::Vector2d(traction.segment<2>(2 * static_cast<Eigen::Index>(sample_at(t))));
+  };
+  // Where the film has cavitated the liquid no longer follows the chip: a traction side at p_c.
+  const fluid::BoundaryScalar follows_chip = [this](const Eigen::Vector2d&, double t) {
+    return cavitation_ && cavitation_->cavitated(sample_at(t)) ? 0.0 : 1.0;
   };
   const fluid::BoundaryField tool_velocity = [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); };
   fluid_->set_conditions({{Side::top, fluid::SideConditionKind::velocity, tool_velocity, {}, 0.0},
-                          {Side::bottom, fluid::SideConditionKind::robin, chip_velocity, previous, alpha}});
+                          {Side::bottom, fluid::SideConditionKind::robin, chip_velocity, previous, alpha, follows_chip}});
   const fluid::FluidStepReport r = fluid_->solve_step(dt);
   current_.fluid_newton_iterations += r.newton_iterations;
   current_.min_relative_jacobian = std::min(current_.min_relative_jacobian, r.min_relative_jacobian);
@@ -134,7 +159,14 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
   }
   const auto samples = fluid_->robin_traction(Side::bottom);
   new_traction.resize(2 * static_cast<Eigen::Index>(samples.size()));
-  for (size_t q = 0; q < samples.size(); ++q) new_traction.segment<2>(2 * static_cast<Eigen::Index>(q)) = samples[q].traction;
+  for (size_t q = 0; q < samples.size(); ++q) {
+    const Eigen::Vector2d& normal = samples[q].normal;
+    normal_stress_[q] = samples[q].traction.dot(normal);
+    opening_rate_[q] = (chip_velocity(samples[q].position, samples[q].parameter) - samples[q].velocity).dot(normal);
+    const bool cavitated = cavitation_ && cavitation_->cavitated(q);
+    new_traction.segment<2>(2 * static_cast<Eigen::Index>(q)) =
+        cavitated ? Eigen::Vector2d(-cavitation_->cavitation_pressure() * normal) : samples[q].traction;
+  }
   return true;
 }
 
@@ -173,8 +205,9 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   }
   current_.coupling_iterations = report.iterations;
   if (trace_coupling()) {
-    std::fprintf(stderr, "coupling t %.4g dt %.3g: %s after %d (fluid Newton %d)\n", t0 + dt, dt,
-                 report.converged ? "converged" : "failed", report.iterations, current_.fluid_newton_iterations);
+    std::fprintf(stderr, "coupling t %.4g dt %.3g: %s after %d (fluid Newton %d, cavitated %.3f)\n", t0 + dt, dt,
+                 report.converged ? "converged" : "failed", current_.coupling_iterations, current_.fluid_newton_iterations,
+                 cavitation_ ? cavitation_->cavitated_fraction() : 0.0);
     for (size_t k = 0; k < report.load_residuals.size(); ++k) {
       std::fprintf(stderr, "  |dlambda| %.4e Pa  |dd| %.4e m\n", report.load_residuals[k], report.displacement_changes[k]);
     }
@@ -192,34 +225,26 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   for (Eigen::Index a = 0; a < f.size(); a += 2) current_.fluid_force += f.segment<2>(a);
   current_.film_area = fluid_->space().area();
   current_.pocket_areas = pocket_areas();
+  if (cavitation_) {
+    // Where the film is cavitated in the next step, from this step's liquid.
+    cavitation_->update(film_samples(), dt);
+    current_.cavitated_fraction = cavitation_->cavitated_fraction();
+    current_.cavity_area = cavitation_->cavity_area();
+  }
   history_.push_back(current_);
   return true;
 }
 
 std::vector<double> LubricatedChip::pocket_areas() const {
-  // Film thickness × dx at the bottom side's Gauss points (x = u: the columns do not move along x),
-  // summed between contact spots; the interval is periodic, so the last pocket continues the first.
-  const auto& points = fluid_->space().side_points(Side::bottom);
-  std::vector<double> pockets;
-  double open = 0.0, before_first_spot = 0.0;
-  bool seen_spot = false;
-  for (const auto& p : points) {
-    const double film = film_thickness(p);
-    if (film < kContactFilmFactor * options_.mesh.min_film) {
-      if (!seen_spot) {
-        before_first_spot = open;
-      } else if (open > 0.0) {
-        pockets.push_back(open);
-      }
-      seen_spot = true;
-      open = 0.0;
-      continue;
-    }
-    open += film * p.weight;
+  const std::vector<FilmSample> samples = film_samples();
+  if (std::none_of(samples.begin(), samples.end(), [](const FilmSample& f) { return f.spot; })) return {};
+  std::vector<double> areas;
+  for (const auto& run : pocket_runs(samples)) {
+    double area = 0.0;
+    for (size_t q : run) area += samples[q].film * samples[q].length;
+    areas.push_back(area);
   }
-  if (!seen_spot) return {};
-  if (open + before_first_spot > 0.0) pockets.push_back(open + before_first_spot);
-  return pockets;
+  return areas;
 }
 
 }  // namespace mufric::coupling

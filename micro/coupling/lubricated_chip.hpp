@@ -7,9 +7,11 @@
 // Where the film is at its minimum thickness the chip touches the tool: there the chip boundary
 // carries contact, and the fluid's traction is not passed on (one interaction per location).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "micro/coupling/cavitation.hpp"
 #include "micro/coupling/chip_interface.hpp"
 #include "micro/coupling/partitioned.hpp"
 #include "micro/fluid/mesh_update.hpp"
@@ -19,7 +21,8 @@
 namespace mufric::coupling {
 
 // A fluid point whose film is thinner than this many minimum films is (partly) a contact spot: its
-// traction reaches the chip scaled from 1 here down to 0 at one minimum film.
+// traction reaches the chip scaled from 1 here down to 0 at one minimum film (the default of
+// LubricantOptions::contact_fade).
 inline constexpr double kContactFilmFactor = 2.0;
 
 struct LubricantOptions {
@@ -38,6 +41,10 @@ struct LubricantOptions {
   // chip leaves then — e.g. the start of sliding, the lubricant having drained while the chip was
   // pressed (the chip's steps before it are dry).
   double film_from = 0.0;            // s
+  double contact_fade = kContactFilmFactor;  // minimum films over which the fluid's share fades (> 1)
+  // The film cavitates where its liquid would pull the chip with a pressure below this (Pa;
+  // cavitation.hpp); none: the liquid holds any tension (seed 000's model).
+  std::optional<double> cavitation_pressure;
 };
 
 // What one accepted step did at the interface.
@@ -48,6 +55,8 @@ struct LubricatedStep {
   Eigen::Vector2d fluid_force = Eigen::Vector2d::Zero();  // on the chip, N per unit depth
   double film_area = 0.0;              // m² per unit depth: the lubricant's volume
   std::vector<double> pocket_areas;    // m² per unit depth, between contact spots (empty: no contact spot)
+  double cavitated_fraction = 0.0;     // of the interface's length, cavitated for the next step
+  double cavity_area = 0.0;            // m² per unit depth: the cavities' space, not filled by liquid
 };
 
 class LubricatedChip {
@@ -72,6 +81,8 @@ class LubricatedChip {
   bool film(const Eigen::VectorXd& displacement, const Eigen::VectorXd& traction, double dt, Eigen::VectorXd& new_traction,
             std::string& reason);
   Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
+  std::vector<FilmSample> film_samples() const;  // the film's bottom side, for pockets and cavitation
+  size_t sample_at(double parameter) const;      // the bottom side sample at a curve parameter
   std::vector<double> pocket_areas() const;
   double film_thickness(const fluid::ParametricPoint& bottom_point) const;  // m, tool minus chip above it
   void form_film();  // the film in the gap the chip's surface (surface_) leaves now
@@ -91,6 +102,9 @@ class LubricatedChip {
   Eigen::VectorXd mesh_start_;                 // film mesh displacement at the start of the step
   std::vector<LubricatedStep> history_;
   LubricatedStep current_;
+  std::optional<CavitatingFilm> cavitation_;  // with a cavitation pressure
+  // The last exchange's liquid at the bottom samples: σn·n, and (g − v)·n, the chip leaving it.
+  std::vector<double> normal_stress_, opening_rate_;
   double last_accepted_dt_ = 0.0;
   bool film_formed_ = false;
   double formed_film_area_ = 0.0;

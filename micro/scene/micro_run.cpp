@@ -168,6 +168,8 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"coupling_iterations", s.coupling_iterations},
                  {"film_area_m2_per_m", s.film_area},
                  {"pocket_areas_m2_per_m", s.pocket_areas},
+                 {"cavitated_fraction", s.cavitated_fraction},
+                 {"cavity_area_m2_per_m", s.cavity_area},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
                  {"newton_iterations", s.newton_iterations}});
@@ -259,6 +261,8 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.chip_mass_per_area = scene.material.density * scene.chip_height;
   o.reference_step = scene.dt;
   o.film_from = l.fill == "after-pressing" ? slide_start : 0.0;
+  o.contact_fade = l.contact_fade;
+  if (l.cavitation == "mass-conserving") o.cavitation_pressure = l.cavitation_pressure;
   o.coupling.acceleration = l.acceleration == "aitken"       ? coupling::Acceleration::aitken
                             : l.acceleration == "relaxation" ? coupling::Acceleration::constant_relaxation
                                                              : coupling::Acceleration::iqn_ils;
@@ -390,6 +394,8 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       step.coupling_iterations = l.coupling_iterations;
       step.film_area = l.film_area;
       step.pocket_areas = l.pocket_areas;
+      step.cavitated_fraction = l.cavitated_fraction;
+      step.cavity_area = l.cavity_area;
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;

@@ -26,6 +26,8 @@ struct MicroStep {
   int coupling_iterations = 0;                      // lubricated: fluid–structure exchanges in the step
   double film_area = 0.0;                           // lubricated: the film's area, m² per unit depth
   std::vector<double> pocket_areas;                 // lubricated: between contact spots, m² per unit depth
+  double cavitated_fraction = 0.0;                  // lubricated: of the interface, cavitated pockets
+  double cavity_area = 0.0;                         // lubricated: their space not filled by liquid, m² per unit depth
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;

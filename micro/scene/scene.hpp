@@ -58,6 +58,12 @@ struct LubricantSpec {
   // the chip pressed dry (the lubricant drained) and the film formed in the gap it leaves when
   // sliding starts (press-slide only).
   std::string fill = "gap";
+  // Tension in the film: "none", the liquid holds any (seed 000's model); "mass-conserving", where the
+  // liquid would pull the chip below cavitation_pressure a cavity opens (micro/coupling/cavitation.hpp).
+  std::string cavitation = "mass-conserving";
+  double cavitation_pressure = 0.0;  // Pa, relative to the ambient zero of the applied load
+  // Minimum films over which the fluid's load fades out into a contact spot (a continuous switch).
+  double contact_fade = 2.0;
   double robin_weight = 0.0;   // α_R, Pa s/m; 0: ρ_chip h_chip / time.step
   double mesh_stiffening = 1.0;  // χ of the Jacobian-based stiffening of the film's mesh
   std::string acceleration = "iqn-ils";  // iqn-ils, aitken or relaxation
