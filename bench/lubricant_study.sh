@@ -2,7 +2,7 @@
 # The lubricant's protocol study: the same scene run dry and lubricated under several film models,
 # two runs at a time on one core each, with a table of what each run finds over its mu window —
 # mu, the real contact area, how the normal load splits between contact and lubricant, where the
-# film ruptured, and the work (cut-backs, coupling exchanges, seconds). Every run's result.json is
+# film cavitated, and the work (cut-backs, coupling exchanges, seconds). Every run's result.json is
 # kept in OUT_DIR/<label>/.
 # Usage: bash bench/lubricant_study.sh BUILD OUT_DIR [coarse|default] label="--set k=v ..." ...
 #   a variant's overrides are added to `--set physics=lubricated` (label dry: a dry run, no lubricant);
@@ -48,7 +48,7 @@ wait
 /usr/bin/python3 - "$out" "${labels[@]}" <<'PY'
 import json, sys, pathlib
 out = pathlib.Path(sys.argv[1])
-print("| run | mu | contact area | window load [N/m]: contact y / lubricant y (x) | film ruptured | steps | cut-backs | coupling exchanges (max) | seconds |")
+print("| run | mu | contact area | window load [N/m]: contact y / lubricant y (x) | film cavitated | steps | cut-backs | coupling exchanges (max) | seconds |")
 print("|---|---|---|---|---|---|---|---|---|")
 for label in sys.argv[2:]:
     d = out / label
@@ -68,7 +68,7 @@ for label in sys.argv[2:]:
     lub = draw.get("lubricant", {})
     g = r["diagnostics"]
     exchanges = f'{lub["coupling_iterations"]} ({lub["max_coupling_iterations_per_step"]})' if lub else "—"
-    ruptured = f'{100 * mean("ruptured_fraction"):.1f} %' if lub else "—"
-    print(f'| {label} | {mu} | {100 * mean("contact_area_fraction"):.1f} % | {fy - ly:.0f} / {ly:.0f} ({lx:.0f}) | {ruptured} | '
+    cavitated = f'{100 * mean("cavitated_fraction"):.1f} %' if lub else "—"
+    print(f'| {label} | {mu} | {100 * mean("contact_area_fraction"):.1f} % | {fy - ly:.0f} / {ly:.0f} ({lx:.0f}) | {cavitated} | '
           f'{len(draw["history"])} | {g["cutbacks"]} | {exchanges} | {seconds} |')
 PY

@@ -345,6 +345,41 @@ TEST(ChipInterface, GraphParameterIsFoundAcrossPeriods) {
   }
 }
 
+TEST(ChipInterface, AFoldedCurveIsSeenFromAboveByItsUpperEnvelope) {
+  // x(t) = t + 0.25 L sin(2πt/L) turns back (dx/dt = 1 + π/2 cos < 0 near t = L/2): over part of the
+  // period three points share an x. The brute-force answer: every sign change of x(t) − x0 on 20 000
+  // samples, bisected, the highest point kept.
+  const double period = kInterval, pi = std::numbers::pi;
+  const auto point = [&](double t) {
+    return Eigen::Vector2d(t + 0.25 * period * std::sin(2 * pi * t / period),
+                           0.1 * period * std::cos(2 * pi * t / period) + 0.05 * period * std::sin(4 * pi * t / period));
+  };
+  const PeriodicGraph g(point, 0.0, period, 64);
+  EXPECT_TRUE(g.folded());
+  int folded_points = 0;
+  for (double x0 : {-3.3e-6, 0.7e-6, 4.6e-6, 4.9e-6, 5.2e-6, 5.45e-6, 6.2e-6, 9.5e-6, 14.8e-6}) {  // the fold: 4.47–5.53 µm
+    const double xr = x0 - std::floor(x0 / period) * period;
+    double best_y = -1e300, best_x = 0.0;
+    int roots = 0;
+    const int n = 20000;
+    for (int k = 0; k < n; ++k) {
+      double a = period * k / n, b = period * (k + 1) / n;
+      if ((point(a).x() - xr) * (point(b).x() - xr) > 0.0) continue;
+      ++roots;
+      for (int i = 0; i < 60; ++i) {
+        const double m = 0.5 * (a + b);
+        ((point(a).x() - xr) * (point(m).x() - xr) <= 0.0 ? b : a) = m;
+      }
+      if (point(a).y() > best_y) best_y = point(a).y(), best_x = point(a).x();
+    }
+    folded_points += roots > 1 ? 1 : 0;
+    const double t = g.parameter_at(x0);
+    EXPECT_NEAR(point(t).x() - (x0 - xr), best_x, 1e-12 * period) << x0;
+    EXPECT_NEAR(g.height_at(x0), best_y, 1e-9 * period) << x0;
+  }
+  EXPECT_GE(folded_points, 2);  // the check went through the fold
+}
+
 TEST(ChipInterface, LoadsMoveToTheChipConservatively) {
   const spline::SplineCurve surface = periodic_curve(2, 32, kInterval, chip_height);
   const solid::IgaSpace chip(solid::chip_patch(surface, {.degree = 2, .spans_x = 32, .spans_y = 4, .y_bottom = -2e-6}));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/error.hpp"
 
@@ -17,28 +18,21 @@ PeriodicGraph::PeriodicGraph(std::function<Eigen::Vector2d(double)> point, doubl
   }
   interval_ = x_.back() - x_.front();
   if (!(interval_ > 0.0)) throw Error("periodic graph: the curve does not advance in x over a period");
-  for (size_t k = 1; k < x_.size(); ++k) {
-    if (!(x_[k] > x_[k - 1])) throw Error("periodic graph: the curve is not a graph over x (it turns back near x = " +
-                                          std::to_string(x_[k]) + " m)");
-  }
+  for (size_t k = 1; k < x_.size(); ++k) folded_ = folded_ || !(x_[k] > x_[k - 1]);
 }
 
-double PeriodicGraph::parameter_at(double x) const {
-  const double periods = std::floor((x - x_.front()) / interval_);
-  const double xr = x - periods * interval_;
-  auto it = std::upper_bound(x_.begin(), x_.end(), xr);
-  const auto j = static_cast<size_t>(std::clamp<std::ptrdiff_t>(it - x_.begin() - 1, 0, static_cast<std::ptrdiff_t>(x_.size()) - 2));
+double PeriodicGraph::root_in(size_t j, double xr) const {
   double a = t_[j], b = t_[j + 1];
   double fa = x_[j] - xr, fb = x_[j + 1] - xr;
   const double tolerance = kGraphParameterTolerance * period_;
   // Illinois: regula falsi that halves the retained end's value when the same end stays twice.
   int side = 0;
   double t = a;
-  for (int k = 0; k < 100 && b - a > tolerance; ++k) {
-    if (fa == 0.0) return a + periods * period_;
-    if (fb == 0.0) return b + periods * period_;
+  for (int k = 0; k < 100 && std::abs(b - a) > tolerance; ++k) {
+    if (fa == 0.0) return a;
+    if (fb == 0.0) return b;
     t = (a * fb - b * fa) / (fb - fa);
-    if (!(t > a && t < b)) t = 0.5 * (a + b);
+    if (!(t > std::min(a, b) && t < std::max(a, b))) t = 0.5 * (a + b);
     const double ft = point_(t).x() - xr;
     if (std::abs(ft) <= kGraphParameterTolerance * interval_) break;
     if ((ft < 0.0) == (fa < 0.0)) {
@@ -51,7 +45,26 @@ double PeriodicGraph::parameter_at(double x) const {
       side = 1;
     }
   }
-  return t + periods * period_;
+  return t;
+}
+
+double PeriodicGraph::parameter_at(double x) const {
+  const double periods = std::floor((x - x_.front()) / interval_);
+  const double xr = x - periods * interval_;
+  if (!folded_) {
+    auto it = std::upper_bound(x_.begin(), x_.end(), xr);
+    const auto j = static_cast<size_t>(std::clamp<std::ptrdiff_t>(it - x_.begin() - 1, 0, static_cast<std::ptrdiff_t>(x_.size()) - 2));
+    return root_in(j, xr) + periods * period_;
+  }
+  // Every sample interval whose ends straddle xr holds a root; the highest point wins.
+  double best_t = 0.0, best_y = -std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j + 1 < x_.size(); ++j) {
+    if ((x_[j] - xr) * (x_[j + 1] - xr) > 0.0) continue;
+    const double t = root_in(j, xr);
+    const double y = point_(t).y();
+    if (y > best_y) best_y = y, best_t = t;
+  }
+  return best_t + periods * period_;
 }
 
 ChipSurface::ChipSurface(const solid::IgaSpace& chip)

@@ -20,9 +20,11 @@
 
 namespace mufric::coupling {
 
-// A periodic curve that is a graph over x: its parameter at a given x (x(t) increases by the
-// period's shift per parameter period). Dense samples bracket the answer, bisection-secant
-// (Illinois, Dowell & Jarratt, BIT 11, 1971) refines it to kGraphParameterTolerance.
+// A periodic curve seen from above as a graph over x: its parameter at a given x (x(t) advances by
+// the period's shift per parameter period). Dense samples bracket the answer, bisection-secant
+// (Illinois, Dowell & Jarratt, BIT 11, 1971) refines it to kGraphParameterTolerance. Where the curve
+// folds back (a lip ploughed up by an asperity) several parameters share an x: the highest point is
+// taken — the upper envelope, the surface the film above sees (what lies under a lip is left out).
 inline constexpr double kGraphParameterTolerance = 1e-13;  // of the parameter period
 class PeriodicGraph {
  public:
@@ -32,11 +34,14 @@ class PeriodicGraph {
   double parameter_at(double x) const;
   double height_at(double x) const { return point_(parameter_at(x)).y(); }
   double interval() const { return interval_; }  // the x shift per parameter period
+  bool folded() const { return folded_; }        // x(t) turns back somewhere
 
  private:
+  double root_in(size_t sample, double x) const;  // x(t) = x in [t_k, t_k+1], x within one period
   std::function<Eigen::Vector2d(double)> point_;
   double lo_, period_, interval_ = 0.0;
-  std::vector<double> t_, x_;  // increasing samples over one period, x_[0] the first
+  bool folded_ = false;
+  std::vector<double> t_, x_;  // samples over one period in t, x_[0] the first
 };
 
 // The chip's top side (the patch's v = hi side) at a displacement and velocity.
