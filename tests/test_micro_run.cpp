@@ -312,6 +312,7 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   apply_override(j, "protocol.phases=1");
   MicroResult dry = run_micro(parse_scene(j, "dry"));
   apply_override(j, "physics=\"lubricated\"");
+  apply_override(j, "lubricant.fill=\"gap\"");  // all the lubricant in the initial gap: it carries the load
   const Scene scene = parse_scene(j, "lubricated");
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mufric_lubricated_vtu";
   std::filesystem::create_directories(dir);
@@ -341,6 +342,26 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   const nlohmann::json r = wet.to_json(scene);
   EXPECT_TRUE(r.contains("lubricant"));
   EXPECT_GT(r["history"].back()["coupling_iterations"].get<int>(), 0);
+}
+
+TEST(Lubricated, TheDefaultLubricatedSceneIsTheDryOneWithTheLubricant) {
+  // micro/scene/lubricated_default.json: the dry default with physics lubricated and the lubricant's
+  // settings written out — each of them the value a lubricated run takes when the section is absent.
+  const std::string path = std::string(MUFRIC_SOURCE_DIR) + "/micro/scene/lubricated_default.json";
+  nlohmann::json wet = read_scene_json(path), dry = default_scene_json();
+  const Scene scene = parse_scene(wet, path);
+  EXPECT_EQ(scene.physics, "lubricated");
+  const LubricantSpec written = scene.lubricant, absent = parse_scene(dry, "dry").lubricant;
+  EXPECT_EQ(written.fill, absent.fill);
+  EXPECT_EQ(written.cavitation, absent.cavitation);
+  EXPECT_DOUBLE_EQ(written.min_film, absent.min_film);
+  EXPECT_DOUBLE_EQ(written.contact_fade, absent.contact_fade);
+  EXPECT_DOUBLE_EQ(written.cavitation_pressure, absent.cavitation_pressure);
+  EXPECT_DOUBLE_EQ(written.coupling_tolerance, absent.coupling_tolerance);
+  EXPECT_EQ(written.elements_y, absent.elements_y);
+  wet.erase("lubricant");
+  wet["physics"] = "dry";
+  EXPECT_EQ(wet, dry);
 }
 
 TEST(Lubricated, TheTrappedFilmPullsTheChipUnlessItCavitates) {

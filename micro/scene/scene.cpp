@@ -280,7 +280,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
     l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
     l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
-    l.fill = f.text("fill", l.fill, {"gap", "after-pressing"});
+    l.fill = f.text("fill", s.protocol.name == Protocol::press_slide ? l.fill : "gap", {"gap", "after-pressing"});
     if (l.fill == "after-pressing" && s.protocol.name != Protocol::press_slide) {
       f.fail("fill", "after-pressing needs the press-slide protocol (seed 000's presses while sliding)");
     }
