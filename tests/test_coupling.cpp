@@ -288,6 +288,19 @@ TEST(CavitatingFilm, ACavityOpensWhereTheLiquidPullsAndClosesWhenTheWallReturns)
   cavitation.update(film, 1e-9);
   EXPECT_FALSE(cavitation.cavitated(0));
   EXPECT_EQ(cavitation.cavity_area(), 0.0);
+  // A new film's contact spots hold no liquid: cavities as thick as the layer (20 nm) that close only
+  // if the chip comes 20 nm nearer the liquid.
+  std::vector<FilmSample> formed{{20e-9, 1e-6, true, 0.0, 0.0}, {1e-7, 1e-6, false, 0.0, 0.0}};
+  CavitatingFilm fresh(0.0);
+  fresh.form(formed);
+  EXPECT_TRUE(fresh.cavitated(0));
+  EXPECT_FALSE(fresh.cavitated(1));
+  EXPECT_NEAR(fresh.cavity_area(), 20e-9 * 1e-6, 1e-27);
+  formed[0].opening_rate = -10.0;  // m/s toward the liquid, for 1 ns: 10 nm
+  fresh.update(formed, 1e-9);
+  EXPECT_TRUE(fresh.cavitated(0));
+  fresh.update(formed, 1e-9);
+  EXPECT_FALSE(fresh.cavitated(0));
   // A lower cavitation pressure (the liquid holds 0.2 MPa of tension) keeps both samples full.
   CavitatingFilm strong(-2e5);
   film[0].normal_stress = 1e5;

@@ -34,6 +34,22 @@ std::vector<std::vector<size_t>> pocket_runs(const std::vector<FilmSample>& samp
   return runs;
 }
 
+void CavitatingFilm::form(const std::vector<FilmSample>& samples) {
+  reset();
+  cavitated_.assign(samples.size(), 0);
+  cavity_.assign(samples.size(), 0.0);
+  double length = 0.0, cavitated_length = 0.0;
+  for (size_t q = 0; q < samples.size(); ++q) {
+    length += samples[q].length;
+    if (!samples[q].spot) continue;
+    cavitated_[q] = 1;
+    cavity_[q] = samples[q].film;
+    cavity_area_ += samples[q].film * samples[q].length;
+    cavitated_length += samples[q].length;
+  }
+  cavitated_fraction_ = length > 0.0 ? cavitated_length / length : 0.0;
+}
+
 void CavitatingFilm::update(const std::vector<FilmSample>& samples, double dt) {
   cavitated_.resize(samples.size(), 0);
   cavity_.resize(samples.size(), 0.0);

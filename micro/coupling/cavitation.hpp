@@ -39,6 +39,9 @@ class CavitatingFilm {
   explicit CavitatingFilm(double cavitation_pressure) : p_c_(cavitation_pressure) {}
   double cavitation_pressure() const { return p_c_; }
   bool cavitated(size_t sample) const { return sample < cavitated_.size() && cavitated_[sample] != 0; }
+  // A film just formed: its contact spots hold no liquid — the minimum layer kept there is space,
+  // not lubricant — so they start as cavities as thick as the layer; the rest is full.
+  void form(const std::vector<FilmSample>& samples);
   // After an accepted step of length dt: the samples' states for the next step.
   void update(const std::vector<FilmSample>& samples, double dt);
   void reset() { cavitated_.clear(), cavity_.clear(), cavity_area_ = 0.0, cavitated_fraction_ = 0.0; }

@@ -54,7 +54,7 @@ void LubricatedChip::form_film() {
   traction_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(bottom_parameters_.size()));
   normal_stress_.assign(bottom_parameters_.size(), 0.0);
   opening_rate_.assign(bottom_parameters_.size(), 0.0);
-  if (cavitation_) cavitation_->reset();  // a new film: full everywhere
+  if (cavitation_) cavitation_->form(film_samples());  // the contact spots' minimum layer holds no liquid
 }
 
 size_t LubricatedChip::sample_at(double parameter) const {
