@@ -73,8 +73,10 @@ struct LubricantSpec {
   int reuse_steps = 8;
   double qr_filter = 1e-8;
   // Relative, of the interface load and displacement. The chip's own Newton tolerance, amplified by α_R/Δt,
-  // leaves the load a noise floor near 1e-4 of its size once the chip yields (bench/RESULTS.md).
-  double coupling_tolerance = 1e-3;
+  // leaves the load a noise floor near 1e-4 of its size once the chip yields; with contact spots
+  // opening and closing beside the film the iteration stalls near 1e-3 at some points of the box, and
+  // 3e-3 moves μ by 0.4 % where both converge (bench/RESULTS.md).
+  double coupling_tolerance = 3e-3;
   int max_coupling_iterations = 50;
 };
 
