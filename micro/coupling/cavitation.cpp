@@ -35,40 +35,39 @@ std::vector<std::vector<size_t>> pocket_runs(const std::vector<FilmSample>& samp
 }
 
 void CavitatingFilm::form(const std::vector<FilmSample>& samples) {
-  reset();
   cavitated_.assign(samples.size(), 0);
   cavity_.assign(samples.size(), 0.0);
-  double length = 0.0, cavitated_length = 0.0;
   for (size_t q = 0; q < samples.size(); ++q) {
-    length += samples[q].length;
     if (!samples[q].spot) continue;
     cavitated_[q] = 1;
     cavity_[q] = samples[q].film;
-    cavity_area_ += samples[q].film * samples[q].length;
-    cavitated_length += samples[q].length;
   }
-  cavitated_fraction_ = length > 0.0 ? cavitated_length / length : 0.0;
+  tally(samples);
 }
 
 void CavitatingFilm::update(const std::vector<FilmSample>& samples, double dt) {
   cavitated_.resize(samples.size(), 0);
   cavity_.resize(samples.size(), 0.0);
-  cavity_area_ = 0.0;
-  double length = 0.0, cavitated_length = 0.0;
   for (size_t q = 0; q < samples.size(); ++q) {
-    const FilmSample& s = samples[q];
-    length += s.length;
     if (cavitated_[q] != 0) {
-      cavity_[q] += dt * s.opening_rate;
+      cavity_[q] += dt * samples[q].opening_rate;
       if (cavity_[q] <= kClosedCavityThickness) cavitated_[q] = 0, cavity_[q] = 0.0;  // the liquid is back at the wall
-    } else if (s.normal_stress > -p_c_) {
+    } else if (samples[q].normal_stress > -p_c_) {
       cavitated_[q] = 1;  // the liquid pulls: the cavity opens from the next step on
       cavity_[q] = 0.0;
     }
-    if (cavitated_[q] != 0) {
-      cavity_area_ += cavity_[q] * s.length;
-      cavitated_length += s.length;
-    }
+  }
+  tally(samples);
+}
+
+void CavitatingFilm::tally(const std::vector<FilmSample>& samples) {
+  cavity_area_ = 0.0;
+  double length = 0.0, cavitated_length = 0.0;
+  for (size_t q = 0; q < samples.size(); ++q) {
+    length += samples[q].length;
+    if (cavitated_[q] == 0) continue;
+    cavity_area_ += cavity_[q] * samples[q].length;
+    cavitated_length += samples[q].length;
   }
   cavitated_fraction_ = length > 0.0 ? cavitated_length / length : 0.0;
 }

@@ -44,11 +44,11 @@ class CavitatingFilm {
   void form(const std::vector<FilmSample>& samples);
   // After an accepted step of length dt: the samples' states for the next step.
   void update(const std::vector<FilmSample>& samples, double dt);
-  void reset() { cavitated_.clear(), cavity_.clear(), cavity_area_ = 0.0, cavitated_fraction_ = 0.0; }
   double cavity_area() const { return cavity_area_; }              // m² per unit depth, after update()
   double cavitated_fraction() const { return cavitated_fraction_; }  // of the wall's length
 
  private:
+  void tally(const std::vector<FilmSample>& samples);  // cavity_area_ and cavitated_fraction_ from the states
   double p_c_;
   std::vector<char> cavitated_;
   std::vector<double> cavity_;  // m, the cavity's thickness at each cavitated sample

@@ -224,10 +224,11 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   const Eigen::VectorXd& f = load_->forces();
   for (Eigen::Index a = 0; a < f.size(); a += 2) current_.fluid_force += f.segment<2>(a);
   current_.film_area = fluid_->space().area();
-  current_.pocket_areas = pocket_areas();
+  const std::vector<FilmSample> samples = film_samples();
+  current_.pocket_areas = pocket_areas(samples);
   if (cavitation_) {
     // Where the film is cavitated in the next step, from this step's liquid.
-    cavitation_->update(film_samples(), dt);
+    cavitation_->update(samples, dt);
     current_.cavitated_fraction = cavitation_->cavitated_fraction();
     current_.cavity_area = cavitation_->cavity_area();
   }
@@ -235,8 +236,7 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   return true;
 }
 
-std::vector<double> LubricatedChip::pocket_areas() const {
-  const std::vector<FilmSample> samples = film_samples();
+std::vector<double> LubricatedChip::pocket_areas(const std::vector<FilmSample>& samples) {
   if (std::none_of(samples.begin(), samples.end(), [](const FilmSample& f) { return f.spot; })) return {};
   std::vector<double> areas;
   for (const auto& run : pocket_runs(samples)) {

@@ -83,7 +83,7 @@ class LubricatedChip {
   Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
   std::vector<FilmSample> film_samples() const;  // the film's bottom side, for pockets and cavitation
   size_t sample_at(double parameter) const;      // the bottom side sample at a curve parameter
-  std::vector<double> pocket_areas() const;
+  static std::vector<double> pocket_areas(const std::vector<FilmSample>& samples);
   double film_thickness(const fluid::ParametricPoint& bottom_point) const;  // m, tool minus chip above it
   void form_film();  // the film in the gap the chip's surface (surface_) leaves now
 

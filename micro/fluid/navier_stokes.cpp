@@ -28,6 +28,12 @@ double parameter_along(const ParametricPoint& p, Side side) {
   return (side == Side::bottom || side == Side::top) ? p.u : p.v;
 }
 
+// α at a point of a side: the Robin weight times its share there (0 on velocity and traction sides).
+double robin_weight_at(const SideCondition& c, const Eigen::Vector2d& x, double t) {
+  if (c.kind != SideConditionKind::robin) return 0.0;
+  return c.robin_share ? c.robin_weight * c.robin_share(x, t) : c.robin_weight;
+}
+
 }  // namespace
 
 NavierStokes::NavierStokes(FluidSpace space, NavierStokesOptions options)
@@ -168,12 +174,11 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
   for (const auto& c : conditions_) {
     if (c.kind == SideConditionKind::velocity) continue;
     if (c.kind == SideConditionKind::robin && !c.velocity) throw Error("fluid: a Robin side needs its velocity");
-    const double side_alpha = c.kind == SideConditionKind::robin ? c.robin_weight : 0.0;
     for (const ParametricPoint& p : space_.side_points(c.side)) {
       const PhysicalPoint q = space_.map(p, &c.side);
       const double t = parameter_along(p, c.side);
       const Eigen::Vector2d h = c.traction ? c.traction(q.position, t) : Eigen::Vector2d::Zero();
-      const double alpha = c.robin_share ? side_alpha * c.robin_share(q.position, t) : side_alpha;
+      const double alpha = robin_weight_at(c, q.position, t);
       Eigen::Vector2d load = h;
       if (alpha != 0.0) load += alpha * (c.velocity(q.position, t) - velocity(p));
       const auto n = static_cast<Eigen::Index>(p.nodes.size());
@@ -315,7 +320,7 @@ std::vector<NavierStokes::TractionSample> NavierStokes::robin_traction(Side side
     const PhysicalPoint q = space_.map(p, &side);
     const double t = parameter_along(p, side);
     Eigen::Vector2d traction = robin->traction ? robin->traction(q.position, t) : Eigen::Vector2d::Zero();
-    const double alpha = robin->robin_weight * (robin->robin_share ? robin->robin_share(q.position, t) : 1.0);
+    const double alpha = robin_weight_at(*robin, q.position, t);
     const Eigen::Vector2d v = velocity(p);
     traction += alpha * (robin->velocity(q.position, t) - v);
     out.push_back({q.position, traction, q.normal, t, q.weight, v});
