@@ -35,7 +35,8 @@ using Rewrite = std::function<void(const std::string& original, const std::strin
 // Runs `rewrite(original, copy)` in a forked child; `rewrite` must parse `original` and write what it
 // accepted to `copy`. Throws Error "<what> '<original>': <reason>" when the child throws (its message
 // is passed on as it is), crashes (the signal is named), runs out of time or memory, or writes
-// nothing. Only for processes that may fork (the CLI, the server), not inside a meso code.
+// nothing. A child that sleeps without progress (a lock inherited locked at fork) is forked again,
+// a few times at most. Only for processes that may fork (the CLI, the server), not inside a meso code.
 IsolatedCopy rewrite_in_child(const std::string& original, const std::string& what, const Rewrite& rewrite,
                               const IsolationLimits& limits = {});
 

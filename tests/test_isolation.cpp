@@ -5,6 +5,8 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -30,14 +32,55 @@ TEST(Isolation, CrashIsAnErrorNamingTheFileAndSignal) {
   EXPECT_NE(message.find("parsing it crashed (signal "), std::string::npos) << message;
 }
 
+// A corrupt file makes the HDF5 library loop: busy, never asleep.
 TEST(Isolation, HangIsKilledAfterTheLimit) {
   IsolationLimits limits;
   limits.seconds = 0.5;
   const auto start = std::chrono::steady_clock::now();
-  const std::string message =
-      failure([](const std::string&, const std::string&) { std::this_thread::sleep_for(std::chrono::hours(1)); }, limits);
+  const std::string message = failure(
+      [](const std::string&, const std::string&) {
+        volatile unsigned long spins = 0;
+        for (;;) spins = spins + 1;
+      },
+      limits);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
   EXPECT_NE(message.find("did not finish within"), std::string::npos) << message;
+}
+
+// A child forked while another thread of the parent holds a lock inherits it locked and sleeps on
+// it forever (what libasan's allocator lock did to the server's model reload under load). The
+// child is recognised by sleeping without CPU and forked again once the lock is free, well before
+// the time limit.
+TEST(Isolation, AChildStuckOnAnInheritedLockIsForkedAgain) {
+  std::mutex lock;
+  std::promise<void> held;
+  std::thread holder([&] {
+    std::lock_guard guard(lock);
+    held.set_value();
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  });
+  held.get_future().wait();
+  IsolationLimits limits;
+  limits.seconds = 60.0;
+  const auto start = std::chrono::steady_clock::now();
+  const IsolatedCopy copy = rewrite_in_child("/in.h5", "model", [&](const std::string&, const std::string& out) {
+    std::lock_guard guard(lock);
+    std::ofstream(out) << "done";
+  }, limits);
+  holder.join();
+  EXPECT_TRUE(std::filesystem::exists(copy.path()));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
+}
+
+// A child that always sleeps is refused after a few forks, not after the whole time limit.
+TEST(Isolation, AChildThatAlwaysSleepsIsRefusedEarly) {
+  IsolationLimits limits;
+  limits.seconds = 600.0;
+  const auto start = std::chrono::steady_clock::now();
+  const std::string message =
+      failure([](const std::string&, const std::string&) { std::this_thread::sleep_for(std::chrono::hours(1)); }, limits);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+  EXPECT_NE(message.find("slept without progress"), std::string::npos) << message;
 }
 
 TEST(Isolation, ExceptionMessagePassesThrough) {
