@@ -85,10 +85,13 @@ void plan_command(const PlanOptions& o) {
   plan.plan_design = plan_design_name(design);
   plan.plan_seed = static_cast<long long>(o.seed);
   plan.scene_json = sc.effective.dump(2);
-  plan.source = "micro-model plan (" + sc.source + ")";
+  // What a reader of `dataset status` needs first: which physics, and whether the named scene was changed.
+  const std::string scene_label = sc.source + (o.overrides.empty() ? "" : " with " + std::to_string(o.overrides.size()) + " --set") +
+                                  ", physics " + sc.physics;
+  plan.source = "micro-model plan (" + scene_label + ")";
   write_dataset(o.out, plan);
   std::printf("wrote %s: %lld points, %s design (seed %llu), scene %s (sha256 %s)\n", o.out.c_str(), o.samples,
-              plan.plan_design.c_str(), o.seed, sc.source.c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());
+              plan.plan_design.c_str(), o.seed, scene_label.c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());
   print_box(box);
 }
 

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <algorithm>
 #include <sstream>
@@ -44,6 +45,43 @@ class Cli : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::filesystem::path dir_;
+};
+
+// `mufric serve --models DIR` in a child process on a free loopback port, its stderr in LOG.
+class ServeProcess {
+ public:
+  ServeProcess(const std::string& models, const std::string& log, const std::string& ready_file) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      freopen(log.c_str(), "w", stderr);
+      unsetenv("GOMP_SPINCOUNT");  // as a user who chose no wait policy
+      unsetenv("OMP_WAIT_POLICY");
+      execl(MUFRIC_EXE, MUFRIC_EXE, "serve", "--models", models.c_str(), "--listen", "127.0.0.1:0", "--ready-file",
+            ready_file.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    for (int i = 0; i < 100 && address_.empty() && pid_ > 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::ifstream(ready_file) >> address_;
+    }
+  }
+  ~ServeProcess() {
+    if (pid_ > 0) stop();
+  }
+  pid_t pid() const { return pid_; }
+  const std::string& address() const { return address_; }  // empty: it did not start
+  // SIGTERM, then the exit status (−1 unless it exited normally).
+  int stop() {
+    kill(pid_, SIGTERM);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  std::string address_;
 };
 
 TEST_F(Cli, HelpExplainsTheSubcommands) {
@@ -126,22 +164,9 @@ TEST_F(Cli, NaNInATrainingRowIsNamedByLine) {
 TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   std::filesystem::create_directories(path("models"));
   ASSERT_EQ(run("law seward --table 4 --out " + path("models/law.h5")).exit_code, 0);
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string log = path("serve.log");
-    freopen(log.c_str(), "w", stderr);
-    unsetenv("GOMP_SPINCOUNT");  // as a user who chose no wait policy
-    unsetenv("OMP_WAIT_POLICY");
-    execl(MUFRIC_EXE, MUFRIC_EXE, "serve", "--models", path("models").c_str(), "--listen", "127.0.0.1:0",
-          "--ready-file", path("address").c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  std::string address;
-  for (int i = 0; i < 100 && address.empty(); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    std::ifstream(path("address")) >> address;
-  }
+  ServeProcess server(path("models"), path("serve.log"), path("address"));
+  const std::string& address = server.address();
+  const pid_t pid = server.pid();
   ASSERT_FALSE(address.empty()) << "server did not start";
   {
     // Regression: with libgomp's default spinning, a micro run beside one CPU-bound process took
@@ -158,10 +183,7 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   const CommandResult missing = run("predict --model grpc://" + address + "/other --p 80MPa --v 10m/min --angle 90deg");
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_NE(missing.output.find("NOT_FOUND"), std::string::npos) << missing.output;
-  kill(pid, SIGTERM);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_EQ(server.stop(), 0);
   std::ifstream log(path("serve.log"));
   std::string text, line;
   while (std::getline(log, line)) text += line + "\n";
@@ -310,6 +332,41 @@ TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
   r = run("dataset run --plan " + path("plan.h5") + " --db " + path("s0.h5") + " --shard 0/2 --set load.ramp=2ns");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("different scene"), std::string::npos) << r.output;
+}
+
+// A lubricated dataset goes through the dry chain unchanged — plan, run, train — and one server
+// answers the dry and the lubricated model side by side, each by its name (three micro-model runs
+// of the tiny scene per physics, at 300–400 MPa where the lubricant changes μ most).
+TEST_F(Cli, DryAndLubricatedModelsAreServedSideBySide) {
+  std::filesystem::create_directories(path("models"));
+  for (const std::string physics : {"dry", "lubricated"}) {
+    CommandResult r = run("dataset plan --out " + path(physics + "-plan.h5") +
+                          " --samples 3 --design lhs --seed 1 --p 300MPa:400MPa --v 50m/min:100m/min --T 25C:200C" +
+                          kTinyScene + " --set physics=" + physics);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run("dataset run --plan " + path(physics + "-plan.h5") + " --db " + path(physics + ".h5"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run("dataset status " + path(physics + ".h5"));
+    EXPECT_NE(r.output.find("samples: 3 (3 converged"), std::string::npos) << physics << ": " << r.output;
+    EXPECT_NE(r.output.find("physics " + physics + ")"), std::string::npos) << r.output;
+    r = run("train --data " + path(physics + ".h5") + " --out " + path("models/" + physics + ".h5"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  ServeProcess server(path("models"), path("serve.log"), path("address"));
+  ASSERT_FALSE(server.address().empty()) << "server did not start";
+  std::map<std::string, double> mu;
+  for (const std::string model : {"dry", "lubricated"}) {
+    const CommandResult r = run("predict --model grpc://" + server.address() + "/" + model + " --p 350MPa --v 75m/min --T 100C");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto at = r.output.find("mu = ");
+    ASSERT_NE(at, std::string::npos) << r.output;
+    mu[model] = std::stod(r.output.substr(at + 5));
+  }
+  std::cout << "served mu at 350 MPa, 75 m/min, 100 C: dry " << mu["dry"] << ", lubricated " << mu["lubricated"] << "\n";
+  EXPECT_GT(mu["dry"], 0.0);
+  EXPECT_GT(mu["lubricated"], 0.0);
+  EXPECT_NE(mu["dry"], mu["lubricated"]);
+  EXPECT_EQ(server.stop(), 0);
 }
 
 TEST_F(Cli, DatasetErrorsNameTheFlag) {

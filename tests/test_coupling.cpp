@@ -145,7 +145,8 @@ struct PistonPocket {
         [this](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string& why) { return structure(load, d, why); },
         [this](const Eigen::VectorXd& d, const Eigen::VectorXd& load, Eigen::VectorXd& new_load, std::string& why) {
           return fluid(d, load, new_load, why);
-        }};
+        },
+        {}};  // the piston's pocket is checked after the run
     Outcome out;
     Eigen::VectorXd delta = Eigen::VectorXd::Zero(1);
     Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(ns.space().side_points(Side::top).size()));
@@ -466,6 +467,48 @@ TEST(ChipInterface, FilmMeshFollowsTheChipAndKeepsItsMinimumThickness) {
 
 // A coupled step may solve the chip several times with different interface loads; the last trial is
 // what the step accepts, exactly as if that load had been the only one (dynamic, three steps).
+// A scalar interface: λ = 1 + λ/2 (fixed point 2) by constant relaxation ω = 1, the residual halving
+// each exchange. With a kinematic residual reported (here 10⁻ᵏ at exchange k), the step also waits
+// for it: the load alone converges at exchange 10 (|λ̃ − λ| = 2⁻⁹ < 1e-3 λ̃, λ̃ ≈ 2), a kinematic
+// tolerance of 1e-12 holds it to exchange 12, and with 1e-25 the step runs out of its 20 exchanges.
+TEST(CoupledStep, AReportedKinematicResidualMustAlsoConverge) {
+  CouplingOptions options;
+  options.acceleration = Acceleration::constant_relaxation;
+  options.relaxation = 1.0;
+  options.relative_tolerance = 1e-3;
+  options.load_tolerance = 0.0;
+  options.displacement_tolerance = 1.0;  // the displacement is the load here: not the criterion tested
+  options.max_iterations = 20;
+  int exchange = 0;
+  const PartitionedSolvers solvers{
+      [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
+        d = load;
+        return true;
+      },
+      [&](const Eigen::VectorXd& d, const Eigen::VectorXd&, Eigen::VectorXd& next, std::string&) {
+        ++exchange;
+        next = Eigen::VectorXd::Constant(1, 1.0 + 0.5 * d(0));
+        return true;
+      },
+      [&] { return std::pow(10.0, -exchange); }};
+  const auto run = [&](double kinematic_tolerance) {
+    options.kinematic_tolerance = kinematic_tolerance;
+    exchange = 0;
+    InterfaceAccelerator accelerator(options);
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
+    return coupled_step(solvers, load, d, accelerator, options);
+  };
+  const CouplingStepReport loose = run(1.0);
+  ASSERT_TRUE(loose.converged);
+  EXPECT_EQ(loose.iterations, 10);
+  const CouplingStepReport tight = run(1e-12);
+  ASSERT_TRUE(tight.converged);
+  EXPECT_EQ(tight.iterations, 12);
+  ASSERT_EQ(tight.kinematic_residuals.size(), 12u);
+  EXPECT_DOUBLE_EQ(tight.kinematic_residuals.back(), 1e-12);
+  EXPECT_FALSE(run(1e-25).converged);
+}
+
 TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
   const spline::SplineCurve surface = periodic_curve(2, 16, kInterval, chip_height);
   const auto build = [&] {

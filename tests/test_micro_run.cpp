@@ -303,16 +303,17 @@ TEST(PressSlide, ResultSaysHowMuWasObtained) {
   EXPECT_THROW(parse_scene(csv, "flat realisations"), Error);
 }
 
-// The lubricated chip on the small press-slide scene (one tool phase): it runs through pressing and
-// sliding with every coupled step converged; the lubricant carries load on the chip, keeps its volume
-// (incompressible, in a closed periodic film) to the interpolation of its moving boundary, and the
-// real contact area is not larger than dry.
+// The lubricated chip on the small press-slide scene (one tool phase), seed 000's liquid (no
+// cavitation): it runs through pressing and sliding with every coupled step converged; the lubricant
+// carries load on the chip, keeps its volume (incompressible, in a closed periodic film) to the
+// coupling's volume tolerance, and the real contact area is not larger than dry.
 TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   nlohmann::json j = small_press_slide();
   apply_override(j, "protocol.phases=1");
   MicroResult dry = run_micro(parse_scene(j, "dry"));
   apply_override(j, "physics=\"lubricated\"");
   apply_override(j, "lubricant.fill=\"gap\"");  // all the lubricant in the initial gap: it carries the load
+  apply_override(j, "lubricant.cavitation=\"none\"");
   const Scene scene = parse_scene(j, "lubricated");
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mufric_lubricated_vtu";
   std::filesystem::create_directories(dir);
@@ -334,10 +335,18 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   // The fluid pushes the chip away from the tool (−y) with a sizeable share of the applied load.
   const double applied = scene.pressure * scene.interval;
   EXPECT_LT(wet.history.back().fluid_force.y(), -0.1 * applied);
-  // The film keeps its volume to 0.2 % here, not yet to solver tolerance: its bottom interpolates the
-  // chip's moving surface at the columns, and the flux of the chip's velocity through the film's
-  // boundary matches the boundary's own motion only to that interpolation (an open item).
-  EXPECT_NEAR(wet.lubricant->final_film_area / wet.lubricant->initial_film_area, 1.0, 5e-3);
+  // The film's volume changes only by the liquid each step's mismatch of interface velocities moves
+  // through its wall (the coupling's volume criterion bounds that per step): before the film's walls
+  // moved with its mesh it lost 0.25 % here while that sum was 4e-5.
+  double allowed = 0.0;
+  for (const auto& step : wet.history) {
+    EXPECT_LE(step.film_volume_error, scene.lubricant.volume_tolerance) << "at t = " << step.time;
+    allowed += step.film_volume_error;
+  }
+  const double drift = std::abs(wet.lubricant->final_film_area / wet.lubricant->initial_film_area - 1.0);
+  std::cout << "film volume drift " << drift << ", the steps' volume errors sum to " << allowed << "\n";
+  EXPECT_LE(drift, 1.01 * allowed + 1e-9);
+  EXPECT_LT(drift, 0.01);
   EXPECT_LE(wet.contact_fraction, dry.contact_fraction);
   const nlohmann::json r = wet.to_json(scene);
   EXPECT_TRUE(r.contains("lubricant"));
@@ -358,6 +367,7 @@ TEST(Lubricated, TheDefaultLubricatedSceneIsTheDryOneWithTheLubricant) {
   EXPECT_DOUBLE_EQ(written.contact_fade, absent.contact_fade);
   EXPECT_DOUBLE_EQ(written.cavitation_pressure, absent.cavitation_pressure);
   EXPECT_DOUBLE_EQ(written.coupling_tolerance, absent.coupling_tolerance);
+  EXPECT_DOUBLE_EQ(written.volume_tolerance, absent.volume_tolerance);
   EXPECT_EQ(written.elements_y, absent.elements_y);
   wet.erase("lubricant");
   wet["physics"] = "dry";

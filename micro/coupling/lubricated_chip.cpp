@@ -25,8 +25,8 @@ LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::Splin
     : problem_(problem), tool_curve_(tool), options_(std::move(options)), mesh_update_(options_.mesh_update),
       accelerator_(options_.coupling) {
   if (!(options_.contact_fade > 1.0)) throw Error("lubricant: the contact fade must span more than one minimum film");
-  if (!(options_.robin_weight > 0.0) && !(options_.chip_mass_per_area > 0.0 && options_.reference_step > 0.0)) {
-    throw Error("lubricant: give a Robin weight, or the chip's mass per area and a reference step for the automatic one");
+  if (!(options_.robin_weight > 0.0) && !(options_.chip_mass_per_area > 0.0 && options_.shortest_weight_step > 0.0)) {
+    throw Error("lubricant: give a Robin weight, or the chip's mass per area and the shortest step for the automatic one");
   }
   surface_ = std::make_unique<ChipSurface>(problem_.space());
   const auto& tb = tool_curve_.basis();
@@ -134,11 +134,23 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
     reason = moved.reason;
     return false;
   }
-  fluid_->set_mesh(space.displacement(), (space.displacement() - mesh_start_) / dt);
-  const double alpha = options_.robin_weight > 0.0 ? options_.robin_weight : options_.chip_mass_per_area / options_.reference_step;
+  const double alpha = options_.robin_weight > 0.0
+                           ? options_.robin_weight
+                           : options_.chip_mass_per_area / std::max(dt, options_.shortest_weight_step);
+  // The film's wall moves with the chip along the surface and with the film mesh's bottom across it:
+  // that bottom interpolates the chip's surface at the columns, so the chip's own normal velocity
+  // would move liquid through the film's boundary by that interpolation; the wall's keeps the film's
+  // volume to the coupling's tolerance.
   const ChipSurface* chip = surface_.get();
-  const fluid::BoundaryField chip_velocity = [chip](const Eigen::Vector2d& x, double) {
-    return chip->velocity(chip->parameter_at(x.x()));
+  const Eigen::VectorXd mesh_velocity = (space.displacement() - mesh_start_) / dt;
+  const double bottom_v = space.patch().v_basis().lo();
+  const fluid::BoundaryField wall_velocity = [chip, &space, &mesh_velocity, bottom_v](const Eigen::Vector2d& x, double u) {
+    const Eigen::Vector2d g = chip->velocity(chip->parameter_at(x.x()));
+    const Side bottom = Side::bottom;
+    const fluid::ParametricPoint p = space.at(u, bottom_v);
+    const Eigen::Vector2d normal = space.map(p, &bottom).normal;
+    const Eigen::Vector2d wall = fluid::FluidSpace::interpolate2(p, mesh_velocity, 2, 0);
+    return Eigen::Vector2d(g + (wall - g).dot(normal) * normal);
   };
   const fluid::BoundaryField previous = [this, &traction](const Eigen::Vector2d&, double t) {
     return Eigen::Vector2d(traction.segment<2>(2 * static_cast<Eigen::Index>(sample_at(t))));
@@ -147,9 +159,17 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
   const fluid::BoundaryScalar follows_chip = [this](const Eigen::Vector2d&, double t) {
     return cavitation_ && cavitation_->cavitated(sample_at(t)) ? 0.0 : 1.0;
   };
-  const fluid::BoundaryField tool_velocity = [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); };
+  // The tool stands still, but where the chip presses into it the film's top is lifted to keep the
+  // minimum film above the chip: the top moves with its mesh (which is still on the tool elsewhere),
+  // so the film's volume changes only as its walls move (the mesh velocity is in the velocity's space:
+  // the prescribed flux is the top's own).
+  const double top_v = space.patch().v_basis().hi();
+  const fluid::BoundaryField tool_velocity = [&space, &mesh_velocity, top_v](const Eigen::Vector2d&, double u) {
+    return fluid::FluidSpace::interpolate2(space.at(u, top_v), mesh_velocity, 2, 0);
+  };
+  fluid_->set_mesh(space.displacement(), mesh_velocity);
   fluid_->set_conditions({{Side::top, fluid::SideConditionKind::velocity, tool_velocity, {}, 0.0},
-                          {Side::bottom, fluid::SideConditionKind::robin, chip_velocity, previous, alpha, follows_chip}});
+                          {Side::bottom, fluid::SideConditionKind::robin, wall_velocity, previous, alpha, follows_chip}});
   const fluid::FluidStepReport r = fluid_->solve_step(dt);
   current_.fluid_newton_iterations += r.newton_iterations;
   current_.min_relative_jacobian = std::min(current_.min_relative_jacobian, r.min_relative_jacobian);
@@ -162,11 +182,18 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
   for (size_t q = 0; q < samples.size(); ++q) {
     const Eigen::Vector2d& normal = samples[q].normal;
     normal_stress_[q] = samples[q].traction.dot(normal);
-    opening_rate_[q] = (chip_velocity(samples[q].position, samples[q].parameter) - samples[q].velocity).dot(normal);
+    opening_rate_[q] = (wall_velocity(samples[q].position, samples[q].parameter) - samples[q].velocity).dot(normal);
     const bool cavitated = cavitation_ && cavitation_->cavitated(q);
     new_traction.segment<2>(2 * static_cast<Eigen::Index>(q)) =
         cavitated ? Eigen::Vector2d(-cavitation_->cavitation_pressure() * normal) : samples[q].traction;
   }
+  // The volume this step's mismatch of the interface velocities moves through the film's wall, over
+  // the film's (a cavity's thickness follows the wall by itself: only full samples count).
+  double created = 0.0;
+  for (size_t q = 0; q < samples.size(); ++q) {
+    if (!(cavitation_ && cavitation_->cavitated(q))) created += samples[q].weight * opening_rate_[q] * dt;
+  }
+  volume_error_ = std::abs(created) / space.area();
   return true;
 }
 
@@ -192,7 +219,8 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
       },
       [&](const Eigen::VectorXd& d, const Eigen::VectorXd& traction, Eigen::VectorXd& next, std::string& why) {
         return film(d, traction, dt, next, why);
-      }};
+      },
+      [&] { return volume_error_; }};
   Eigen::VectorXd traction = traction_, displacement;
   CouplingStepReport report;
   try {
@@ -209,7 +237,8 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
                  report.converged ? "converged" : "failed", current_.coupling_iterations, current_.fluid_newton_iterations,
                  cavitation_ ? cavitation_->cavitated_fraction() : 0.0);
     for (size_t k = 0; k < report.load_residuals.size(); ++k) {
-      std::fprintf(stderr, "  |dlambda| %.4e Pa  |dd| %.4e m\n", report.load_residuals[k], report.displacement_changes[k]);
+      std::fprintf(stderr, "  |dlambda| %.4e Pa  |dd| %.4e m  film volume error %.3e\n", report.load_residuals[k],
+                   report.displacement_changes[k], report.kinematic_residuals[k]);
     }
   }
   if (!report.converged) {
@@ -224,6 +253,8 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   const Eigen::VectorXd& f = load_->forces();
   for (Eigen::Index a = 0; a < f.size(); a += 2) current_.fluid_force += f.segment<2>(a);
   current_.film_area = fluid_->space().area();
+
+  current_.volume_error = volume_error_;
   const std::vector<FilmSample> samples = film_samples();
   current_.pocket_areas = pocket_areas(samples);
   if (cavitation_) {

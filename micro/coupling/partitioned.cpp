@@ -137,7 +137,13 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
     const bool displacement_converged =
         displacement_change <= options.displacement_tolerance +
                                    options.relative_tolerance * (start.size() == d.size() ? (d - start).norm() : d.norm());
-    if (load_converged && displacement_converged) {
+    bool kinematics_converged = true;
+    if (solvers.kinematic_residual) {
+      const double kinematic = solvers.kinematic_residual();
+      report.kinematic_residuals.push_back(kinematic);
+      kinematics_converged = kinematic <= options.kinematic_tolerance;
+    }
+    if (load_converged && displacement_converged && kinematics_converged) {
       report.converged = true;
       load = lambda_tilde;
       displacement = d;

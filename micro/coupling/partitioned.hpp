@@ -31,6 +31,7 @@ struct CouplingOptions {
   double relative_tolerance = 1e-8;       // of |λ̃| for the load, of the step's motion |d − d_start| for the displacement
   double load_tolerance = 1e-3;           // Pa: |λ̃ − λ| below this (plus the relative part) is converged
   double displacement_tolerance = 1e-15;  // m: |d_k − d_(k−1)| below this (plus the relative part) is converged
+  double kinematic_tolerance = 1e-4;      // of the solvers' kinematic residual, when they report one
   int max_iterations = 50;
 };
 
@@ -63,6 +64,10 @@ struct PartitionedSolvers {
   std::function<bool(const Eigen::VectorXd& load, Eigen::VectorXd& displacement, std::string& reason)> structure;
   std::function<bool(const Eigen::VectorXd& displacement, const Eigen::VectorXd& load, Eigen::VectorXd& new_load,
                      std::string& reason)> fluid;
+  // Optional: how far the fluid's interface velocity is from the structure's after the last fluid
+  // solve, as a dimensionless measure (a Robin condition meets the velocities only at the fixed
+  // point: v − g = (λ − λ̃)/α). Checked against kinematic_tolerance besides load and displacement.
+  std::function<double()> kinematic_residual;
 };
 
 struct CouplingStepReport {
@@ -71,6 +76,7 @@ struct CouplingStepReport {
   int iterations = 0;                      // structure–fluid exchanges
   std::vector<double> load_residuals;      // |λ̃ − λ| per iteration
   std::vector<double> displacement_changes;  // |d_k − d_(k−1)| per iteration (d_(−1): the predictor)
+  std::vector<double> kinematic_residuals;   // per iteration, when the solvers report one
 };
 
 // One coupled step. load: the last step's interface load on entry (sized; zeros for a first step),

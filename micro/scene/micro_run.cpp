@@ -170,6 +170,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"pocket_areas_m2_per_m", s.pocket_areas},
                  {"cavitated_fraction", s.cavitated_fraction},
                  {"cavity_area_m2_per_m", s.cavity_area},
+                 {"film_volume_error", s.film_volume_error},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
                  {"newton_iterations", s.newton_iterations}});
@@ -259,7 +260,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.mesh_update.stiffening_exponent = l.mesh_stiffening;
   o.robin_weight = l.robin_weight;
   o.chip_mass_per_area = scene.material.density * scene.chip_height;
-  o.reference_step = scene.dt;
+  o.shortest_weight_step = scene.dt;
   o.film_from = l.fill == "after-pressing" ? slide_start : 0.0;
   o.contact_fade = l.contact_fade;
   if (l.cavitation == "mass-conserving") o.cavitation_pressure = l.cavitation_pressure;
@@ -270,6 +271,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.coupling.reuse_steps = l.reuse_steps;
   o.coupling.qr_filter = l.qr_filter;
   o.coupling.relative_tolerance = l.coupling_tolerance;
+  o.coupling.kinematic_tolerance = l.volume_tolerance;
   o.coupling.max_iterations = l.max_coupling_iterations;
   return o;
 }
@@ -396,6 +398,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       step.pocket_areas = l.pocket_areas;
       step.cavitated_fraction = l.cavitated_fraction;
       step.cavity_area = l.cavity_area;
+      step.film_volume_error = l.volume_error;
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;

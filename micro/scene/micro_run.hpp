@@ -28,6 +28,7 @@ struct MicroStep {
   std::vector<double> pocket_areas;                 // lubricated: between contact spots, m² per unit depth
   double cavitated_fraction = 0.0;                  // lubricated: of the interface, cavitated pockets
   double cavity_area = 0.0;                         // lubricated: their space not filled by liquid, m² per unit depth
+  double film_volume_error = 0.0;                   // lubricated: liquid moved through the film's wall by the coupling's mismatch, of the film
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;
