@@ -337,7 +337,7 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   EXPECT_LT(wet.history.back().fluid_force.y(), -0.1 * applied);
   // The film's volume changes only by the liquid each step's mismatch of interface velocities moves
   // through its wall (the coupling's volume criterion bounds that per step): before the film's walls
-  // moved with its mesh it lost 0.25 % here while that sum was 4e-5.
+  // moved with its mesh it lost 0.25 % here at a volume tolerance of 1e-6, while that sum was 4e-5.
   double allowed = 0.0;
   for (const auto& step : wet.history) {
     EXPECT_LE(step.film_volume_error, scene.lubricant.volume_tolerance) << "at t = " << step.time;
@@ -346,7 +346,7 @@ TEST(Lubricated, SmallSceneRunsWithTheFilmCarryingLoad) {
   const double drift = std::abs(wet.lubricant->final_film_area / wet.lubricant->initial_film_area - 1.0);
   std::cout << "film volume drift " << drift << ", the steps' volume errors sum to " << allowed << "\n";
   EXPECT_LE(drift, 1.01 * allowed + 1e-9);
-  EXPECT_LT(drift, 0.01);
+  EXPECT_LT(drift, 5e-3);  // the bound this test had before the criterion
   EXPECT_LE(wet.contact_fraction, dry.contact_fraction);
   const nlohmann::json r = wet.to_json(scene);
   EXPECT_TRUE(r.contains("lubricant"));

@@ -179,6 +179,9 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
   }
   const auto samples = fluid_->robin_traction(Side::bottom);
   new_traction.resize(2 * static_cast<Eigen::Index>(samples.size()));
+  // The volume this step's mismatch of the interface velocities moves through the film's wall, over
+  // the film's (a cavity's thickness follows the wall by itself: only full samples count).
+  double created = 0.0;
   for (size_t q = 0; q < samples.size(); ++q) {
     const Eigen::Vector2d& normal = samples[q].normal;
     normal_stress_[q] = samples[q].traction.dot(normal);
@@ -186,12 +189,7 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
     const bool cavitated = cavitation_ && cavitation_->cavitated(q);
     new_traction.segment<2>(2 * static_cast<Eigen::Index>(q)) =
         cavitated ? Eigen::Vector2d(-cavitation_->cavitation_pressure() * normal) : samples[q].traction;
-  }
-  // The volume this step's mismatch of the interface velocities moves through the film's wall, over
-  // the film's (a cavity's thickness follows the wall by itself: only full samples count).
-  double created = 0.0;
-  for (size_t q = 0; q < samples.size(); ++q) {
-    if (!(cavitation_ && cavitation_->cavitated(q))) created += samples[q].weight * opening_rate_[q] * dt;
+    if (!cavitated) created += samples[q].weight * opening_rate_[q] * dt;
   }
   volume_error_ = std::abs(created) / space.area();
   return true;
@@ -253,7 +251,6 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   const Eigen::VectorXd& f = load_->forces();
   for (Eigen::Index a = 0; a < f.size(); a += 2) current_.fluid_force += f.segment<2>(a);
   current_.film_area = fluid_->space().area();
-
   current_.volume_error = volume_error_;
   const std::vector<FilmSample> samples = film_samples();
   current_.pocket_areas = pocket_areas(samples);
