@@ -57,7 +57,7 @@ owner() {  # log
   local frame
   if grep -qE 'std::terminate|__cxa_throw|uncaught exception' "$1"; then echo mufric; return; fi
   frame=$(grep -E '^ +#[0-9]+ ' "$1" |
-          grep -vE 'libclang_rt|compiler-rt|sanitizer_common|/asan/|/ubsan/|libFuzzer|fuzzer/Fuzzer| in fuzzer::|libc\.so|nptl/|stdlib/|signal/|sysdeps/|libstdc\+\+|libgcc|in (abort|raise|__GI_|gsignal|malloc|free|calloc|realloc|operator new|operator delete|__interceptor_|__asan|__sanitizer|__ubsan|str[a-z]*|mem[a-z]*|main|_start) |in main \(|__libc_start| in (__sanitizer|__asan|__ubsan|__interceptor_|__lsan)' |
+          grep -vE 'libclang_rt|compiler-rt|sanitizer_common|/asan/|/ubsan/|libFuzzer|fuzzer/Fuzzer| in fuzzer::|libc\.so|nptl/|stdlib/|signal/|sysdeps/|libstdc\+\+|libgcc|in (abort|raise|__GI_|gsignal|malloc|free|calloc|realloc|operator new|operator delete|__interceptor_|__asan|__sanitizer|__ubsan|str[a-z]*|mem[a-z]*|main|_start)[ (]|in main \(|__libc_start| in (__sanitizer|__asan|__ubsan|__interceptor_|__lsan)' |
           head -1)
   if [[ -z $frame ]]; then echo unknown; elif [[ $frame == *libhdf5* || $frame == *H5* ]]; then echo hdf5; else echo mufric; fi
 }
