@@ -169,8 +169,8 @@ struct PistonPocket {
       if (cavitation) {  // the film's state for the next step
         std::vector<FilmSample> film;
         for (size_t i = 0; i < normal_stress.size(); ++i) {
-          film.push_back({kHeight + piston_start, kWidth / static_cast<double>(normal_stress.size()), false, normal_stress[i],
-                          opening_rate[i]});
+          const double width = kWidth / static_cast<double>(normal_stress.size());
+          film.push_back({kHeight + piston_start, width, width, false, normal_stress[i], opening_rate[i]});
         }
         cavitation->update(film, dt);
       }
@@ -259,7 +259,7 @@ TEST(EnclosedPocket, APulledPistonIsHeldByTensionUnlessTheFilmCavitates) {
 
 TEST(Pockets, RunsBetweenSpotsWrapAroundThePeriod) {
   // Spots at 2 and 5 of 7 samples: pockets {3, 4} and {6, 0, 1} (across the period's end).
-  std::vector<FilmSample> film(7, FilmSample{1e-7, 1e-6, false, 0.0, 0.0});
+  std::vector<FilmSample> film(7, FilmSample{1e-7, 1e-6, 1e-6, false, 0.0, 0.0});
   EXPECT_EQ(pocket_runs(film).size(), 1u);
   film[2].spot = film[5].spot = true;
   const auto runs = pocket_runs(film);
@@ -268,9 +268,37 @@ TEST(Pockets, RunsBetweenSpotsWrapAroundThePeriod) {
   EXPECT_EQ(runs[1], (std::vector<size_t>{6, 0, 1}));
 }
 
+TEST(CavitatingFilm, TheLiquidThatRunsPastAClosingCavityFillsTheNearestCavities) {
+  // Five samples of 1 µm; samples 0 and 3 are spots, formed as cavities of 2 and 3 nm (× 1 µm). In
+  // 1 ns the wall at sample 0 comes back 3 nm: its cavity closes, and 1 nm × 1 µm of liquid ran on
+  // past the wall; the nearest cavity, sample 3 (two samples away across the period's end, 0 → 4 → 3),
+  // takes it, so the cavities together shrink by exactly the 3 nm × 1 µm the wall moved in.
+  const double width = 1e-6;
+  std::vector<FilmSample> film(5, FilmSample{1e-7, width, width, false, -1e5, 0.0});
+  film[0].spot = film[3].spot = true;
+  film[0].film = 2e-9, film[3].film = 3e-9;
+  CavitatingFilm cavitation(0.0);
+  cavitation.form(film);
+  EXPECT_NEAR(cavitation.cavity_area(), 5e-9 * width, 1e-27);
+  film[0].opening_rate = -3.0;  // m/s for 1 ns: the wall comes 3 nm back onto 2 nm of cavity
+  film[1].opening_rate = 0.5;   // a full sample: its wall's motion changes the film, not the cavities
+  cavitation.update(film, 1e-9);
+  EXPECT_FALSE(cavitation.cavitated(0));
+  EXPECT_TRUE(cavitation.cavitated(3));
+  EXPECT_NEAR(cavitation.closing_overshoot(), 1e-9 * width, 1e-27);
+  EXPECT_EQ(cavitation.lost_overshoot(), 0.0);
+  // The cavities lost the 3 nm the closing wall moved in: 2 at sample 0, 1 at sample 3.
+  EXPECT_NEAR(cavitation.cavity_area(), 2e-9 * width, 1e-27);
+  // With no cavity left to take it, the excess is lost, and said.
+  film[3].opening_rate = -2.5;  // 2 nm of cavity, 2.5 nm of wall
+  cavitation.update(film, 1e-9);
+  EXPECT_EQ(cavitation.cavity_area(), 0.0);
+  EXPECT_NEAR(cavitation.lost_overshoot(), 0.5e-9 * width, 1e-27);
+}
+
 TEST(CavitatingFilm, ACavityOpensWhereTheLiquidPullsAndClosesWhenTheWallReturns) {
   // Sample 0 pulls (σn·n = 0.1 MPa > −p_c = 0), sample 1 pushes; each stands for 1 µm.
-  std::vector<FilmSample> film{{1e-7, 1e-6, false, 1e5, 0.0}, {1e-7, 1e-6, false, -1e5, 0.0}};
+  std::vector<FilmSample> film{{1e-7, 1e-6, 1e-6, false, 1e5, 0.0}, {1e-7, 1e-6, 1e-6, false, -1e5, 0.0}};
   CavitatingFilm cavitation(0.0);
   cavitation.update(film, 1e-9);
   EXPECT_TRUE(cavitation.cavitated(0));
@@ -289,17 +317,21 @@ TEST(CavitatingFilm, ACavityOpensWhereTheLiquidPullsAndClosesWhenTheWallReturns)
   cavitation.update(film, 1e-9);
   EXPECT_FALSE(cavitation.cavitated(0));
   EXPECT_EQ(cavitation.cavity_area(), 0.0);
-  // A new film's contact spots hold no liquid: cavities as thick as the layer (20 nm) that close only
-  // if the chip comes 20 nm nearer the liquid.
-  std::vector<FilmSample> formed{{20e-9, 1e-6, true, 0.0, 0.0}, {1e-7, 1e-6, false, 0.0, 0.0}};
+  // A new film's contact spots hold no liquid: cavities as large as the layer (20 nm thick across x)
+  // that close only when the chip has come that layer's thickness along the wall's normal nearer the
+  // liquid. The spot's wall is sloped (1.25 µm of wall over 1 µm of x, a 3-4-5 slope): the layer is
+  // 16 nm thick along the normal, and a cavity of thickness c takes c × 1.25 µm of area.
+  std::vector<FilmSample> formed{{20e-9, 1e-6, 1.25e-6, true, 0.0, 0.0}, {1e-7, 1e-6, 1e-6, false, 0.0, 0.0}};
   CavitatingFilm fresh(0.0);
   fresh.form(formed);
   EXPECT_TRUE(fresh.cavitated(0));
   EXPECT_FALSE(fresh.cavitated(1));
   EXPECT_NEAR(fresh.cavity_area(), 20e-9 * 1e-6, 1e-27);
+  EXPECT_NEAR(fresh.cavitated_fraction(), 1.25 / 2.25, 1e-15);
   formed[0].opening_rate = -10.0;  // m/s toward the liquid, for 1 ns: 10 nm
   fresh.update(formed, 1e-9);
   EXPECT_TRUE(fresh.cavitated(0));
+  EXPECT_NEAR(fresh.cavity_area(), 6e-9 * 1.25e-6, 1e-27);
   fresh.update(formed, 1e-9);
   EXPECT_FALSE(fresh.cavitated(0));
   // A lower cavitation pressure (the liquid holds 0.2 MPa of tension) keeps both samples full.
@@ -463,6 +495,41 @@ TEST(ChipInterface, FilmMeshFollowsTheChipAndKeepsItsMinimumThickness) {
   EXPECT_LT(worst, 2e-9);
   EXPECT_GE(thinnest, o.min_film * (1 - 1e-12));
   EXPECT_LT(thinnest, 2 * o.min_film);  // the tool dips into the chip here: the film is at its minimum
+}
+
+// The film's net moved onto a chip that turns into steep walls (slopes up to 5, as a ploughed lip's)
+// by the algebraic column motion: never folds on the way, and ends where a film built from scratch on
+// that chip starts (an independent construction: gap_patch).
+TEST(ChipInterface, TheFilmsColumnNetFollowsASteepeningChipWithoutFolding) {
+  const auto steep = [](double x) { return 0.2e-6 * std::tanh(40.0 * std::sin(2 * std::numbers::pi * x / kInterval)); };
+  const spline::SplineCurve tool_curve = periodic_curve(3, 32, kInterval, tool_height);
+  const PeriodicGraph tool([&](double t) { return tool_curve.point(t); }, 0.0, kInterval, 256);
+  const auto chip_at = [&](double fraction) {
+    return periodic_curve(2, 64, kInterval, [&](double x) { return (1 - fraction) * chip_height(x) + fraction * steep(x); });
+  };
+  GapMeshOptions o;
+  o.elements_x = 64;
+  o.min_film = 20e-9;
+  const spline::SplineCurve start_curve = chip_at(0.0);
+  const PeriodicGraph start([&](double t) { return start_curve.point(t); }, 0.0, kInterval, 512);
+  fluid::FluidSpace space(gap_patch(start, tool, 0.0, o));
+  double lowest = 1.0;
+  Eigen::MatrixX2d net;
+  for (int k = 1; k <= 10; ++k) {
+    const spline::SplineCurve curve = chip_at(0.1 * k);
+    const PeriodicGraph chip([&](double t) { return curve.point(t); }, 0.0, kInterval, 512);
+    net = gap_net(space.patch(), gap_boundary_rows(space.patch(), chip, tool, o));
+    Eigen::VectorXd displacement(2 * space.node_count());
+    for (int a = 0; a < space.node_count(); ++a) displacement.segment<2>(2 * a) = (net.row(a) - space.patch().points().row(a)).transpose();
+    space.set_displacement(displacement);
+    lowest = std::min(lowest, space.min_relative_jacobian());
+  }
+  std::cout << "smallest relative Jacobian on the way to the steep chip: " << lowest << "\n";
+  EXPECT_GT(lowest, 0.0);
+  const spline::SplineCurve end_curve = chip_at(1.0);
+  const PeriodicGraph end([&](double t) { return end_curve.point(t); }, 0.0, kInterval, 512);
+  const spline::SplineSurface fresh = gap_patch(end, tool, 0.0, o);
+  EXPECT_LT((net - fresh.points()).cwiseAbs().maxCoeff(), 1e-18);
 }
 
 // A coupled step may solve the chip several times with different interface loads; the last trial is

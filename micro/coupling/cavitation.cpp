@@ -1,5 +1,7 @@
 #include "micro/coupling/cavitation.hpp"
 
+#include <algorithm>
+
 namespace mufric::coupling {
 
 std::vector<std::vector<size_t>> pocket_runs(const std::vector<FilmSample>& samples) {
@@ -40,22 +42,44 @@ void CavitatingFilm::form(const std::vector<FilmSample>& samples) {
   for (size_t q = 0; q < samples.size(); ++q) {
     if (!samples[q].spot) continue;
     cavitated_[q] = 1;
-    cavity_[q] = samples[q].film;
+    cavity_[q] = samples[q].film * samples[q].width;  // the layer's area (its thickness is across x)
   }
   tally(samples);
 }
 
 void CavitatingFilm::update(const std::vector<FilmSample>& samples, double dt) {
-  cavitated_.resize(samples.size(), 0);
-  cavity_.resize(samples.size(), 0.0);
-  for (size_t q = 0; q < samples.size(); ++q) {
+  const size_t n = samples.size();
+  cavitated_.resize(n, 0);
+  cavity_.resize(n, 0.0);
+  std::vector<double> overshoot(n, 0.0);
+  for (size_t q = 0; q < n; ++q) {
     if (cavitated_[q] != 0) {
-      cavity_[q] += dt * samples[q].opening_rate;
-      if (cavity_[q] <= kClosedCavityThickness) cavitated_[q] = 0, cavity_[q] = 0.0;  // the liquid is back at the wall
+      cavity_[q] += dt * samples[q].opening_rate * samples[q].wall_length;
+      if (cavity_[q] <= kClosedCavityThickness * samples[q].wall_length) {  // the liquid is back at the wall
+        overshoot[q] = std::max(0.0, -cavity_[q]);
+        cavitated_[q] = 0, cavity_[q] = 0.0;
+      }
     } else if (samples[q].normal_stress > -p_c_) {
       cavitated_[q] = 1;  // the liquid pulls: the cavity opens from the next step on
       cavity_[q] = 0.0;
     }
+  }
+  // The liquid that ran past the wall where a cavity closed fills the nearest cavities, nearer first.
+  closing_overshoot_ = lost_overshoot_ = 0.0;
+  for (size_t q = 0; q < n; ++q) {
+    double excess = overshoot[q];
+    closing_overshoot_ += excess;
+    for (size_t d = 1; excess > 0.0 && d <= n / 2; ++d) {
+      for (const size_t r : {(q + n - d) % n, (q + d) % n}) {
+        if (cavitated_[r] == 0 || cavity_[r] <= 0.0) continue;
+        const double taken = std::min(cavity_[r], excess);
+        cavity_[r] -= taken;
+        excess -= taken;
+        if (cavity_[r] <= kClosedCavityThickness * samples[r].wall_length) cavitated_[r] = 0, cavity_[r] = 0.0;
+        if (excess <= 0.0) break;
+      }
+    }
+    lost_overshoot_ += excess;
   }
   tally(samples);
 }
@@ -64,10 +88,10 @@ void CavitatingFilm::tally(const std::vector<FilmSample>& samples) {
   cavity_area_ = 0.0;
   double length = 0.0, cavitated_length = 0.0;
   for (size_t q = 0; q < samples.size(); ++q) {
-    length += samples[q].length;
+    length += samples[q].wall_length;
     if (cavitated_[q] == 0) continue;
-    cavity_area_ += cavity_[q] * samples[q].length;
-    cavitated_length += samples[q].length;
+    cavity_area_ += cavity_[q];
+    cavitated_length += samples[q].wall_length;
   }
   cavitated_fraction_ = length > 0.0 ? cavitated_length / length : 0.0;
 }

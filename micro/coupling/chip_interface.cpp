@@ -157,6 +157,21 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> boundary_heights(const Columns& c, c
   return {bottom, top};
 }
 
+// The control net between a bottom and a top row of the same columns (row i + nu j): each column's
+// points at the v basis' Greville fractions across the film, 0 at the chip and 1 at the tool.
+Eigen::MatrixX2d net_between(const spline::SplineBasis& across, const Eigen::MatrixX2d& rows) {
+  const auto nu = rows.rows() / 2;
+  const int nv = across.count();
+  Eigen::MatrixX2d points(nu * nv, 2);
+  for (int j = 0; j < nv; ++j) {
+    const double s = across.greville_abscissa(j);
+    for (Eigen::Index i = 0; i < nu; ++i) {
+      points.row(i + nu * j) = Eigen::RowVector2d(rows(i, 0), rows(i, 1) + s * (rows(nu + i, 1) - rows(i, 1)));
+    }
+  }
+  return points;
+}
+
 }  // namespace
 
 spline::SplineSurface gap_patch(const PeriodicGraph& chip, const PeriodicGraph& tool, double x0, const GapMeshOptions& o) {
@@ -170,15 +185,19 @@ spline::SplineSurface gap_patch(const PeriodicGraph& chip, const PeriodicGraph& 
   const spline::SplineBasis bv = spline::SplineBasis::open_uniform(o.degree, o.elements_y, 0.0, 1.0);
   const Columns c = columns_of(bu);
   const auto [bottom, top] = boundary_heights(c, chip, tool, o.min_film);
-  const int nu = bu.count(), nv = bv.count();
-  spline::Points2 points(nu * nv, 2);
-  for (int j = 0; j < nv; ++j) {
-    const double s = bv.greville_abscissa(j);  // the row's fraction across the film: 0 at the chip, 1 at the tool
-    for (int i = 0; i < nu; ++i) {
-      points.row(i + nu * j) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], bottom(i) + s * (top(i) - bottom(i)));
-    }
+  const int nu = bu.count();
+  Eigen::MatrixX2d rows(2 * nu, 2);
+  for (int i = 0; i < nu; ++i) {
+    rows.row(i) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], bottom(i));
+    rows.row(nu + i) = Eigen::RowVector2d(c.x[static_cast<size_t>(i)], top(i));
   }
+  spline::Points2 points = net_between(bv, rows);
   return spline::SplineSurface(bu, bv, std::move(points), {}, Eigen::Vector2d(chip.interval(), 0.0));
+}
+
+Eigen::MatrixX2d gap_net(const spline::SplineSurface& patch, const Eigen::MatrixX2d& rows) {
+  if (rows.rows() != 2 * patch.u_basis().count()) throw Error("gap mesh: the rows do not match the patch's columns");
+  return net_between(patch.v_basis(), rows);
 }
 
 Eigen::MatrixX2d gap_boundary_rows(const spline::SplineSurface& patch, const PeriodicGraph& chip, const PeriodicGraph& tool,

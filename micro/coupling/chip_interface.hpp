@@ -103,4 +103,10 @@ spline::SplineSurface gap_patch(const PeriodicGraph& chip, const PeriodicGraph& 
 Eigen::MatrixX2d gap_boundary_rows(const spline::SplineSurface& patch, const PeriodicGraph& chip, const PeriodicGraph& tool,
                                    const GapMeshOptions& options);
 
+// The whole control net of such a patch (row i + nu j) for given bottom and top rows: each column's
+// points spaced across the film at the v basis' Greville fractions, as the patch was built. This
+// algebraic net cannot fold while every top point is above its bottom one (x grows along a row and
+// y along a column, so det J = x_u y_v > 0), which gap_boundary_rows guarantees by min_film.
+Eigen::MatrixX2d gap_net(const spline::SplineSurface& patch, const Eigen::MatrixX2d& rows);
+
 }  // namespace mufric::coupling

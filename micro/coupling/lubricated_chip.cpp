@@ -19,6 +19,26 @@ bool trace_coupling() {
   return on;
 }
 
+// The film's net moved onto new bottom and top rows algebraically (gap_net): each column's points
+// spaced across the film as when it formed.
+fluid::MeshMoveReport move_columns(fluid::FluidSpace& space, const Eigen::MatrixX2d& rows) {
+  const Eigen::MatrixX2d net = gap_net(space.patch(), rows);
+  Eigen::VectorXd displacement = space.displacement();
+  for (int node = 0; node < space.node_count(); ++node) {
+    displacement.segment<2>(2 * node) += net.row(node).transpose() - space.node_position(node);
+  }
+  const Eigen::VectorXd before = space.displacement();
+  space.set_displacement(displacement);
+  fluid::MeshMoveReport r;
+  r.min_relative_jacobian = space.min_relative_jacobian();
+  r.ok = r.min_relative_jacobian > 0.0;
+  if (!r.ok) {
+    space.set_displacement(before);
+    r.reason = "the film's column net would fold (min relative det J = " + std::to_string(r.min_relative_jacobian) + ")";
+  }
+  return r;
+}
+
 }  // namespace
 
 LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::SplineCurve& tool, LubricantOptions options)
@@ -39,6 +59,7 @@ LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::Splin
   if (!(options_.film_from > 0.0)) {
     film_formed_ = true;
     formed_film_area_ = fluid_->space().area();
+    formed_liquid_area_ = liquid_area();
   }
 }
 
@@ -64,14 +85,16 @@ size_t LubricatedChip::sample_at(double parameter) const {
 }
 
 std::vector<FilmSample> LubricatedChip::film_samples() const {
-  const auto& points = fluid_->space().side_points(Side::bottom);
+  const fluid::FluidSpace& space = fluid_->space();
+  const auto& points = space.side_points(Side::bottom);
   std::vector<FilmSample> samples;
   samples.reserve(points.size());
+  const Side bottom = Side::bottom;
   for (size_t q = 0; q < points.size(); ++q) {
     const double film = film_thickness(points[q]);
-    // The parametric weight is the length along x: the columns are at x = u.
-    samples.push_back({film, points[q].weight, film < options_.contact_fade * options_.mesh.min_film, normal_stress_[q],
-                       opening_rate_[q]});
+    // The parametric weight is the width along x (the columns are at x = u), the mapped one the wall's length.
+    samples.push_back({film, points[q].weight, space.map(points[q], &bottom).weight,
+                       film < options_.contact_fade * options_.mesh.min_film, normal_stress_[q], opening_rate_[q]});
   }
   return samples;
 }
@@ -81,6 +104,10 @@ double LubricatedChip::film_thickness(const fluid::ParametricPoint& bottom_point
   const fluid::FluidSpace& space = fluid_->space();
   const double top = space.patch().v_basis().hi();
   return space.map(space.at(bottom_point.u, top)).position.y() - space.map(bottom_point).position.y();
+}
+
+double LubricatedChip::liquid_area() const {
+  return fluid_->space().area() - (cavitation_ ? cavitation_->cavity_area() : 0.0);
 }
 
 Eigen::VectorXd LubricatedChip::transfer(const Eigen::VectorXd& traction) const {
@@ -129,7 +156,8 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
     prescribed.emplace_back(b, rows.row(i).transpose() - space.node_position(b));
     prescribed.emplace_back(t, rows.row(n + i).transpose() - space.node_position(t));
   }
-  const fluid::MeshMoveReport moved = mesh_update_.move(space, prescribed);
+  const fluid::MeshMoveReport moved = options_.mesh_motion == FilmMeshMotion::columns ? move_columns(space, rows)
+                                                                                       : mesh_update_.move(space, prescribed);
   if (!moved.ok) {
     reason = moved.reason;
     return false;
@@ -180,7 +208,9 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
   const auto samples = fluid_->robin_traction(Side::bottom);
   new_traction.resize(2 * static_cast<Eigen::Index>(samples.size()));
   // The volume this step's mismatch of the interface velocities moves through the film's wall, over
-  // the film's (a cavity's thickness follows the wall by itself: only full samples count).
+  // the film's (a cavity's area follows the wall by itself: only full samples count). Over the
+  // liquid's the liquid drifted 1.3 % instead of 10 % on the study run, at twice the exchanges, and
+  // the box centre stopped (RESULTS, "The lubricant, fifth pass").
   double created = 0.0;
   for (size_t q = 0; q < samples.size(); ++q) {
     const Eigen::Vector2d& normal = samples[q].normal;
@@ -191,6 +221,7 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
         cavitated ? Eigen::Vector2d(-cavitation_->cavitation_pressure() * normal) : samples[q].traction;
     if (!cavitated) created += samples[q].weight * opening_rate_[q] * dt;
   }
+  mismatch_area_ = created;
   volume_error_ = std::abs(created) / space.area();
   return true;
 }
@@ -203,6 +234,7 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
     accelerator_.forget_past_steps();
     film_formed_ = true;
     formed_film_area_ = fluid_->space().area();
+    formed_liquid_area_ = liquid_area();
   }
   current_ = LubricatedStep();
   // The fixed-point map depends on the step length (the chip's inertia per step): secant pairs of
@@ -259,7 +291,12 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
     cavitation_->update(samples, dt);
     current_.cavitated_fraction = cavitation_->cavitated_fraction();
     current_.cavity_area = cavitation_->cavity_area();
+    if (trace_coupling()) {
+      std::fprintf(stderr, "  liquid %.6e m2/m: full samples' mismatch %.4e, closing overshoot %.4e, lost %.4e\n",
+                   liquid_area(), mismatch_area_, cavitation_->closing_overshoot(), cavitation_->lost_overshoot());
+    }
   }
+  current_.liquid_area = liquid_area();
   history_.push_back(current_);
   return true;
 }
@@ -269,7 +306,7 @@ std::vector<double> LubricatedChip::pocket_areas(const std::vector<FilmSample>& 
   std::vector<double> areas;
   for (const auto& run : pocket_runs(samples)) {
     double area = 0.0;
-    for (size_t q : run) area += samples[q].film * samples[q].length;
+    for (size_t q : run) area += samples[q].film * samples[q].width;
     areas.push_back(area);
   }
   return areas;

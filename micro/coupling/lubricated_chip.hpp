@@ -25,10 +25,18 @@ namespace mufric::coupling {
 // LubricantOptions::contact_fade).
 inline constexpr double kContactFilmFactor = 2.0;
 
+// How the film's interior follows its moving walls. columns (the default): each column's control
+// points stay spaced across the film as when it formed — it cannot fold (gap_net). elastic: the
+// elastic mesh-update method with Jacobian-based stiffening (mesh_update.hpp), which let the interior
+// drift sideways step after step until it folded under the ploughed chip (the default 64 × 12 scene
+// stopped at 2.5 µm of 4.5; RESULTS, "The lubricant, fifth pass").
+enum class FilmMeshMotion { columns, elastic };
+
 struct LubricantOptions {
   fluid::FluidProperties fluid;      // seed 000 Table 2
   GapMeshOptions mesh;
-  fluid::MeshUpdateOptions mesh_update;
+  FilmMeshMotion mesh_motion = FilmMeshMotion::columns;
+  fluid::MeshUpdateOptions mesh_update;  // for the elastic motion
   CouplingOptions coupling;
   // α_R of the Robin condition (Pa s/m); 0: the chip's mass per unit surface over the step being
   // taken, ρ_chip h_chip / Δt — the weight that makes the iteration exact for a rigid chip (the
@@ -62,6 +70,7 @@ struct LubricatedStep {
   std::vector<double> pocket_areas;    // m² per unit depth, between contact spots (empty: no contact spot)
   double cavitated_fraction = 0.0;     // of the interface's length, cavitated for the next step
   double cavity_area = 0.0;            // m² per unit depth: the cavities' space, not filled by liquid
+  double liquid_area = 0.0;            // m² per unit depth: the liquid's volume (the film's without cavitation)
   double volume_error = 0.0;           // liquid moved through the film's wall by the velocity mismatch, of the film
 };
 
@@ -78,6 +87,7 @@ class LubricatedChip {
   const fluid::NavierStokes& fluid() const { return *fluid_; }
   // The film's area (m² per unit depth) when it formed (0 before).
   double formed_film_area() const { return formed_film_area_; }
+  double formed_liquid_area() const { return formed_liquid_area_; }  // the film's less its cavities', when formed
   // The film's traction on the chip transferred in the last accepted step, as nodal forces.
   const Eigen::VectorXd& nodal_forces() const { return load_->forces(); }
 
@@ -91,6 +101,7 @@ class LubricatedChip {
   size_t sample_at(double parameter) const;      // the bottom side sample at a curve parameter
   static std::vector<double> pocket_areas(const std::vector<FilmSample>& samples);
   double film_thickness(const fluid::ParametricPoint& bottom_point) const;  // m, tool minus chip above it
+  double liquid_area() const;  // m² per unit depth: the film's less its cavities'
   void form_film();  // the film in the gap the chip's surface (surface_) leaves now
 
   solid::SolidProblem& problem_;
@@ -112,9 +123,10 @@ class LubricatedChip {
   // The last exchange's liquid at the bottom samples: σn·n, and (g − v)·n, the chip leaving it.
   std::vector<double> normal_stress_, opening_rate_;
   double last_accepted_dt_ = 0.0;
+  double mismatch_area_ = 0.0;  // m² per unit depth, signed: the last fluid solve's liquid through the full wall
   double volume_error_ = 0.0;  // liquid the last fluid solve's velocity mismatch makes in the step, relative
   bool film_formed_ = false;
-  double formed_film_area_ = 0.0;
+  double formed_film_area_ = 0.0, formed_liquid_area_ = 0.0;
 };
 
 }  // namespace mufric::coupling

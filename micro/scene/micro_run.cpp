@@ -151,6 +151,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                       {"fluid_newton_iterations", lubricant->fluid_newton_iterations},
                       {"min_relative_jacobian", lubricant->min_relative_jacobian},
                       {"film_area_m2_per_m", {lubricant->initial_film_area, lubricant->final_film_area}},
+                      {"liquid_area_m2_per_m", {lubricant->initial_liquid_area, lubricant->final_liquid_area}},
                       {"final_pocket_areas_m2_per_m", lubricant->final_pocket_areas},
                       {"fluid_dofs", lubricant->fluid_dofs}};
   }
@@ -170,6 +171,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"pocket_areas_m2_per_m", s.pocket_areas},
                  {"cavitated_fraction", s.cavitated_fraction},
                  {"cavity_area_m2_per_m", s.cavity_area},
+                 {"liquid_area_m2_per_m", s.liquid_area},
                  {"film_volume_error", s.film_volume_error},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
@@ -257,6 +259,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.mesh.elements_x = l.elements_x > 0 ? l.elements_x : scene.elements_x;
   o.mesh.elements_y = l.elements_y;
   o.mesh.min_film = l.min_film;
+  o.mesh_motion = l.mesh_motion == "elastic" ? coupling::FilmMeshMotion::elastic : coupling::FilmMeshMotion::columns;
   o.mesh_update.stiffening_exponent = l.mesh_stiffening;
   o.robin_weight = l.robin_weight;
   o.chip_mass_per_area = scene.material.density * scene.chip_height;
@@ -398,6 +401,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       step.pocket_areas = l.pocket_areas;
       step.cavitated_fraction = l.cavitated_fraction;
       step.cavity_area = l.cavity_area;
+      step.liquid_area = l.liquid_area;
       step.film_volume_error = l.volume_error;
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
@@ -422,8 +426,10 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);
     }
     l.initial_film_area = lubricant->formed_film_area();
+    l.initial_liquid_area = lubricant->formed_liquid_area();
     if (!lubricant->history().empty()) {
       l.final_film_area = lubricant->history().back().film_area;
+      l.final_liquid_area = lubricant->history().back().liquid_area;
       l.final_pocket_areas = lubricant->history().back().pocket_areas;
     }
   }

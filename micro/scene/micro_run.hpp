@@ -28,6 +28,7 @@ struct MicroStep {
   std::vector<double> pocket_areas;                 // lubricated: between contact spots, m² per unit depth
   double cavitated_fraction = 0.0;                  // lubricated: of the interface, cavitated pockets
   double cavity_area = 0.0;                         // lubricated: their space not filled by liquid, m² per unit depth
+  double liquid_area = 0.0;                         // lubricated: the liquid's volume, m² per unit depth (film less cavities)
   double film_volume_error = 0.0;                   // lubricated: liquid moved through the film's wall by the coupling's mismatch, of the film
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
@@ -41,6 +42,7 @@ struct LubricantRecord {
   int coupling_iterations = 0, max_coupling_iterations = 0, fluid_newton_iterations = 0;
   double min_relative_jacobian = 1.0;
   double initial_film_area = 0.0, final_film_area = 0.0;  // m² per unit depth, when formed and at the end
+  double initial_liquid_area = 0.0, final_liquid_area = 0.0;  // the same of the liquid (film less cavities)
   std::vector<double> final_pocket_areas;                  // m² per unit depth
   int fluid_dofs = 0;
 };

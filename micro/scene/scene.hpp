@@ -67,7 +67,10 @@ struct LubricantSpec {
   // Minimum films over which the fluid's load fades out into a contact spot (a continuous switch).
   double contact_fade = 2.0;
   double robin_weight = 0.0;   // α_R, Pa s/m; 0: ρ_chip h_chip / max(Δt, time.step)
-  double mesh_stiffening = 1.0;  // χ of the Jacobian-based stiffening of the film's mesh
+  // How the film's interior follows its walls: "columns" (algebraic, cannot fold) or "elastic" (EMUM,
+  // with mesh_stiffening the χ of its Jacobian-based stiffening); micro/coupling/lubricated_chip.hpp.
+  std::string mesh_motion = "columns";
+  double mesh_stiffening = 1.0;
   std::string acceleration = "iqn-ils";  // iqn-ils, aitken or relaxation
   double relaxation = 0.5;
   int reuse_steps = 8;
