@@ -298,7 +298,11 @@ TEST_F(Service, FileThatCrashesTheHdf5LibraryIsRefusedAndTheServerLives) {
 TEST_F(Service, ClientReconnectsAfterTheServerRestarts) {
   auto server = std::make_unique<LoopbackServer>(dir_);
   const int port = server->port();
-  const auto remote = client::connect("grpc://127.0.0.1:" + std::to_string(port) + "/coulomb");
+  // Eight retries back off over 12.8 s in all: the new server (loading and checking its models in
+  // children) took longer than the default four retries' 0.75 s under the sanitizers on a busy machine.
+  client::Options patient;
+  patient.retries = 8;
+  const auto remote = client::connect("grpc://127.0.0.1:" + std::to_string(port) + "/coulomb", patient);
   const Points pts = random_points(8);
   EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.3);
   server.reset();  // killed
