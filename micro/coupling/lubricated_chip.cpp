@@ -19,26 +19,6 @@ bool trace_coupling() {
   return on;
 }
 
-// The film's net moved onto new bottom and top rows algebraically (gap_net): each column's points
-// spaced across the film as when it formed.
-fluid::MeshMoveReport move_columns(fluid::FluidSpace& space, const Eigen::MatrixX2d& rows) {
-  const Eigen::MatrixX2d net = gap_net(space.patch(), rows);
-  Eigen::VectorXd displacement = space.displacement();
-  for (int node = 0; node < space.node_count(); ++node) {
-    displacement.segment<2>(2 * node) += net.row(node).transpose() - space.node_position(node);
-  }
-  const Eigen::VectorXd before = space.displacement();
-  space.set_displacement(displacement);
-  fluid::MeshMoveReport r;
-  r.min_relative_jacobian = space.min_relative_jacobian();
-  r.ok = r.min_relative_jacobian > 0.0;
-  if (!r.ok) {
-    space.set_displacement(before);
-    r.reason = "the film's column net would fold (min relative det J = " + std::to_string(r.min_relative_jacobian) + ")";
-  }
-  return r;
-}
-
 }  // namespace
 
 LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::SplineCurve& tool, LubricantOptions options)
@@ -144,11 +124,17 @@ bool LubricatedChip::structure(solid::TimeIntegrator& integrator, double t0, dou
   return true;
 }
 
-bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& traction, double dt, Eigen::VectorXd& new_traction,
-                          std::string& reason) {
+fluid::MeshMoveReport LubricatedChip::move_film_mesh(const Eigen::MatrixX2d& rows) {
   fluid::FluidSpace& space = fluid_->space();
-  space.set_displacement(mesh_start_);
-  const Eigen::MatrixX2d rows = gap_boundary_rows(space.patch(), surface_->graph(), *tool_, options_.mesh);
+  if (options_.mesh_motion == FilmMeshMotion::columns) {
+    // Each column's points spaced across the film as when it formed (gap_net).
+    const Eigen::MatrixX2d net = gap_net(space.patch(), rows);
+    Eigen::VectorXd displacement = space.displacement();
+    for (int node = 0; node < space.node_count(); ++node) {
+      displacement.segment<2>(2 * node) += net.row(node).transpose() - space.node_position(node);
+    }
+    return fluid::place_mesh(space, displacement);
+  }
   std::vector<std::pair<int, Eigen::Vector2d>> prescribed;
   const auto n = static_cast<Eigen::Index>(bottom_nodes_.size());
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -156,8 +142,14 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
     prescribed.emplace_back(b, rows.row(i).transpose() - space.node_position(b));
     prescribed.emplace_back(t, rows.row(n + i).transpose() - space.node_position(t));
   }
-  const fluid::MeshMoveReport moved = options_.mesh_motion == FilmMeshMotion::columns ? move_columns(space, rows)
-                                                                                       : mesh_update_.move(space, prescribed);
+  return mesh_update_.move(space, prescribed);
+}
+
+bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& traction, double dt, Eigen::VectorXd& new_traction,
+                          std::string& reason) {
+  fluid::FluidSpace& space = fluid_->space();
+  space.set_displacement(mesh_start_);
+  const fluid::MeshMoveReport moved = move_film_mesh(gap_boundary_rows(space.patch(), surface_->graph(), *tool_, options_.mesh));
   if (!moved.ok) {
     reason = moved.reason;
     return false;

@@ -96,6 +96,8 @@ class LubricatedChip {
                  Eigen::VectorXd& displacement, std::string& reason);
   bool film(const Eigen::VectorXd& displacement, const Eigen::VectorXd& traction, double dt, Eigen::VectorXd& new_traction,
             std::string& reason);
+  // The film's net onto new bottom and top rows (gap_boundary_rows), by the options' mesh motion.
+  fluid::MeshMoveReport move_film_mesh(const Eigen::MatrixX2d& rows);
   Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
   std::vector<FilmSample> film_samples() const;  // the film's bottom side, for pockets and cavitation
   size_t sample_at(double parameter) const;      // the bottom side sample at a curve parameter

@@ -81,9 +81,13 @@ MeshMoveReport MeshUpdate::move(FluidSpace& space, const std::vector<std::pair<i
     report.reason = "the mesh-update matrix could not be factorised: " + solver_.reason();
     return report;
   }
-  const Eigen::VectorXd solved = solver_.solve(rhs);
+  return place_mesh(space, space.displacement() + solver_.solve(rhs));
+}
+
+MeshMoveReport place_mesh(FluidSpace& space, const Eigen::VectorXd& displacement) {
+  MeshMoveReport report;
   const Eigen::VectorXd before = space.displacement();
-  space.set_displacement(before + solved);
+  space.set_displacement(displacement);
   report.min_relative_jacobian = space.min_relative_jacobian();
   if (!(report.min_relative_jacobian > 0.0)) {
     space.set_displacement(before);

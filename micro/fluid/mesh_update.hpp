@@ -24,6 +24,10 @@ struct MeshMoveReport {
   double min_relative_jacobian = 1.0;  // of the moved mesh (≤ 0: folded)
 };
 
+// Gives the space this displacement of its net if the mesh it makes is valid (min relative
+// Jacobian > 0); otherwise leaves the space as it was and says why.
+MeshMoveReport place_mesh(FluidSpace& space, const Eigen::VectorXd& displacement);
+
 class MeshUpdate {
  public:
   explicit MeshUpdate(MeshUpdateOptions options = {});
