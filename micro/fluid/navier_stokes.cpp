@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 #include "common/error.hpp"
 
@@ -103,9 +104,12 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
     }
   };
 
+  Eigen::VectorXd advect;                // c·∇N_b at a point
+  std::vector<Eigen::Matrix2d> dstrong;  // ∂(strong)/∂v_b at a point
   for (int e = 0; e < space_.element_count(); ++e) {
     const std::vector<int>& nodes = space_.element_nodes(e);
     const auto n = static_cast<Eigen::Index>(nodes.size());
+    advect.resize(n);
     Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
     Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
     for (const ParametricPoint& p : space_.element_points(e)) {
@@ -133,8 +137,16 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
       const Eigen::Vector2d inertia = rho * ((v - v_old) * inv_dt + d.gradient * c);
       const Eigen::Vector2d strong = inertia + d.pressure_gradient - mu * (d.laplacian + d.grad_div) - rho * body;
       const Eigen::Matrix2d sym = d.gradient + d.gradient.transpose();
-      Eigen::VectorXd advect(n);  // c·∇N_a
-      for (Eigen::Index a = 0; a < n; ++a) advect(a) = c.dot(q.gradients.col(a));
+      // Per shape function b, once per point (not once per a): c·∇N_b, ΔN_b and ∂(strong_i)/∂v_bk =
+      // ρ(δ_ik(N_b/Δt + c·∇N_b) + N_b ∂_k v_i) − μ(δ_ik ΔN_b + ∂_i∂_k N_b).
+      dstrong.resize(static_cast<size_t>(n));
+      for (Eigen::Index b = 0; b < n; ++b) {
+        advect(b) = c.dot(q.gradients.col(b));
+        const Eigen::Matrix2d hb = hessian(q, b);
+        Eigen::Matrix2d& ds = dstrong[static_cast<size_t>(b)];
+        ds = rho * q.values(b) * d.gradient - mu * hb;
+        ds.diagonal().array() += rho * (q.values(b) * inv_dt + advect(b)) - mu * (hb(0, 0) + hb(1, 1));
+      }
 
       for (Eigen::Index a = 0; a < n; ++a) {
         const double na = q.values(a);
@@ -147,21 +159,19 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
         for (Eigen::Index b = 0; b < n; ++b) {
           const double nb = q.values(b);
           const Eigen::Vector2d gb = q.gradients.col(b);
-          const Eigen::Matrix2d hb = hessian(q, b);
-          // ∂(strong_i)/∂v_bk: ρ(δ_ik(N_b/Δt + c·∇N_b) + N_b ∂_k v_i) − μ(δ_ik ΔN_b + ∂_i∂_k N_b).
-          Eigen::Matrix2d dstrong = rho * nb * d.gradient - mu * hb;
-          dstrong.diagonal().array() += rho * (nb * inv_dt + advect(b)) - mu * (hb(0, 0) + hb(1, 1));
+          const Eigen::Matrix2d& ds = dstrong[static_cast<size_t>(b)];
+          const double mass_advection = na * rho * (nb * inv_dt + advect(b)), diffusion = mu * ga.dot(gb);
           for (int i = 0; i < 2; ++i) {
             for (int kk = 0; kk < 2; ++kk) {
-              const double galerkin = na * rho * ((i == kk ? nb * inv_dt + advect(b) : 0.0) + nb * d.gradient(i, kk)) +
-                                      mu * ((i == kk ? ga.dot(gb) : 0.0) + ga(kk) * gb(i));
-              const double supg = tau_m * (advect(a) * dstrong(i, kk) + nb * ga(kk) * strong(i));
+              const double galerkin = (i == kk ? mass_advection + diffusion : 0.0) + na * rho * nb * d.gradient(i, kk) +
+                                      mu * ga(kk) * gb(i);
+              const double supg = tau_m * (advect(a) * ds(i, kk) + nb * ga(kk) * strong(i));
               k(3 * a + i, 3 * b + kk) += wt * (galerkin + supg + rho * nu_c * ga(i) * gb(kk));
             }
             k(3 * a + i, 3 * b + 2) += wt * (-nb * ga(i) + tau_m * advect(a) * gb(i));
           }
           for (int kk = 0; kk < 2; ++kk) {
-            k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(dstrong.col(kk)));
+            k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(ds.col(kk)));
           }
           k(3 * a + 2, 3 * b + 2) += wt * tau_m / rho * ga.dot(gb);
         }
