@@ -305,7 +305,7 @@ void add_micro_commands(CLI::App& app) {
   profile->callback([o] { run_profile(*o); });
 
   auto r = std::make_shared<RunCommandOptions>();
-  auto* run = micro->add_subcommand("run", "One high-fidelity dry run: mu by eq. 17 with its history and diagnostics");
+  auto* run = micro->add_subcommand("run", "One high-fidelity run, dry or lubricated: mu by eq. 17 with its history and diagnostics");
   run->add_option("scene", r->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
   run->add_option("--set", r->overrides, "Override a scene value, e.g. --set load.pressure=1300MPa (repeatable)");
   run->add_option("--out", r->out, "Directory for result.json, chip.vtu, tool.vtu (and film.vtu when lubricated)")->capture_default_str();

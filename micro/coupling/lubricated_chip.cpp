@@ -21,6 +21,13 @@ bool trace_coupling() {
 
 }  // namespace
 
+double robin_weight(const LubricantOptions& options, double dt) {
+  if (options.robin_weight > 0.0) return options.robin_weight;
+  // Backward Euler on ρh v̇ + β d = −σn gives (ρh/Δt + βΔt) v = −σn + …: the structure's own Robin
+  // relation (Badia, Nobile & Vergara 2008), with Δt no shorter than the scene's base step.
+  return options.chip_mass_per_area / std::max(dt, options.shortest_weight_step) + options.robin_stiffness * dt;
+}
+
 LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::SplineCurve& tool, LubricantOptions options)
     : problem_(problem), tool_curve_(tool), options_(std::move(options)), mesh_update_(options_.mesh_update),
       accelerator_(options_.coupling) {
@@ -154,9 +161,7 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
     reason = moved.reason;
     return false;
   }
-  const double alpha = options_.robin_weight > 0.0
-                           ? options_.robin_weight
-                           : options_.chip_mass_per_area / std::max(dt, options_.shortest_weight_step);
+  const double alpha = robin_weight(options_, dt);
   // The film's wall moves with the chip along the surface and with the film mesh's bottom across it:
   // that bottom interpolates the chip's surface at the columns, so the chip's own normal velocity
   // would move liquid through the film's boundary by that interpolation; the wall's keeps the film's

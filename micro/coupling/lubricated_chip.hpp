@@ -47,7 +47,11 @@ struct LubricantOptions {
   // velocity side, which an enclosed film cannot follow (the tiny dataset scene failed its first
   // sliding step; fixed weights 1e6–1e8 Pa s/m pass it, 1e9 fails). RESULTS, "The lubricant,
   // fourth pass". IQN-ILS forgets past steps when Δt changes, so its secant pairs stay one map's.
+  // The chip's stiffness enters as in Badia, Nobile & Vergara's generalized string model (J. Comput.
+  // Phys. 227, 2008): α_R = ρ_chip h_chip / Δt + β Δt, β = robin_stiffness (Pa/m). Pressed on the
+  // tool, the chip resists the film by its stiffness far more than by its inertia.
   double robin_weight = 0.0;
+  double robin_stiffness = 0.0;      // β, Pa/m, for the automatic α_R
   double chip_mass_per_area = 0.0;   // kg/m², for the automatic α_R
   double shortest_weight_step = 0.0;  // s, for the automatic α_R (the scene's time.step)
   // When the film is formed: at t = 0 in the whole initial gap (0), or at this time from the gap the
@@ -59,6 +63,9 @@ struct LubricantOptions {
   // cavitation.hpp); none: the liquid holds any tension (seed 000's model).
   std::optional<double> cavitation_pressure;
 };
+
+// α_R for a step of length dt: options.robin_weight when given, else the automatic weight.
+double robin_weight(const LubricantOptions& options, double dt);
 
 // What one accepted step did at the interface.
 struct LubricatedStep {

@@ -262,6 +262,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.mesh_motion = l.mesh_motion == "elastic" ? coupling::FilmMeshMotion::elastic : coupling::FilmMeshMotion::columns;
   o.mesh_update.stiffening_exponent = l.mesh_stiffening;
   o.robin_weight = l.robin_weight;
+  o.robin_stiffness = l.robin_stiffness;
   o.chip_mass_per_area = scene.material.density * scene.chip_height;
   o.shortest_weight_step = scene.dt;
   o.film_from = l.fill == "after-pressing" ? slide_start : 0.0;

@@ -288,6 +288,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     l.cavitation_pressure = f.quantity("cavitation_pressure", QuantityKind::pressure, l.cavitation_pressure, -1e9, 1e9);
     l.contact_fade = f.number("contact_fade", l.contact_fade, 1.01, 100.0);
     l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
+    l.robin_stiffness = f.number("robin_stiffness", l.robin_stiffness, 0.0, 1e25);
     l.mesh_motion = f.text("mesh_motion", l.mesh_motion, {"columns", "elastic"});
     l.mesh_stiffening = f.number("mesh_stiffening", l.mesh_stiffening, 0.0, 5.0);
     l.acceleration = f.text("acceleration", l.acceleration, {"iqn-ils", "aitken", "relaxation"});

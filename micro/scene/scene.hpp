@@ -66,7 +66,9 @@ struct LubricantSpec {
   double cavitation_pressure = 0.0;  // Pa, relative to the ambient zero of the applied load
   // Minimum films over which the fluid's load fades out into a contact spot (a continuous switch).
   double contact_fade = 2.0;
-  double robin_weight = 0.0;   // α_R, Pa s/m; 0: ρ_chip h_chip / max(Δt, time.step)
+  // α_R, Pa s/m; 0: the automatic ρ_chip h_chip / max(Δt, time.step) + robin_stiffness Δt.
+  double robin_weight = 0.0;
+  double robin_stiffness = 0.0;  // β, Pa/m: the chip's stiffness in the automatic α_R (coupling/lubricated_chip.hpp)
   // How the film's interior follows its walls: "columns" (algebraic, cannot fold) or "elastic" (EMUM,
   // with mesh_stiffening the χ of its Jacobian-based stiffening); micro/coupling/lubricated_chip.hpp.
   std::string mesh_motion = "columns";
