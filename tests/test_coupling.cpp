@@ -617,6 +617,47 @@ TEST(CoupledStep, AReportedKinematicResidualMustAlsoConverge) {
   EXPECT_FALSE(run(1e-25).converged);
 }
 
+// A step whose load change stops falling fails after stall_iterations exchanges without a new best,
+// where a slowly but steadily contracting one runs to convergence. λ̃ = c − ρλ with plain relaxation:
+// the change |λ̃ − λ| is multiplied by ρ each exchange (the closed form of this scalar iteration), so
+// ρ = 0.9 converges in ~90 exchanges and ρ = 1 (an oscillation of constant size) never improves.
+TEST(CoupledStep, AStalledIterationFailsEarlyAndASlowOneConverges) {
+  CouplingOptions options;
+  options.acceleration = Acceleration::constant_relaxation;
+  options.relaxation = 1.0;
+  options.relative_tolerance = 1e-4;
+  options.load_tolerance = 0.0;
+  options.displacement_tolerance = 1.0;  // the displacement is the load here: not the criterion tested
+  options.max_iterations = 500;
+  options.stall_iterations = 6;
+  double rho = 0.0;
+  const PartitionedSolvers solvers{
+      [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
+        d = load;
+        return true;
+      },
+      [&](const Eigen::VectorXd& d, const Eigen::VectorXd&, Eigen::VectorXd& next, std::string&) {
+        next = Eigen::VectorXd::Constant(1, 1.0 - rho * d(0));
+        return true;
+      },
+      {}};
+  const auto run = [&](double contraction) {
+    rho = contraction;
+    InterfaceAccelerator accelerator(options);
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
+    return coupled_step(solvers, load, d, accelerator, options);
+  };
+  const CouplingStepReport slow = run(0.9);
+  ASSERT_TRUE(slow.converged) << slow.reason;
+  EXPECT_GT(slow.iterations, 50);
+  const CouplingStepReport stalled = run(1.0);
+  EXPECT_FALSE(stalled.converged);
+  EXPECT_EQ(stalled.iterations, 1 + options.stall_iterations);  // the best is the first; six more without a better one
+  EXPECT_NE(stalled.reason.find("stalled"), std::string::npos) << stalled.reason;
+  options.stall_iterations = 0;  // off: the oscillation runs to max_iterations
+  EXPECT_EQ(run(1.0).iterations, options.max_iterations);
+}
+
 TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
   const spline::SplineCurve surface = periodic_curve(2, 16, kInterval, chip_height);
   const auto build = [&] {

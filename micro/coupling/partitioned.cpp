@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "common/error.hpp"
@@ -112,6 +113,8 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
   CouplingStepReport report;
   const Eigen::VectorXd start_load = load, start = displacement;
   Eigen::VectorXd lambda = load, lambda_tilde, d, d_previous = displacement;
+  double best_load_residual = std::numeric_limits<double>::infinity();
+  int best_iteration = 0;
   accelerator.begin_step();
   for (int it = 1; it <= options.max_iterations; ++it) {
     std::string reason;
@@ -149,6 +152,13 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
       displacement = d;
       accelerator.end_step();
       return report;
+    }
+    if (load_residual < best_load_residual) best_load_residual = load_residual, best_iteration = it;
+    if (options.stall_iterations > 0 && it - best_iteration >= options.stall_iterations) {
+      report.reason = "the interface iteration stalled: |load change| has stayed above its best of the step (" +
+                      std::to_string(best_load_residual) + " Pa at exchange " + std::to_string(best_iteration) + ") for " +
+                      std::to_string(options.stall_iterations) + " exchanges";
+      break;
     }
     d_previous = d;
     lambda = accelerator.next(lambda, lambda_tilde);

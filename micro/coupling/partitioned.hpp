@@ -33,6 +33,11 @@ struct CouplingOptions {
   double displacement_tolerance = 1e-15;  // m: |d_k − d_(k−1)| below this (plus the relative part) is converged
   double kinematic_tolerance = 1e-4;      // of the solvers' kinematic residual, when they report one
   int max_iterations = 50;
+  // A step fails once this many exchanges in a row have not brought |λ̃ − λ| below its best of the
+  // step (0: never): such a step was, on the coarse study point, a step that went on to fail —
+  // mostly in a chip solve that spent its 30 Newton iterations first — and its cut-back retry is
+  // cheaper than the rest of it.
+  int stall_iterations = 0;
 };
 
 // The interface fixed-point accelerator; keeps what it learns from one time step to the next.

@@ -277,6 +277,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.coupling.relative_tolerance = l.coupling_tolerance;
   o.coupling.kinematic_tolerance = l.volume_tolerance;
   o.coupling.max_iterations = l.max_coupling_iterations;
+  o.coupling.stall_iterations = l.stall_iterations;
   return o;
 }
 

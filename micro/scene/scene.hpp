@@ -87,6 +87,8 @@ struct LubricantSpec {
   // 2 % per step and μ 8 % off; 1e-3 puts μ within 0.6 % of 1e-5 (bench/RESULTS.md).
   double volume_tolerance = 1e-3;
   int max_coupling_iterations = 50;
+  // Exchanges without a new best traction change after which a step fails and is cut back (0: never).
+  int stall_iterations = 0;
 };
 
 struct Scene {
