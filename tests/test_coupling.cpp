@@ -3,6 +3,7 @@
 // Förster & Wall, Comput. Mech. 38, 2006). The exact answer: the piston cannot move, the pocket keeps
 // its volume and its pressure equals the applied one.
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <numbers>
 #include <optional>
@@ -573,38 +574,51 @@ TEST(ChipInterface, TheFilmsColumnNetFollowsASteepeningChipWithoutFolding) {
   EXPECT_LT((net - fresh.points()).cwiseAbs().maxCoeff(), 1e-18);
 }
 
-// A coupled step may solve the chip several times with different interface loads; the last trial is
-// what the step accepts, exactly as if that load had been the only one (dynamic, three steps).
-// A scalar interface: λ = 1 + λ/2 (fixed point 2) by constant relaxation ω = 1, the residual halving
-// each exchange. With a kinematic residual reported (here 10⁻ᵏ at exchange k), the step also waits
-// for it: the load alone converges at exchange 10 (|λ̃ − λ| = 2⁻⁹ < 1e-3 λ̃, λ̃ ≈ 2), a kinematic
-// tolerance of 1e-12 holds it to exchange 12, and with 1e-25 the step runs out of its 20 exchanges.
-TEST(CoupledStep, AReportedKinematicResidualMustAlsoConverge) {
+// A scalar interface for coupled_step by plain relaxation (ω = 1): the structure returns the load as
+// its displacement (so the displacement criterion is not the one tested), the fluid maps it by `map`.
+struct ScalarInterface {
   CouplingOptions options;
-  options.acceleration = Acceleration::constant_relaxation;
-  options.relaxation = 1.0;
-  options.relative_tolerance = 1e-3;
-  options.load_tolerance = 0.0;
-  options.displacement_tolerance = 1.0;  // the displacement is the load here: not the criterion tested
-  options.max_iterations = 20;
-  int exchange = 0;
-  const PartitionedSolvers solvers{
-      [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
-        d = load;
-        return true;
-      },
-      [&](const Eigen::VectorXd& d, const Eigen::VectorXd&, Eigen::VectorXd& next, std::string&) {
-        ++exchange;
-        next = Eigen::VectorXd::Constant(1, 1.0 + 0.5 * d(0));
-        return true;
-      },
-      [&] { return std::pow(10.0, -exchange); }};
-  const auto run = [&](double kinematic_tolerance) {
-    options.kinematic_tolerance = kinematic_tolerance;
-    exchange = 0;
+  std::function<double(double)> map;
+  std::function<double()> kinematic;  // optional
+  int exchanges = 0;
+  ScalarInterface(double relative_tolerance, int max_iterations) {
+    options.acceleration = Acceleration::constant_relaxation;
+    options.relaxation = 1.0;
+    options.relative_tolerance = relative_tolerance;
+    options.load_tolerance = 0.0;
+    options.displacement_tolerance = 1.0;
+    options.max_iterations = max_iterations;
+  }
+  CouplingStepReport run() {
+    exchanges = 0;
+    const PartitionedSolvers solvers{
+        [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
+          d = load;
+          return true;
+        },
+        [this](const Eigen::VectorXd& d, const Eigen::VectorXd&, Eigen::VectorXd& next, std::string&) {
+          ++exchanges;
+          next = Eigen::VectorXd::Constant(1, map(d(0)));
+          return true;
+        },
+        kinematic};
     InterfaceAccelerator accelerator(options);
     Eigen::VectorXd load = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
     return coupled_step(solvers, load, d, accelerator, options);
+  }
+};
+
+// λ = 1 + λ/2 (fixed point 2), the residual halving each exchange. With a kinematic residual reported
+// (here 10⁻ᵏ at exchange k), the step also waits for it: the load alone converges at exchange 10
+// (|λ̃ − λ| = 2⁻⁹ < 1e-3 λ̃, λ̃ ≈ 2), a kinematic tolerance of 1e-12 holds it to exchange 12, and with
+// 1e-25 the step runs out of its 20 exchanges.
+TEST(CoupledStep, AReportedKinematicResidualMustAlsoConverge) {
+  ScalarInterface scalar(1e-3, 20);
+  scalar.map = [](double load) { return 1.0 + 0.5 * load; };
+  scalar.kinematic = [&scalar] { return std::pow(10.0, -scalar.exchanges); };
+  const auto run = [&](double kinematic_tolerance) {
+    scalar.options.kinematic_tolerance = kinematic_tolerance;
+    return scalar.run();
   };
   const CouplingStepReport loose = run(1.0);
   ASSERT_TRUE(loose.converged);
@@ -618,46 +632,31 @@ TEST(CoupledStep, AReportedKinematicResidualMustAlsoConverge) {
 }
 
 // A step whose load change stops falling fails after stall_iterations exchanges without a new best,
-// where a slowly but steadily contracting one runs to convergence. λ̃ = c − ρλ with plain relaxation:
-// the change |λ̃ − λ| is multiplied by ρ each exchange (the closed form of this scalar iteration), so
-// ρ = 0.9 converges in ~90 exchanges and ρ = 1 (an oscillation of constant size) never improves.
+// where a slowly but steadily contracting one runs to convergence. λ̃ = 1 − ρλ: the change |λ̃ − λ| is
+// multiplied by ρ each exchange (the closed form of this scalar iteration), so ρ = 0.9 converges in
+// ~90 exchanges and ρ = 1 (an oscillation of constant size) never improves.
 TEST(CoupledStep, AStalledIterationFailsEarlyAndASlowOneConverges) {
-  CouplingOptions options;
-  options.acceleration = Acceleration::constant_relaxation;
-  options.relaxation = 1.0;
-  options.relative_tolerance = 1e-4;
-  options.load_tolerance = 0.0;
-  options.displacement_tolerance = 1.0;  // the displacement is the load here: not the criterion tested
-  options.max_iterations = 500;
-  options.stall_iterations = 6;
+  ScalarInterface scalar(1e-4, 500);
+  scalar.options.stall_iterations = 6;
   double rho = 0.0;
-  const PartitionedSolvers solvers{
-      [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
-        d = load;
-        return true;
-      },
-      [&](const Eigen::VectorXd& d, const Eigen::VectorXd&, Eigen::VectorXd& next, std::string&) {
-        next = Eigen::VectorXd::Constant(1, 1.0 - rho * d(0));
-        return true;
-      },
-      {}};
+  scalar.map = [&rho](double load) { return 1.0 - rho * load; };
   const auto run = [&](double contraction) {
     rho = contraction;
-    InterfaceAccelerator accelerator(options);
-    Eigen::VectorXd load = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
-    return coupled_step(solvers, load, d, accelerator, options);
+    return scalar.run();
   };
   const CouplingStepReport slow = run(0.9);
   ASSERT_TRUE(slow.converged) << slow.reason;
   EXPECT_GT(slow.iterations, 50);
   const CouplingStepReport stalled = run(1.0);
   EXPECT_FALSE(stalled.converged);
-  EXPECT_EQ(stalled.iterations, 1 + options.stall_iterations);  // the best is the first; six more without a better one
+  EXPECT_EQ(stalled.iterations, 1 + scalar.options.stall_iterations);  // the best is the first; six more without a better one
   EXPECT_NE(stalled.reason.find("stalled"), std::string::npos) << stalled.reason;
-  options.stall_iterations = 0;  // off: the oscillation runs to max_iterations
-  EXPECT_EQ(run(1.0).iterations, options.max_iterations);
+  scalar.options.stall_iterations = 0;  // off: the oscillation runs to max_iterations
+  EXPECT_EQ(run(1.0).iterations, scalar.options.max_iterations);
 }
 
+// A coupled step may solve the chip several times with different interface loads; the last trial is
+// what the step accepts, exactly as if that load had been the only one (dynamic, three steps).
 TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
   const spline::SplineCurve surface = periodic_curve(2, 16, kInterval, chip_height);
   const auto build = [&] {
