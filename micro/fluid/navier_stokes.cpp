@@ -110,6 +110,7 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
     const std::vector<int>& nodes = space_.element_nodes(e);
     const auto n = static_cast<Eigen::Index>(nodes.size());
     advect.resize(n);
+    dstrong.resize(static_cast<size_t>(n));
     Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
     Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
     for (const ParametricPoint& p : space_.element_points(e)) {
@@ -139,7 +140,6 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
       const Eigen::Matrix2d sym = d.gradient + d.gradient.transpose();
       // Per shape function b, once per point (not once per a): c·∇N_b, ΔN_b and ∂(strong_i)/∂v_bk =
       // ρ(δ_ik(N_b/Δt + c·∇N_b) + N_b ∂_k v_i) − μ(δ_ik ΔN_b + ∂_i∂_k N_b).
-      dstrong.resize(static_cast<size_t>(n));
       for (Eigen::Index b = 0; b < n; ++b) {
         advect(b) = c.dot(q.gradients.col(b));
         const Eigen::Matrix2d hb = hessian(q, b);
