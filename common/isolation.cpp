@@ -28,8 +28,9 @@ constexpr size_t kMaxMessageBytes = 4096;
 
 // fork() in a threaded process (the server's gRPC threads) copies every lock as it is: a child
 // forked while another thread held one (libasan 8 does not lock its allocator around fork; a
-// library's global mutex) waits for it forever. Parsing never sleeps: a child asleep without using
-// CPU for this long is such a child, and a fresh fork almost surely finds the lock free.
+// library's global mutex) waits for it forever, asleep or spinning. Parsing never does either: a child
+// that makes no progress (touched_anything, computed_in_user_space) for this long is such a child, and a fresh fork almost
+// surely finds the lock free.
 constexpr double kStalledSeconds = 2.0;
 constexpr int kForkAttempts = 3;
 constexpr int kActivityCheckMs = 250;
@@ -102,11 +103,13 @@ struct ChildOutcome {
   std::string message;  // what the child wrote to the pipe
 };
 
-// Whether the child sleeps (state S) and how much CPU it has used, from /proc/<pid>/stat
-// (proc(5): state is the 3rd field, utime and stime the 14th and 15th).
+// What the child has done, from /proc/<pid>/stat (proc(5): minflt is the 10th field,
+// utime and stime the 14th and 15th) and /proc/<pid>/io (bytes read and written by any means).
 struct ChildActivity {
-  bool sleeping = false;
-  unsigned long long cpu_ticks = 0;
+  unsigned long long minor_faults = 0;
+  unsigned long long user_ticks = 0;
+  unsigned long long system_ticks = 0;
+  unsigned long long io_bytes = 0;  // 0 where /proc/<pid>/io is not readable
 };
 
 std::optional<ChildActivity> child_activity(pid_t pid) {
@@ -116,13 +119,32 @@ std::optional<ChildActivity> child_activity(pid_t pid) {
   const auto name_end = line.rfind(')');  // the command name may hold spaces and parentheses
   if (name_end == std::string::npos) return std::nullopt;
   std::istringstream fields(line.substr(name_end + 1));
-  char state = 0;
-  fields >> state;
+  ChildActivity activity;
   std::string skipped;
-  for (int field = 4; field <= 13; ++field) fields >> skipped;
-  unsigned long long user = 0, system = 0;
-  if (!(fields >> user >> system)) return std::nullopt;
-  return ChildActivity{state == 'S', user + system};
+  for (int field = 3; field <= 9; ++field) fields >> skipped;
+  fields >> activity.minor_faults;
+  for (int field = 11; field <= 13; ++field) fields >> skipped;
+  if (!(fields >> activity.user_ticks >> activity.system_ticks)) return std::nullopt;
+  std::ifstream io("/proc/" + std::to_string(pid) + "/io");
+  std::string key;
+  unsigned long long value = 0;
+  while (io >> key >> value) {
+    if (key == "rchar:" || key == "wchar:") activity.io_bytes += value;
+  }
+  return activity;
+}
+
+// Parsing reads, writes, touches new memory or computes in user space (a large covariance is
+// refactorised without I/O). A child stuck on an inherited lock does none of these: a sleeping lock
+// leaves it asleep without CPU, a spinning one (libasan's StaticSpinMutex: sched_yield in a loop)
+// spends its CPU mostly in the kernel. The split of CPU time is judged over the whole stall window:
+// the clock ticks of a child that yields on a busy machine are too few to judge a single look by.
+bool touched_anything(const ChildActivity& before, const ChildActivity& now) {
+  return now.io_bytes != before.io_bytes || now.minor_faults != before.minor_faults;
+}
+
+bool computed_in_user_space(const ChildActivity& before, const ChildActivity& now) {
+  return now.user_ticks - before.user_ticks > now.system_ticks - before.system_ticks;
 }
 
 // One child: fork, run the rewrite, read its message until it exits, is out of time or stalls.
@@ -144,8 +166,8 @@ ChildOutcome run_child(const std::string& original, const std::string& copy_path
   ChildOutcome outcome;
   const auto now = [] { return std::chrono::steady_clock::now(); };
   const auto deadline = now() + std::chrono::duration<double>(limits.seconds);
-  auto last_progress = now();
-  unsigned long long last_cpu_ticks = 0;
+  auto window_start = now();
+  std::optional<ChildActivity> window_activity;  // the child's counters when the window started
   for (;;) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now());
     if (left.count() <= 0) {
@@ -157,9 +179,13 @@ ChildOutcome run_child(const std::string& original, const std::string& copy_path
     if (ready < 0 && errno != EINTR) break;
     if (ready <= 0) {
       const auto activity = child_activity(pid);
-      if (activity && (!activity->sleeping || activity->cpu_ticks != last_cpu_ticks)) last_progress = now();
-      if (activity) last_cpu_ticks = activity->cpu_ticks;
-      if (now() - last_progress > std::chrono::duration<double>(kStalledSeconds)) {
+      if (!activity) continue;
+      const bool window_over = now() - window_start > std::chrono::duration<double>(kStalledSeconds);
+      if (!window_activity || touched_anything(*window_activity, *activity) ||
+          (window_over && computed_in_user_space(*window_activity, *activity))) {
+        window_start = now();
+        window_activity = activity;
+      } else if (window_over) {
         outcome.end = ChildEnd::stalled;
         break;
       }
@@ -189,7 +215,7 @@ IsolatedCopy rewrite_in_child(const std::string& original, const std::string& wh
     outcome = run_child(original, copy.path(), rewrite, limits, fail);
     if (outcome.end != ChildEnd::stalled) break;
     if (attempt == kForkAttempts) {
-      throw fail("the checking process slept without progress in " + std::to_string(kForkAttempts) +
+      throw fail("the checking process waited without progress in " + std::to_string(kForkAttempts) +
                  " attempts (a lock held by another thread when it was forked); refused for now");
     }
   }
