@@ -3,16 +3,16 @@
 // to share (the sparse LU's supernodes): threads that spin in sched_yield cost more than they give.
 namespace mufric {
 
-// Limits OpenBLAS to one thread while the caller runs its own parallel loop; restores on exit.
+// Limits OpenBLAS to one thread while any guard is alive, in any thread; the last guard to go
+// restores the count the first one found.
 class SingleThreadedBlas {
  public:
   SingleThreadedBlas();
   ~SingleThreadedBlas();
   SingleThreadedBlas(const SingleThreadedBlas&) = delete;
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
-
- private:
-  int previous_;
 };
+
+int blas_threads();  // OpenBLAS's current thread count
 
 }  // namespace mufric
