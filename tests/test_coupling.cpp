@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -580,7 +581,9 @@ struct ScalarInterface {
   CouplingOptions options;
   std::function<double(double)> map;
   std::function<double()> kinematic;  // optional
+  double solvable_load = std::numeric_limits<double>::infinity();  // the structure fails beyond |λ| > this
   int exchanges = 0;
+  double converged_load = 0.0;  // the step's load on return
   ScalarInterface(double relative_tolerance, int max_iterations) {
     options.acceleration = Acceleration::constant_relaxation;
     options.relaxation = 1.0;
@@ -592,7 +595,11 @@ struct ScalarInterface {
   CouplingStepReport run() {
     exchanges = 0;
     const PartitionedSolvers solvers{
-        [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
+        [this](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string& why) {
+          if (std::abs(load(0)) > solvable_load) {
+            why = "load out of reach";
+            return false;
+          }
           d = load;
           return true;
         },
@@ -603,8 +610,10 @@ struct ScalarInterface {
         },
         kinematic};
     InterfaceAccelerator accelerator(options);
-    Eigen::VectorXd load = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
-    return coupled_step(solvers, load, d, accelerator, options);
+    Eigen::VectorXd start = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
+    const CouplingStepReport report = coupled_step(solvers, start, d, accelerator, options);
+    converged_load = start(0);
+    return report;
   }
 };
 
@@ -653,6 +662,26 @@ TEST(CoupledStep, AStalledIterationFailsEarlyAndASlowOneConverges) {
   EXPECT_NE(stalled.reason.find("stalled"), std::string::npos) << stalled.reason;
   scalar.options.stall_iterations = 0;  // off: the oscillation runs to max_iterations
   EXPECT_EQ(run(1.0).iterations, scalar.options.max_iterations);
+}
+
+// A solver failing on an iterate restarts the step from the last solved iterate with half the
+// relaxation. λ̃ = 1 − 2λ (fixed point 1/3): with ω = 1 the iterates are 0, 1, −1, 3 (the change grows
+// by −2 each exchange) and the structure fails at λ = 3 (beyond 1.5). Restarted from λ = −1 (image 3)
+// with ω = 1/2, the error is multiplied by 1 − 3ω = −1/2 per exchange and the step converges to 1/3.
+TEST(CoupledStep, ASolverFailureRestartsFromTheLastSolvedIterate) {
+  ScalarInterface scalar(1e-10, 200);
+  scalar.map = [](double load) { return 1.0 - 2.0 * load; };
+  scalar.solvable_load = 1.5;
+  const CouplingStepReport failed = scalar.run();
+  EXPECT_FALSE(failed.converged);
+  EXPECT_EQ(failed.restarts, 0);
+  EXPECT_NE(failed.reason.find("structure solve failed at coupling iteration 4: load out of reach"), std::string::npos)
+      << failed.reason;
+  scalar.options.max_restarts = 1;
+  const CouplingStepReport restarted = scalar.run();
+  ASSERT_TRUE(restarted.converged) << restarted.reason;
+  EXPECT_EQ(restarted.restarts, 1);
+  EXPECT_NEAR(scalar.converged_load, 1.0 / 3.0, 1e-9);
 }
 
 // A coupled step may solve the chip several times with different interface loads; the last trial is

@@ -208,6 +208,51 @@ TEST(FluidVerification, LidDrivenCavityMatchesGhiaAtRe100) {
   EXPECT_LE(r.report.newton_iterations, 10);
 }
 
+// Liquid pumped into the closed channel through its bottom at V (v = (0, V(1 − y/H)), linear, so in
+// the space): an incompressible liquid admits no such flow and the step is refused; a compressible one
+// compresses uniformly, ∂(ln ρ)/∂t = −∇·v = V/H, so after n backward-Euler steps ln(ρ/ρ₀) = nΔtV/H
+// everywhere, and the density law's inverse gives p (closed form): p = K₀ q for a linear density and
+// K₀ q / (1 − q b K₀) for Dowson–Higginson's, q = e^(nΔtV/H) − 1. (Convection adds ρV² ≈ 1e-3 Pa
+// across the channel, ~1e-7 of it; the two laws differ by ~2e-5 here.)
+TEST(FluidChannel, ACompressibleLiquidTakesTheInflowAsUniformCompression) {
+  const double speed = 1e-3, dt = 1e-9, bulk = 1.0 / 0.6e-9;  // m/s, s, Pa (Dowson–Higginson's K₀)
+  const auto exact = [&](const Eigen::Vector2d& x) { return Eigen::Vector2d(0.0, speed * (1.0 - x.y() / kHeight)); };
+  const auto walls = [&](NavierStokes& ns) {
+    ns.set_conditions({{Side::bottom, SideConditionKind::velocity, [&](const Eigen::Vector2d& x, double) { return exact(x); }, {}, 0.0},
+                       {Side::top, SideConditionKind::velocity, constant(Eigen::Vector2d::Zero()), {}, 0.0}});
+    Eigen::VectorXd state = Eigen::VectorXd::Zero(3 * ns.space().node_count());
+    for (int a = 0; a < ns.space().node_count(); ++a) state.segment<2>(3 * a) = exact(ns.space().node_position(a));
+    ns.set_state(state);
+  };
+  NavierStokes incompressible = channel(6, 4);
+  walls(incompressible);
+  const FluidStepReport refused = incompressible.step(dt);
+  EXPECT_FALSE(refused.converged);
+  EXPECT_NE(refused.reason.find("no incompressible flow satisfies it"), std::string::npos) << refused.reason;
+
+  for (const double stiffening : {0.0, 1.7e-9}) {
+  NavierStokesOptions o;
+  o.fluid = kOil;
+  o.fluid.bulk_modulus = bulk;
+  o.fluid.pressure_stiffening = stiffening;
+  NavierStokes ns(FluidSpace(rectangle_patch(2, 6, 4, Eigen::Vector2d::Zero(), Eigen::Vector2d(kLength, kHeight), true)), o);
+  walls(ns);
+  for (int n = 1; n <= 3; ++n) {
+    const FluidStepReport r = ns.step(dt);
+    ASSERT_TRUE(r.converged) << r.reason;
+    const double q = std::expm1(n * dt * speed / kHeight);
+    const double expected = bulk * q / (1.0 - q * stiffening * bulk);  // ≈ 3 kPa per step
+    for (int i = 0; i <= 8; ++i) {
+      for (int j = 0; j <= 8; ++j) {
+        const double x = kLength * i / 8.0 * 0.999, y = kHeight * j / 8.0;
+        EXPECT_NEAR(ns.pressure_at(x, y), expected, 1e-6 * expected) << "b " << stiffening << ", step " << n << " at " << x << ", " << y;
+        EXPECT_LT((ns.velocity_at(x, y) - exact(Eigen::Vector2d(x, y))).norm(), 1e-7 * speed);  // Newton tolerance
+      }
+    }
+  }
+  }
+}
+
 TEST(FluidAle, ShearFlowOnAMovingMeshStaysExact) {
   // A steady shear flow v = (a + U y/H, 0) is linear, so it lies in the space however the mesh
   // moves; its nodal values must follow the moving control points exactly, which the backward-Euler

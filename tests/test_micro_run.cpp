@@ -369,6 +369,9 @@ TEST(Lubricated, TheDefaultLubricatedSceneIsTheDryOneWithTheLubricant) {
   EXPECT_DOUBLE_EQ(written.robin_stiffness, absent.robin_stiffness);
   EXPECT_EQ(written.max_coupling_iterations, absent.max_coupling_iterations);
   EXPECT_EQ(written.stall_iterations, absent.stall_iterations);
+  EXPECT_EQ(written.coupling_restarts, absent.coupling_restarts);
+  EXPECT_EQ(written.compressibility, absent.compressibility);
+  EXPECT_DOUBLE_EQ(written.bulk_modulus, absent.bulk_modulus);
   EXPECT_DOUBLE_EQ(written.cavitation_pressure, absent.cavitation_pressure);
   EXPECT_DOUBLE_EQ(written.coupling_tolerance, absent.coupling_tolerance);
   EXPECT_DOUBLE_EQ(written.volume_tolerance, absent.volume_tolerance);

@@ -70,6 +70,7 @@ double robin_weight(const LubricantOptions& options, double dt);
 // What one accepted step did at the interface.
 struct LubricatedStep {
   int coupling_iterations = 0;
+  int coupling_restarts = 0;           // of the interface iteration after a solver failed (CouplingOptions::max_restarts)
   int fluid_newton_iterations = 0;     // summed over the coupling iterations
   double min_relative_jacobian = 1.0;  // of the film's mesh
   Eigen::Vector2d fluid_force = Eigen::Vector2d::Zero();  // on the chip, N per unit depth

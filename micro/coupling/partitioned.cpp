@@ -26,7 +26,14 @@ InterfaceAccelerator::InterfaceAccelerator(CouplingOptions options) : options_(o
 void InterfaceAccelerator::begin_step() {
   residuals_.clear();
   outputs_.clear();
-  aitken_omega_ = options_.relaxation;
+  relaxation_ = options_.relaxation;
+  aitken_omega_ = relaxation_;
+}
+
+void InterfaceAccelerator::restart_step(double relaxation) {
+  forget_past_steps();
+  begin_step();
+  relaxation_ = aitken_omega_ = relaxation;
 }
 
 void InterfaceAccelerator::end_step() {
@@ -50,7 +57,7 @@ Eigen::VectorXd InterfaceAccelerator::next(const Eigen::VectorXd& x, const Eigen
   columns_used_ = 0;
   switch (options_.acceleration) {
     case Acceleration::constant_relaxation:
-      return x + options_.relaxation * r;
+      return x + relaxation_ * r;
     case Acceleration::aitken: {
       if (k > 0) {
         const Eigen::VectorXd dr = r - residuals_[k - 1];
@@ -73,7 +80,7 @@ Eigen::VectorXd InterfaceAccelerator::next(const Eigen::VectorXd& x, const Eigen
   for (const auto& [dr, dx] : reused_) {
     for (Eigen::Index c = dr.cols() - 1; c >= 0; --c) v.emplace_back(dr.col(c)), w.emplace_back(dx.col(c));
   }
-  if (v.empty()) return x + options_.relaxation * r;
+  if (v.empty()) return x + relaxation_ * r;
   // QR by modified Gram–Schmidt with the filter: a column that keeps less than qr_filter of its norm
   // after removing the newer columns' directions adds only noise to the least-squares model.
   std::vector<Eigen::VectorXd> q;
@@ -96,7 +103,7 @@ Eigen::VectorXd InterfaceAccelerator::next(const Eigen::VectorXd& x, const Eigen
     q.push_back(u / remaining);
     kept.push_back(c);
   }
-  if (kept.empty()) return x + options_.relaxation * r;
+  if (kept.empty()) return x + relaxation_ * r;
   const auto m = static_cast<Eigen::Index>(kept.size());
   // min |V c + r|: R c = −Qᵀ r, then x_(k+1) = x̃ + W c.
   Eigen::VectorXd rhs(m);
@@ -113,19 +120,37 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
   CouplingStepReport report;
   const Eigen::VectorXd start_load = load, start = displacement;
   Eigen::VectorXd lambda = load, lambda_tilde, d, d_previous = displacement;
+  // The last iterate both solvers took, and its image: where a restart goes back to.
+  Eigen::VectorXd lambda_solved, lambda_tilde_solved;
+  double restart_relaxation = options.relaxation;
   double best_load_residual = std::numeric_limits<double>::infinity();
   int best_iteration = 0;
   accelerator.begin_step();
   for (int it = 1; it <= options.max_iterations; ++it) {
     std::string reason;
+    const char* failed = nullptr;
     if (!solvers.structure(lambda, d, reason)) {
-      report.reason = "structure solve failed at coupling iteration " + std::to_string(it) + ": " + reason;
-      break;
+      failed = "structure";
+    } else if (!solvers.fluid(d, lambda, lambda_tilde, reason)) {
+      failed = "fluid";
     }
-    if (!solvers.fluid(d, lambda, lambda_tilde, reason)) {
-      report.reason = "fluid solve failed at coupling iteration " + std::to_string(it) + ": " + reason;
-      break;
+    if (failed != nullptr) {
+      if (lambda_solved.size() == 0 || report.restarts >= options.max_restarts) {
+        report.reason = std::string(failed) + " solve failed at coupling iteration " + std::to_string(it) + ": " + reason;
+        break;
+      }
+      // A safeguarded quasi-Newton: the accelerated iterate left the region the solvers can take
+      // (a chip solve that cannot follow the load). Its secant model, this step's and the past
+      // steps', has misled it: it is dropped, and the iteration restarts from the last solved
+      // iterate with a relaxation halved at each restart, which tends to that solvable iterate.
+      ++report.restarts;
+      restart_relaxation *= 0.5;
+      accelerator.restart_step(restart_relaxation);
+      lambda = lambda_solved + restart_relaxation * (lambda_tilde_solved - lambda_solved);
+      continue;
     }
+    lambda_solved = lambda;
+    lambda_tilde_solved = lambda_tilde;
     if (lambda_tilde.size() != lambda.size()) throw Error("coupling: the fluid returned a load of another size");
     report.iterations = it;
     const double load_residual = (lambda_tilde - lambda).norm();

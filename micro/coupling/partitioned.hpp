@@ -38,6 +38,9 @@ struct CouplingOptions {
   // mostly in a chip solve that spent its 30 Newton iterations first — and its cut-back retry is
   // cheaper than the rest of it.
   int stall_iterations = 0;
+  // A solver that fails on an accelerated iterate restarts the step's iteration this many times
+  // (from the last iterate both solvers took, with plain relaxation) before the step fails.
+  int max_restarts = 0;
 };
 
 // The interface fixed-point accelerator; keeps what it learns from one time step to the next.
@@ -48,6 +51,9 @@ class InterfaceAccelerator {
   // The next iterate from the iterate x and its image x̃.
   Eigen::VectorXd next(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde);
   void end_step();  // a converged step: its secant pairs join the reuse store
+  // Starts the step's iteration over with this relaxation (for the rest of the step) and without any
+  // secant pairs, the past steps' included: they led the iteration where a solver failed.
+  void restart_step(double relaxation);
   // Drops the past steps' pairs: the map they sampled is not this step's (another step length).
   void forget_past_steps() { reused_.clear(); }
   int columns_used() const { return columns_used_; }  // IQN-ILS: secant pairs in the last update
@@ -58,6 +64,7 @@ class InterfaceAccelerator {
   std::vector<Eigen::VectorXd> residuals_, outputs_;
   // Past steps' secant pairs: columns ΔR (residual differences) and ΔX̃ (output differences).
   std::deque<std::pair<Eigen::MatrixXd, Eigen::MatrixXd>> reused_;
+  double relaxation_ = 0.0;  // this step's: options_.relaxation unless restarted
   double aitken_omega_ = 0.0;
   int columns_used_ = 0;
 };
@@ -79,6 +86,7 @@ struct CouplingStepReport {
   bool converged = false;
   std::string reason;
   int iterations = 0;                      // structure–fluid exchanges
+  int restarts = 0;                        // restarts after a solver failed on an accelerated iterate
   std::vector<double> load_residuals;      // |λ̃ − λ| per iteration
   std::vector<double> displacement_changes;  // |d_k − d_(k−1)| per iteration (d_(−1): the predictor)
   std::vector<double> kinematic_residuals;   // per iteration, when the solvers report one

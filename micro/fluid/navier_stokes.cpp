@@ -35,13 +35,35 @@ double robin_weight_at(const SideCondition& c, const Eigen::Vector2d& x, double 
   return c.robin_share ? c.robin_weight * c.robin_share(x, t) : c.robin_weight;
 }
 
+void check_properties(const FluidProperties& fluid) {
+  if (!(fluid.density > 0.0) || !(fluid.viscosity > 0.0)) throw Error("fluid: density and viscosity must be positive");
+  if (!(fluid.bulk_modulus >= 0.0) || !std::isfinite(fluid.bulk_modulus)) {
+    throw Error("fluid: bulk_modulus must be finite and >= 0 (0: incompressible)");
+  }
+  if (!(fluid.pressure_stiffening >= 0.0) || !std::isfinite(fluid.pressure_stiffening)) {
+    throw Error("fluid: pressure_stiffening must be finite and >= 0");
+  }
+}
+
 }  // namespace
+
+double log_density_ratio(const FluidProperties& fluid, double pressure) {
+  if (!(fluid.bulk_modulus > 0.0)) return 0.0;
+  if (pressure < 0.0) return pressure / fluid.bulk_modulus;
+  return std::log1p(pressure / fluid.bulk_modulus / (1.0 + fluid.pressure_stiffening * pressure));
+}
+
+double log_density_ratio_derivative(const FluidProperties& fluid, double pressure) {
+  if (!(fluid.bulk_modulus > 0.0)) return 0.0;
+  if (pressure < 0.0) return 1.0 / fluid.bulk_modulus;
+  const double stiffened = 1.0 + fluid.pressure_stiffening * pressure;
+  const double excess = pressure / fluid.bulk_modulus / stiffened;  // ρ/ρ₀ − 1
+  return 1.0 / (fluid.bulk_modulus * stiffened * stiffened) / (1.0 + excess);
+}
 
 NavierStokes::NavierStokes(FluidSpace space, NavierStokesOptions options)
     : space_(std::move(space)), options_(std::move(options)) {
-  if (!(options_.fluid.density > 0.0) || !(options_.fluid.viscosity > 0.0)) {
-    throw Error("fluid: density and viscosity must be positive");
-  }
+  check_properties(options_.fluid);
   if (options_.pinned_pressure_node && (*options_.pinned_pressure_node < 0 || *options_.pinned_pressure_node >= space_.node_count())) {
     throw Error("fluid: pinned_pressure_node is not a control point of the patch");
   }
@@ -51,7 +73,7 @@ NavierStokes::NavierStokes(FluidSpace space, NavierStokesOptions options)
 }
 
 void NavierStokes::set_properties(const FluidProperties& fluid) {
-  if (!(fluid.density > 0.0) || !(fluid.viscosity > 0.0)) throw Error("fluid: density and viscosity must be positive");
+  check_properties(fluid);
   options_.fluid = fluid;
 }
 
@@ -89,6 +111,9 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
                             Eigen::VectorXd& residual, Eigen::SparseMatrix<double>& jacobian) const {
   const double rho = options_.fluid.density, mu = options_.fluid.viscosity, nu = mu / rho;
   const double inv_dt = dt > 0.0 ? 1.0 / dt : 0.0;
+  // ∂(ln ρ)/∂t at the mesh's points (ALE), backward Euler; the convective part c·∇(ln ρ) is left
+  // out: the liquid's speeds are ~1e-7 of its sound speed, so it is that much smaller than ∇·v.
+  const bool compressible = options_.fluid.bulk_modulus > 0.0 && inv_dt > 0.0;
   const Eigen::Vector2d body = options_.body_force;
   residual = Eigen::VectorXd::Zero(state_.size());
   std::vector<Eigen::Triplet<double>> triplets;
@@ -119,6 +144,12 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
       const Eigen::Vector2d v = velocity(p), v_old = FluidSpace::interpolate2(p, old_state_, 3, 0);
       const Eigen::Vector2d w = FluidSpace::interpolate2(p, mesh_velocity_, 2, 0);
       const double pressure_here = pressure(p);
+      double density_rate = 0.0, density_rate_per_pressure = 0.0;  // ∂(ln ρ)/∂t and its derivative in p
+      if (compressible) {
+        const double old_pressure = FluidSpace::interpolate1(p, old_state_, 3, 2);
+        density_rate = inv_dt * (log_density_ratio(options_.fluid, pressure_here) - log_density_ratio(options_.fluid, old_pressure));
+        density_rate_per_pressure = inv_dt * log_density_ratio_derivative(options_.fluid, pressure_here);
+      }
       VelocityDerivatives d;
       for (Eigen::Index a = 0; a < n; ++a) {
         const Eigen::Vector2d va = state_.segment<2>(3 * nodes[static_cast<size_t>(a)]);
@@ -155,7 +186,7 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
           r(3 * a + i) += wt * (na * (inertia(i) - rho * body(i)) + mu * sym.row(i).dot(ga) - pressure_here * ga(i) +
                                 tau_m * advect(a) * strong(i) + rho * nu_c * ga(i) * divergence);
         }
-        r(3 * a + 2) += wt * (na * divergence + tau_m / rho * ga.dot(strong));
+        r(3 * a + 2) += wt * (na * (divergence + density_rate) + tau_m / rho * ga.dot(strong));
         for (Eigen::Index b = 0; b < n; ++b) {
           const double nb = q.values(b);
           const Eigen::Vector2d gb = q.gradients.col(b);
@@ -173,7 +204,7 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
           for (int kk = 0; kk < 2; ++kk) {
             k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(ds.col(kk)));
           }
-          k(3 * a + 2, 3 * b + 2) += wt * tau_m / rho * ga.dot(gb);
+          k(3 * a + 2, 3 * b + 2) += wt * (tau_m / rho * ga.dot(gb) + na * density_rate_per_pressure * nb);
         }
       }
     }
@@ -281,6 +312,7 @@ FluidStepReport NavierStokes::solve_step(double dt) {
 }
 
 std::string NavierStokes::enclosed_flux_violation() const {
+  if (options_.fluid.bulk_modulus > 0.0) return {};  // a compressible liquid takes any flux
   std::vector<char> given(4, 0);
   for (const auto& c : conditions_) {
     if (c.kind != SideConditionKind::velocity) return {};  // a traction or Robin side lets the volume change

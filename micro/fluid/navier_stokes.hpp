@@ -23,7 +23,18 @@ namespace mufric::fluid {
 struct FluidProperties {  // seed 000 Table 2
   double density = 800.0;     // kg/m³
   double viscosity = 0.032;   // Pa s (dynamic)
+  // K₀, Pa: 0 is incompressible (seed 000). A finite K₀ makes the liquid barotropic, ρ(p)/ρ₀ =
+  // 1 + (p/K₀)/(1 + b p), and continuity D(ln ρ)/Dt + ∇·v = 0: a sealed pocket squeezed by ΔV/V takes
+  // a pressure of about K₀ ΔV/V instead of an unbounded one. b = 0 is a linear density; b = 1.7 GPa⁻¹
+  // with K₀ = 1/0.6 GPa⁻¹ is Dowson & Higginson's (Elasto-hydrodynamic Lubrication, 1966) law for
+  // mineral oils, whose density saturates at 1 + 1/(K₀ b) of ρ₀. Below p = 0 (a traction the
+  // liquid does not hold for long) the density stays linear in p with the slope at 0.
+  double bulk_modulus = 0.0;
+  double pressure_stiffening = 0.0;  // b, 1/Pa
 };
+// ln(ρ(p)/ρ₀) of FluidProperties' density law and its derivative in p.
+double log_density_ratio(const FluidProperties& fluid, double pressure);
+double log_density_ratio_derivative(const FluidProperties& fluid, double pressure);
 
 // Newton stops when the residual of the free equations falls below this fraction of the first
 // iterate's, or every equation's residual below this fraction of the size of its own terms (or the

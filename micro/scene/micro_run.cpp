@@ -148,6 +148,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
   if (lubricant) {
     j["lubricant"] = {{"coupling_iterations", lubricant->coupling_iterations},
                       {"max_coupling_iterations_per_step", lubricant->max_coupling_iterations},
+                      {"coupling_restarts", lubricant->coupling_restarts},
                       {"fluid_newton_iterations", lubricant->fluid_newton_iterations},
                       {"min_relative_jacobian", lubricant->min_relative_jacobian},
                       {"film_area_m2_per_m", {lubricant->initial_film_area, lubricant->final_film_area}},
@@ -254,7 +255,10 @@ namespace {
 coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_start) {
   const LubricantSpec& l = scene.lubricant;
   coupling::LubricantOptions o;
-  o.fluid = {l.density, l.viscosity};
+  // Dowson & Higginson's (1966) pressure stiffening of the density law, 1.7 GPa⁻¹.
+  constexpr double kDowsonHigginsonStiffening = 1.7e-9;
+  o.fluid = {l.density, l.viscosity, l.compressibility == "none" ? 0.0 : l.bulk_modulus,
+             l.compressibility == "dowson-higginson" ? kDowsonHigginsonStiffening : 0.0};
   o.mesh.degree = 2;  // equal-order quadratic velocity and pressure
   o.mesh.elements_x = l.elements_x > 0 ? l.elements_x : scene.elements_x;
   o.mesh.elements_y = l.elements_y;
@@ -278,6 +282,7 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.coupling.kinematic_tolerance = l.volume_tolerance;
   o.coupling.max_iterations = l.max_coupling_iterations;
   o.coupling.stall_iterations = l.stall_iterations;
+  o.coupling.max_restarts = l.coupling_restarts;
   return o;
 }
 
@@ -423,6 +428,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     auto& l = *result.lubricant;
     for (const auto& h : lubricant->history()) {
       l.coupling_iterations += h.coupling_iterations;
+      l.coupling_restarts += h.coupling_restarts;
       l.max_coupling_iterations = std::max(l.max_coupling_iterations, h.coupling_iterations);
       l.fluid_newton_iterations += h.fluid_newton_iterations;
       l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);

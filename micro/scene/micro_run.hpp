@@ -40,6 +40,7 @@ struct MicroStep {
 // inside std::optional while the enclosing class is incomplete.)
 struct LubricantRecord {
   int coupling_iterations = 0, max_coupling_iterations = 0, fluid_newton_iterations = 0;
+  int coupling_restarts = 0;  // in the accepted steps
   double min_relative_jacobian = 1.0;
   double initial_film_area = 0.0, final_film_area = 0.0;  // m² per unit depth, when formed and at the end
   double initial_liquid_area = 0.0, final_liquid_area = 0.0;  // the same of the liquid (film less cavities)

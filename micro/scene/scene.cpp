@@ -277,6 +277,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     auto& l = s.lubricant;
     l.density = f.number("density", l.density, 1.0, 1e5);
     l.viscosity = f.number("viscosity", l.viscosity, 1e-6, 1e6);
+    l.compressibility = f.text("compressibility", l.compressibility, {"none", "linear", "dowson-higginson"});
+    l.bulk_modulus = f.quantity("bulk_modulus", QuantityKind::pressure, l.bulk_modulus, 1e6, 1e13);
     l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
     l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
     l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
@@ -299,6 +301,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     l.volume_tolerance = f.number("volume_tolerance", l.volume_tolerance, 1e-14, 1.0);
     l.max_coupling_iterations = f.integer("max_coupling_iterations", l.max_coupling_iterations, 1, 10000);
     l.stall_iterations = f.integer("stall_iterations", l.stall_iterations, 0, 10000);
+    l.coupling_restarts = f.integer("coupling_restarts", l.coupling_restarts, 0, 100);
     f.finish();
   }
   {

@@ -51,6 +51,11 @@ inline constexpr double kAccelerationShareOfRunIn = 0.25;
 struct LubricantSpec {
   double density = 800.0;      // kg/m³ (seed 000 Table 2)
   double viscosity = 0.032;    // Pa s (seed 000 Table 2)
+  // "none" (incompressible, seed 000), "linear" (ρ/ρ₀ = 1 + p/K₀) or "dowson-higginson" (ρ/ρ₀ =
+  // 1 + (p/K₀)/(1 + 1.7 GPa⁻¹ p)); K₀ the bulk modulus at p = 0, Dowson & Higginson's 1/(0.6 GPa⁻¹) by
+  // default (fluid::FluidProperties).
+  std::string compressibility = "none";
+  double bulk_modulus = 1e9 / 0.6;  // Pa
   int elements_x = 0;          // film columns; 0: the chip's discretisation.elements_x
   int elements_y = 4;          // elements across the film
   // m, the film where the chip touches the tool. 20 nm: thinner ones (5, 10 nm) stop the coarse
@@ -89,6 +94,9 @@ struct LubricantSpec {
   int max_coupling_iterations = 50;
   // Exchanges without a new best traction change after which a step fails and is cut back (0: never).
   int stall_iterations = 0;
+  // Restarts of a step's interface iteration after a solver failed on an accelerated iterate,
+  // before the step fails and is cut back (CouplingOptions::max_restarts).
+  int coupling_restarts = 0;
 };
 
 struct Scene {
