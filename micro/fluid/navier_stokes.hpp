@@ -32,6 +32,9 @@ struct FluidProperties {  // seed 000 Table 2
   double bulk_modulus = 0.0;
   double pressure_stiffening = 0.0;  // b, 1/Pa
 };
+// Dowson & Higginson's (1966) law: K₀ = 1/(0.6 GPa⁻¹), b = 1.7 GPa⁻¹.
+inline constexpr double kDowsonHigginsonBulkModulus = 1e9 / 0.6;  // Pa
+inline constexpr double kDowsonHigginsonStiffening = 1.7e-9;      // 1/Pa
 // ln(ρ(p)/ρ₀) of FluidProperties' density law and its derivative in p.
 double log_density_ratio(const FluidProperties& fluid, double pressure);
 double log_density_ratio_derivative(const FluidProperties& fluid, double pressure);

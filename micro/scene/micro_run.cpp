@@ -255,10 +255,8 @@ namespace {
 coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_start) {
   const LubricantSpec& l = scene.lubricant;
   coupling::LubricantOptions o;
-  // Dowson & Higginson's (1966) pressure stiffening of the density law, 1.7 GPa⁻¹.
-  constexpr double kDowsonHigginsonStiffening = 1.7e-9;
   o.fluid = {l.density, l.viscosity, l.compressibility == "none" ? 0.0 : l.bulk_modulus,
-             l.compressibility == "dowson-higginson" ? kDowsonHigginsonStiffening : 0.0};
+             l.compressibility == "dowson-higginson" ? fluid::kDowsonHigginsonStiffening : 0.0};
   o.mesh.degree = 2;  // equal-order quadratic velocity and pressure
   o.mesh.elements_x = l.elements_x > 0 ? l.elements_x : scene.elements_x;
   o.mesh.elements_y = l.elements_y;

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "micro/fluid/navier_stokes.hpp"
 #include "micro/solid/materials.hpp"
 #include "micro/solid/time_integrator.hpp"
 #include "micro/spline/profile.hpp"
@@ -55,7 +56,7 @@ struct LubricantSpec {
   // 1 + (p/K₀)/(1 + 1.7 GPa⁻¹ p)); K₀ the bulk modulus at p = 0, Dowson & Higginson's 1/(0.6 GPa⁻¹) by
   // default (fluid::FluidProperties).
   std::string compressibility = "none";
-  double bulk_modulus = 1e9 / 0.6;  // Pa
+  double bulk_modulus = fluid::kDowsonHigginsonBulkModulus;  // Pa
   int elements_x = 0;          // film columns; 0: the chip's discretisation.elements_x
   int elements_y = 4;          // elements across the film
   // m, the film where the chip touches the tool. 20 nm: thinner ones (5, 10 nm) stop the coarse
