@@ -28,9 +28,9 @@ constexpr size_t kMaxMessageBytes = 4096;
 
 // fork() in a threaded process (the server's gRPC threads) copies every lock as it is: a child
 // forked while another thread held one (libasan 8 does not lock its allocator around fork; a
-// library's global mutex) waits for it forever, asleep or spinning. Parsing never does either: a child
-// that makes no progress (touched_anything, computed_in_user_space) for this long is such a child, and a fresh fork almost
-// surely finds the lock free.
+// library's global mutex) waits for it forever, asleep or spinning. Parsing never does either: a
+// child that makes no progress (touched_anything, computed_in_user_space) for this long is such a
+// child, and a fresh fork almost surely finds the lock free.
 constexpr double kStalledSeconds = 2.0;
 constexpr int kForkAttempts = 3;
 constexpr int kActivityCheckMs = 250;
