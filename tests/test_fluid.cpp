@@ -4,9 +4,11 @@
 // lid-driven cavity, and a uniform flow on a moving mesh (geometric conservation).
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "common/error.hpp"
 #include "micro/fluid/cavity.hpp"
 #include "micro/fluid/mesh_update.hpp"
 #include "micro/fluid/navier_stokes.hpp"
@@ -251,6 +253,101 @@ TEST(FluidChannel, ACompressibleLiquidTakesTheInflowAsUniformCompression) {
     }
   }
   }
+}
+
+// The same inflow taken by a liquid that leaves the plane: ∇·v = −κ(p − p_a) with v_y = V(1 − y/H)
+// gives the uniform p = p_a + V/(κH), steady, and the whole inflow V·L leaves by the leak.
+TEST(FluidChannel, ALeakingLiquidTakesTheInflowAtTheLeakPressure) {
+  const double speed = 1e-3, dt = 1e-9, ambient = 2e5;  // m/s, s, Pa
+  const double leak = speed / (kHeight * 1e4);           // κ, 1/(Pa s): 10 kPa over ambient
+  const auto exact = [&](const Eigen::Vector2d& x) { return Eigen::Vector2d(0.0, speed * (1.0 - x.y() / kHeight)); };
+  NavierStokes ns = channel(6, 4);
+  ns.set_conditions({{Side::bottom, SideConditionKind::velocity, [&](const Eigen::Vector2d& x, double) { return exact(x); }, {}, 0.0},
+                     {Side::top, SideConditionKind::velocity, constant(Eigen::Vector2d::Zero()), {}, 0.0}});
+  ns.set_leak({[leak](const Eigen::Vector2d&, double) { return leak; }, ambient});
+  const double expected = ambient + speed / (leak * kHeight);
+  Eigen::VectorXd state = Eigen::VectorXd::Zero(3 * ns.space().node_count());  // the steady flow from the start
+  for (int a = 0; a < ns.space().node_count(); ++a) state.segment<2>(3 * a) = exact(ns.space().node_position(a));
+  ns.set_state(state);
+  for (int n = 1; n <= 2; ++n) {
+    const FluidStepReport r = ns.step(dt);
+    ASSERT_TRUE(r.converged) << r.reason;
+    for (int i = 0; i <= 8; ++i) {
+      for (int j = 0; j <= 8; ++j) {
+        const double x = kLength * i / 8.0 * 0.999, y = kHeight * j / 8.0;
+        // The convective term ρ v·∇v ~ ρV²/H, left out of the closed form, is ~1e-9 of the pressure here.
+        EXPECT_NEAR(ns.pressure_at(x, y), expected, 1e-6 * (expected - ambient)) << "step " << n << " at " << x << ", " << y;
+        EXPECT_LT((ns.velocity_at(x, y) - exact(Eigen::Vector2d(x, y))).norm(), 1e-7 * speed);
+      }
+    }
+    EXPECT_NEAR(ns.leak_rate(), speed * kLength, 1e-6 * speed * kLength);
+  }
+}
+
+// κ = h²/(6ηL²) against a finite-difference solve of the out-of-plane Reynolds flow it stands for:
+// d/dz(h³/(12η) dp/dz) = s h over −L < z < L with p(±L) = 0 and a uniform sink s; κ = s/p(0).
+TEST(FluidLeak, TheCoefficientIsTheOutOfPlaneReynoldsFlows) {
+  const double film = 0.3e-6, viscosity = 0.032, half_width = 2e-6, sink = 1e6;  // m, Pa s, m, 1/s
+  const int n = 400;  // interior nodes of −L < z < L
+  const double dz = 2.0 * half_width / (n + 1), conductance = film * film * film / (12.0 * viscosity);
+  // −c(p_{i−1} − 2p_i + p_{i+1})/dz² = s h by the Thomas algorithm (tridiagonal Gaussian elimination).
+  std::vector<double> diagonal(n, 2.0 * conductance / (dz * dz)), rhs(n, sink * film);
+  const double off = -conductance / (dz * dz);
+  for (int i = 1; i < n; ++i) {
+    const double m = off / diagonal[i - 1];
+    diagonal[i] -= m * off;
+    rhs[i] -= m * rhs[i - 1];
+  }
+  std::vector<double> p(n);
+  p[n - 1] = rhs[n - 1] / diagonal[n - 1];
+  for (int i = n - 2; i >= 0; --i) p[i] = (rhs[i] - off * p[i + 1]) / diagonal[i];
+  const double centre = 0.5 * (p[n / 2 - 1] + p[n / 2]);  // z = ±dz/2 around the slice: p(0) − O(dz²)
+  EXPECT_NEAR(out_of_plane_leak_coefficient(film, viscosity, half_width), sink / centre, 1e-4 * sink / centre);
+  EXPECT_THROW(out_of_plane_leak_coefficient(film, viscosity, 0.0), Error);
+}
+
+// The mean-pressure leak moves liquid out of the plane from where p > p̄ to where p < p̄ and keeps the
+// volume: a wall that pushes liquid in on one half of the channel and draws it out on the other is
+// balanced partly by the flow along the channel and partly out of the plane. Its solution must be the
+// ambient leak's with p_a = p̄ (a problem with a unique solution), reached by Newton as fast (the
+// rank-one part of the tangent is exact), with ∫κ(p − p̄) = 0.
+TEST(FluidLeak, TheMeanPressureLeakIsTheAmbientLeakAtItsOwnMean) {
+  const double speed = 1e-3, dt = 1e-9;  // m/s, s
+  const double k0 = speed / (kHeight * 1e4);
+  const auto kappa = [k0](const Eigen::Vector2d& x, double) { return k0 * (1.0 + 0.5 * std::cos(2.0 * std::numbers::pi * x.x() / kLength)); };
+  const auto wall = [speed](const Eigen::Vector2d& x, double) {
+    return Eigen::Vector2d(0.0, speed * std::sin(2.0 * std::numbers::pi * x.x() / kLength));
+  };
+  const auto solve = [&](NavierStokes& ns, PressureLeak leak) {
+    ns.set_conditions({{Side::bottom, SideConditionKind::velocity, wall, {}, 0.0},
+                       {Side::top, SideConditionKind::velocity, constant(Eigen::Vector2d::Zero()), {}, 0.0}});
+    ns.set_leak(std::move(leak));
+    return ns.step(dt);
+  };
+  NavierStokesOptions pinned;
+  pinned.pinned_pressure_node = 0;  // the mean leak, like an enclosed fluid, leaves the pressure level free
+  NavierStokes mean = channel(8, 4, pinned);
+  const FluidStepReport m = solve(mean, {kappa, 0.0, LeakTarget::mean});
+  ASSERT_TRUE(m.converged) << m.reason;
+  const double target = mean.leak_target_pressure();
+  NavierStokes ambient = channel(8, 4);
+  const FluidStepReport a = solve(ambient, {kappa, target, LeakTarget::ambient});
+  ASSERT_TRUE(a.converged) << a.reason;
+  double size = 0.0;
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 4; ++j) size = std::max(size, std::abs(ambient.pressure_at(kLength * i / 8.0 * 0.999, kHeight * j / 4.0) - target));
+  }
+  ASSERT_GT(size, 100.0);  // Pa: the leak carries a real share of the flow
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 4; ++j) {
+      const double x = kLength * i / 8.0 * 0.999, y = kHeight * j / 4.0;
+      EXPECT_NEAR(mean.pressure_at(x, y), ambient.pressure_at(x, y), 1e-6 * size) << x << ", " << y;
+      EXPECT_LT((mean.velocity_at(x, y) - ambient.velocity_at(x, y)).norm(), 1e-6 * speed);
+    }
+  }
+  EXPECT_LE(m.newton_iterations, a.newton_iterations + 1);
+  EXPECT_LT(std::abs(mean.leak_rate()), 1e-9 * mean.leak_exchange_rate());
+  EXPECT_GT(mean.leak_exchange_rate(), 0.0);
 }
 
 TEST(FluidAle, ShearFlowOnAMovingMeshStaysExact) {

@@ -52,9 +52,12 @@ void CavitatingFilm::update(const std::vector<FilmSample>& samples, double dt) {
   cavitated_.resize(n, 0);
   cavity_.resize(n, 0.0);
   std::vector<double> overshoot(n, 0.0);
+  overgrowth_ = 0.0;
   for (size_t q = 0; q < n; ++q) {
     if (cavitated_[q] != 0) {
       cavity_[q] += dt * samples[q].opening_rate * samples[q].wall_length;
+      const double gap = samples[q].film * samples[q].width;
+      if (within_gap_ && cavity_[q] > gap) overgrowth_ += cavity_[q] - gap, cavity_[q] = gap;
       if (cavity_[q] <= kClosedCavityThickness * samples[q].wall_length) {  // the liquid is back at the wall
         overshoot[q] = std::max(0.0, -cavity_[q]);
         cavitated_[q] = 0, cavity_[q] = 0.0;

@@ -32,6 +32,7 @@ LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::Splin
     : problem_(problem), tool_curve_(tool), options_(std::move(options)), mesh_update_(options_.mesh_update),
       accelerator_(options_.coupling) {
   if (!(options_.contact_fade > 1.0)) throw Error("lubricant: the contact fade must span more than one minimum film");
+  if (options_.leak && !(options_.leak_length > 0.0)) throw Error("lubricant: the leak length must be positive");
   if (!(options_.robin_weight > 0.0) && !(options_.chip_mass_per_area > 0.0 && options_.shortest_weight_step > 0.0)) {
     throw Error("lubricant: give a Robin weight, or the chip's mass per area and the shortest step for the automatic one");
   }
@@ -39,7 +40,7 @@ LubricatedChip::LubricatedChip(solid::SolidProblem& problem, const spline::Splin
   const auto& tb = tool_curve_.basis();
   tool_ = std::make_unique<PeriodicGraph>([this](double t) { return tool_curve_.point(t); }, tb.lo(), tb.period(),
                                           8 * tb.count());
-  if (options_.cavitation_pressure) cavitation_.emplace(*options_.cavitation_pressure);
+  if (options_.cavitation_pressure) cavitation_.emplace(*options_.cavitation_pressure, options_.leak.has_value());
   load_ = std::make_shared<NodalLoad>(problem_.dof_count());
   problem_.add_interaction(load_);
   form_film();
@@ -91,6 +92,23 @@ double LubricatedChip::film_thickness(const fluid::ParametricPoint& bottom_point
   const fluid::FluidSpace& space = fluid_->space();
   const double top = space.patch().v_basis().hi();
   return space.map(space.at(bottom_point.u, top)).position.y() - space.map(bottom_point).position.y();
+}
+
+void LubricatedChip::update_leak() {
+  if (!options_.leak) return;
+  const auto& points = fluid_->space().side_points(Side::bottom);
+  leak_coefficients_.resize(points.size());
+  // The columns do not move along x, so every point of the film at the parameter u of a bottom Gauss
+  // point is in that point's column: the film is h thick there. A cavitated column holds a cavity (a
+  // contact spot's layer holds no liquid at all): no liquid leaves it, or the books would count the
+  // same space twice — as cavity and as leaked liquid (the liquid went negative at 1300 MPa).
+  for (size_t q = 0; q < points.size(); ++q) {
+    leak_coefficients_[q] = cavitation_ && cavitation_->cavitated(q)
+                                ? 0.0
+                                : fluid::out_of_plane_leak_coefficient(film_thickness(points[q]), options_.fluid.viscosity,
+                                                                       options_.leak_length);
+  }
+  fluid_->set_leak({[this](const Eigen::Vector2d&, double u) { return leak_coefficients_[sample_at(u)]; }, 0.0, *options_.leak});
 }
 
 double LubricatedChip::liquid_area() const {
@@ -161,6 +179,7 @@ bool LubricatedChip::film(const Eigen::VectorXd&, const Eigen::VectorXd& tractio
     reason = moved.reason;
     return false;
   }
+  update_leak();
   const double alpha = robin_weight(options_, dt);
   // The film's wall moves with the chip along the surface and with the film mesh's bottom across it:
   // that bottom interpolates the chip's surface at the columns, so the chip's own normal velocity
@@ -283,6 +302,8 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   for (Eigen::Index a = 0; a < f.size(); a += 2) current_.fluid_force += f.segment<2>(a);
   current_.film_area = fluid_->space().area();
   current_.volume_error = volume_error_;
+  current_.leaked_area = fluid_->leak_rate() * dt;
+  current_.exchanged_area = fluid_->leak_exchange_rate() * dt;
   const std::vector<FilmSample> samples = film_samples();
   current_.pocket_areas = pocket_areas(samples);
   if (cavitation_) {
@@ -291,8 +312,9 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
     current_.cavitated_fraction = cavitation_->cavitated_fraction();
     current_.cavity_area = cavitation_->cavity_area();
     if (trace_coupling()) {
-      std::fprintf(stderr, "  liquid %.6e m2/m: full samples' mismatch %.4e, closing overshoot %.4e, lost %.4e\n",
-                   liquid_area(), mismatch_area_, cavitation_->closing_overshoot(), cavitation_->lost_overshoot());
+      std::fprintf(stderr, "  liquid %.6e m2/m: full samples' mismatch %.4e, closing overshoot %.4e, lost %.4e, cavity overgrowth %.4e\n",
+                   liquid_area(), mismatch_area_, cavitation_->closing_overshoot(), cavitation_->lost_overshoot(),
+                   cavitation_->overgrowth());
     }
   }
   current_.liquid_area = liquid_area();

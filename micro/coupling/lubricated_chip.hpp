@@ -62,6 +62,14 @@ struct LubricantOptions {
   // The film cavitates where its liquid would pull the chip with a pressure below this (Pa;
   // cavitation.hpp); none: the liquid holds any tension (seed 000's model).
   std::optional<double> cavitation_pressure;
+  // Whether the liquid also flows out of the plane of the cell: none, sealed in it (seed 000's 2D cell,
+  // whose every valley is sealed by its first contact spot); otherwise by Poiseuille flow over
+  // leak_length either side of the slice, κ = h²/(6ηL²) with h the film's local thickness
+  // (fluid::out_of_plane_leak_coefficient), toward the ambient pressure 0 (the liquid drains) or
+  // toward the film's mean pressure (it moves between pockets around the contact spots, as in a 3D
+  // rough contact below percolation, and the film keeps its liquid). RESULTS, "The lubricant, eighth pass".
+  std::optional<fluid::LeakTarget> leak;
+  double leak_length = 1e-6;  // m
 };
 
 // α_R for a step of length dt: options.robin_weight when given, else the automatic weight.
@@ -80,6 +88,8 @@ struct LubricatedStep {
   double cavity_area = 0.0;            // m² per unit depth: the cavities' space, not filled by liquid
   double liquid_area = 0.0;            // m² per unit depth: the liquid's volume (the film's without cavitation)
   double volume_error = 0.0;           // liquid moved through the film's wall by the velocity mismatch, of the film
+  double leaked_area = 0.0;            // m² per unit depth: liquid that left the plane in the step, net (LubricantOptions::leak)
+  double exchanged_area = 0.0;         // m² per unit depth: liquid that moved out of the plane in one direction in the step
 };
 
 class LubricatedChip {
@@ -112,6 +122,7 @@ class LubricatedChip {
   static std::vector<double> pocket_areas(const std::vector<FilmSample>& samples);
   double film_thickness(const fluid::ParametricPoint& bottom_point) const;  // m, tool minus chip above it
   double liquid_area() const;  // m² per unit depth: the film's less its cavities'
+  void update_leak();          // κ over the film's columns, for the film's current thickness
   void form_film();  // the film in the gap the chip's surface (surface_) leaves now
 
   solid::SolidProblem& problem_;
@@ -127,6 +138,7 @@ class LubricatedChip {
   std::vector<double> bottom_parameters_;      // of its bottom side's Gauss points (for the Robin traction)
   Eigen::VectorXd traction_;                   // σn on the film's bottom side points (2 per point), last step
   Eigen::VectorXd mesh_start_;                 // film mesh displacement at the start of the step
+  std::vector<double> leak_coefficients_;      // κ at the bottom side's points, of the current film mesh
   std::vector<LubricatedStep> history_;
   LubricatedStep current_;
   std::optional<CavitatingFilm> cavitation_;  // with a cavitation pressure

@@ -47,6 +47,13 @@ void check_properties(const FluidProperties& fluid) {
 
 }  // namespace
 
+double out_of_plane_leak_coefficient(double film, double viscosity, double leak_length) {
+  if (!(film >= 0.0) || !(viscosity > 0.0) || !(leak_length > 0.0)) {
+    throw Error("fluid: a leak needs a film >= 0, a positive viscosity and a positive leak length");
+  }
+  return film * film / (6.0 * viscosity * leak_length * leak_length);
+}
+
 double log_density_ratio(const FluidProperties& fluid, double pressure) {
   if (!(fluid.bulk_modulus > 0.0)) return 0.0;
   if (pressure < 0.0) return pressure / fluid.bulk_modulus;
@@ -107,8 +114,26 @@ void NavierStokes::prescribed(std::vector<char>& fixed, Eigen::VectorXd& values)
   }
 }
 
+double NavierStokes::integrate_over_leak(const std::function<double(double, double)>& integrand) const {
+  double sum = 0.0;
+  for (int e = 0; e < space_.element_count(); ++e) {
+    for (const ParametricPoint& p : space_.element_points(e)) {
+      const PhysicalPoint q = space_.map(p);
+      sum += q.weight * integrand(leak_.coefficient(q.position, p.u), pressure(p));
+    }
+  }
+  return sum;
+}
+
+double NavierStokes::leak_target_pressure() const {
+  if (!leak_.coefficient || leak_.target == LeakTarget::ambient) return leak_.ambient_pressure;
+  const double total = integrate_over_leak([](double k, double) { return k; });
+  return total > 0.0 ? integrate_over_leak([](double k, double p) { return k * p; }) / total : 0.0;
+}
+
 void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values,
-                            Eigen::VectorXd& residual, Eigen::SparseMatrix<double>& jacobian) const {
+                            Eigen::VectorXd& residual, Eigen::SparseMatrix<double>& jacobian, Eigen::VectorXd* rank_one_a,
+                            Eigen::VectorXd* rank_one_b) const {
   const double rho = options_.fluid.density, mu = options_.fluid.viscosity, nu = mu / rho;
   const double inv_dt = dt > 0.0 ? 1.0 / dt : 0.0;
   // ∂(ln ρ)/∂t at the mesh's points (ALE), backward Euler; the convective part c·∇(ln ρ) is left
@@ -116,6 +141,16 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
   const bool compressible = options_.fluid.bulk_modulus > 0.0 && inv_dt > 0.0;
   const Eigen::Vector2d body = options_.body_force;
   residual = Eigen::VectorXd::Zero(state_.size());
+  // The mean-pressure leak's sink is κ(p − p̄) with p̄ = ∫κp/∫κ: assembled as κp, then −(∂R/∂p̄) p̄
+  // added once p̄ is known (∂R/∂p̄ collects −κ N_a in continuity and LSIC's share in momentum).
+  const bool mean_leak = leak_.coefficient && leak_.target == LeakTarget::mean;
+  const double leak_ambient = mean_leak ? 0.0 : leak_.ambient_pressure;
+  Eigen::VectorXd per_mean, mean_weights;  // −∂R/∂p̄, and ∫κ N_b at each pressure dof
+  if (mean_leak) {
+    per_mean = Eigen::VectorXd::Zero(state_.size());
+    mean_weights = Eigen::VectorXd::Zero(state_.size());
+  }
+  double leak_total = 0.0;  // ∫κ
   std::vector<Eigen::Triplet<double>> triplets;
   const auto add_local = [&](const std::vector<int>& nodes, const Eigen::VectorXd& r, const Eigen::MatrixXd& k) {
     const auto n = static_cast<Eigen::Index>(nodes.size());
@@ -150,6 +185,9 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
         density_rate = inv_dt * (log_density_ratio(options_.fluid, pressure_here) - log_density_ratio(options_.fluid, old_pressure));
         density_rate_per_pressure = inv_dt * log_density_ratio_derivative(options_.fluid, pressure_here);
       }
+      const double leak = leak_.coefficient ? leak_.coefficient(q.position, p.u) : 0.0;  // κ here
+      const double sink = leak * (pressure_here - leak_ambient);
+      leak_total += wt * leak;
       VelocityDerivatives d;
       for (Eigen::Index a = 0; a < n; ++a) {
         const Eigen::Vector2d va = state_.segment<2>(3 * nodes[static_cast<size_t>(a)]);
@@ -162,6 +200,9 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
       }
       const Eigen::Vector2d c = v - w;  // convective velocity relative to the mesh
       const double divergence = d.gradient.trace();
+      // Continuity's residual, whose least-squares (LSIC) term must vanish on an exact solution.
+      const double continuity = divergence + density_rate + sink;
+      const double continuity_per_pressure = density_rate_per_pressure + leak;
       // τ_M = (4/Δt² + c·G c + C_I ν² G:G)^(−1/2), ν_C = 1/(τ_M tr G) (Bazilevs et al. 2007, eq. 63–65).
       const double tau_m = 1.0 / std::sqrt(4.0 * inv_dt * inv_dt + c.dot(q.metric * c) +
                                            kInverseEstimateConstant * nu * nu * q.metric.squaredNorm());
@@ -184,9 +225,9 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
         const Eigen::Vector2d ga = q.gradients.col(a);
         for (int i = 0; i < 2; ++i) {
           r(3 * a + i) += wt * (na * (inertia(i) - rho * body(i)) + mu * sym.row(i).dot(ga) - pressure_here * ga(i) +
-                                tau_m * advect(a) * strong(i) + rho * nu_c * ga(i) * divergence);
+                                tau_m * advect(a) * strong(i) + rho * nu_c * ga(i) * continuity);
         }
-        r(3 * a + 2) += wt * (na * (divergence + density_rate) + tau_m / rho * ga.dot(strong));
+        r(3 * a + 2) += wt * (na * continuity + tau_m / rho * ga.dot(strong));
         for (Eigen::Index b = 0; b < n; ++b) {
           const double nb = q.values(b);
           const Eigen::Vector2d gb = q.gradients.col(b);
@@ -199,12 +240,21 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
               const double supg = tau_m * (advect(a) * ds(i, kk) + nb * ga(kk) * strong(i));
               k(3 * a + i, 3 * b + kk) += wt * (galerkin + supg + rho * nu_c * ga(i) * gb(kk));
             }
-            k(3 * a + i, 3 * b + 2) += wt * (-nb * ga(i) + tau_m * advect(a) * gb(i));
+            k(3 * a + i, 3 * b + 2) +=
+                wt * (-nb * ga(i) + tau_m * advect(a) * gb(i) + rho * nu_c * ga(i) * continuity_per_pressure * nb);
           }
           for (int kk = 0; kk < 2; ++kk) {
             k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(ds.col(kk)));
           }
-          k(3 * a + 2, 3 * b + 2) += wt * (tau_m / rho * ga.dot(gb) + na * density_rate_per_pressure * nb);
+          k(3 * a + 2, 3 * b + 2) += wt * (tau_m / rho * ga.dot(gb) + na * continuity_per_pressure * nb);
+        }
+        if (mean_leak) {
+          const auto row = static_cast<Eigen::Index>(3 * nodes[static_cast<size_t>(a)]);
+          if (!fixed[static_cast<size_t>(row + 2)]) per_mean(row + 2) += wt * na * leak;
+          for (int i = 0; i < 2; ++i) {
+            if (!fixed[static_cast<size_t>(row + i)]) per_mean(row + i) += wt * rho * nu_c * ga(i) * leak;
+          }
+          mean_weights(row + 2) += wt * na * leak;
         }
       }
     }
@@ -235,6 +285,15 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
     }
   }
 
+  if (mean_leak && leak_total > 0.0) {
+    const Eigen::VectorXd b = mean_weights / leak_total;  // ∂p̄/∂p
+    residual -= per_mean * b.dot(state_);
+    if (rank_one_a != nullptr) *rank_one_a = per_mean;
+    if (rank_one_b != nullptr) *rank_one_b = b;
+  } else {
+    if (rank_one_a != nullptr) rank_one_a->resize(0);
+    if (rank_one_b != nullptr) rank_one_b->resize(0);
+  }
   for (Eigen::Index row = 0; row < state_.size(); ++row) {
     if (!fixed[static_cast<size_t>(row)]) continue;
     residual(row) = state_(row) - values(row);
@@ -267,8 +326,9 @@ FluidStepReport NavierStokes::solve_step(double dt) {
   Eigen::VectorXd residual;
   Eigen::SparseMatrix<double> jacobian;
   double first = 0.0;
+  Eigen::VectorXd rank_one_a, rank_one_b;  // the Jacobian's −a bᵀ (a mean-pressure leak)
   for (int it = 0; it <= options_.max_newton_iterations; ++it) {
-    assemble(dt, fixed, values, residual, jacobian);
+    assemble(dt, fixed, values, residual, jacobian, &rank_one_a, &rank_one_b);
     const double norm = residual.norm();
     report.residual_history.push_back(norm);
     if (!std::isfinite(norm)) {
@@ -293,7 +353,17 @@ FluidStepReport NavierStokes::solve_step(double dt) {
       report.reason = "the fluid tangent could not be factorised: " + solver_.reason();
       break;
     }
-    const Eigen::VectorXd delta = solver_.solve(-residual);
+    Eigen::VectorXd delta = solver_.solve(-residual);
+    if (rank_one_a.size() > 0) {
+      // (J − a bᵀ)⁻¹ by Sherman & Morrison (Ann. Math. Stat. 21, 1950): δ = y + z (bᵀy)/(1 − bᵀz), z = J⁻¹a.
+      const Eigen::VectorXd z = solver_.solve(rank_one_a);
+      const double denominator = 1.0 - rank_one_b.dot(z);
+      if (!(std::abs(denominator) > 0.0)) {
+        report.reason = "the fluid tangent with the mean-pressure leak is singular";
+        break;
+      }
+      delta += z * (rank_one_b.dot(delta) / denominator);
+    }
     if (!delta.allFinite()) {
       report.reason = "the fluid Newton correction is not finite";
       break;
@@ -313,6 +383,7 @@ FluidStepReport NavierStokes::solve_step(double dt) {
 
 std::string NavierStokes::enclosed_flux_violation() const {
   if (options_.fluid.bulk_modulus > 0.0) return {};  // a compressible liquid takes any flux
+  if (leak_.coefficient && leak_.target == LeakTarget::ambient) return {};  // so does one leaking out
   std::vector<char> given(4, 0);
   for (const auto& c : conditions_) {
     if (c.kind != SideConditionKind::velocity) return {};  // a traction or Robin side lets the volume change
@@ -334,6 +405,18 @@ std::string NavierStokes::enclosed_flux_violation() const {
   why << "the velocity given on the whole boundary changes the enclosed volume at " << flux
       << " m^2/s per unit depth: no incompressible flow satisfies it (an enclosed fluid needs a traction or Robin side)";
   return why.str();
+}
+
+double NavierStokes::leak_rate() const {
+  if (!leak_.coefficient) return 0.0;
+  const double target = leak_target_pressure();
+  return integrate_over_leak([target](double k, double p) { return k * (p - target); });
+}
+
+double NavierStokes::leak_exchange_rate() const {
+  if (!leak_.coefficient) return 0.0;
+  const double target = leak_target_pressure();
+  return 0.5 * integrate_over_leak([target](double k, double p) { return k * std::abs(p - target); });
 }
 
 std::vector<NavierStokes::TractionSample> NavierStokes::side_traction(Side side) const {

@@ -1,6 +1,8 @@
 #pragma once
 // Incompressible Navier–Stokes in ALE form (seed 000 eq. 7–13) on a moving spline patch:
 //   ρ(∂v/∂t|_χ + (v − w)·∇v) − ∇·σ = ρ b,  ∇·v = 0,  σ = −p I + η(∇v + ∇vᵀ),
+// optionally with a barotropic density (FluidProperties) or a leak out of the plane (PressureLeak)
+// in continuity;
 // w the mesh velocity. Equal-order velocity and pressure, stabilised by SUPG/PSPG with grad-div
 // (LSIC) and the element metric tensor's τ (Tezduyar, Adv. Appl. Mech. 28, 1992; τ as Bazilevs et
 // al., CMAME 197, 2007, eq. 63–65), full strong residual including the viscous term, so the scheme
@@ -67,6 +69,28 @@ enum class SideConditionKind { velocity, traction, robin };
 using BoundaryField = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
 using BoundaryScalar = std::function<double(const Eigen::Vector2d& x, double t)>;
 
+// A value in the fluid's domain at a current position x and the point's parameter u along the patch.
+using DomainScalar = std::function<double(const Eigen::Vector2d& x, double u)>;
+
+// Liquid leaving the plane of the flow: continuity becomes ∇·v + κ(x)(p − p_a) = 0, a sink of
+// κ(p − p_a) per unit volume (1/s) toward a pressure p_a out of the plane; κ ≥ 0 in 1/(Pa s). A 2D
+// slice of a film whose liquid escapes sideways by Poiseuille flow (the thin-film limit of Reynolds'
+// equation, Reynolds, Phil. Trans. R. Soc. 177, 1886) has κ = h²/(6ηL²) (out_of_plane_leak_coefficient).
+// p_a is either a fixed ambient pressure (the liquid drains to, or where p < p_a is drawn from, the
+// outside), or the fluid's own κ-weighted mean pressure p̄ = ∫κp/∫κ: the slice's neighbours out of
+// the plane are, on average, the cell itself (a mean-field closure), so liquid moves between its
+// parts around the contact spots and the volume of the whole is kept (∫κ(p − p̄) = 0).
+enum class LeakTarget { ambient, mean };
+struct PressureLeak {
+  DomainScalar coefficient;        // κ, 1/(Pa s); empty: no leak
+  double ambient_pressure = 0.0;   // p_a, Pa, for LeakTarget::ambient
+  LeakTarget target = LeakTarget::ambient;
+};
+// κ of a film h thick (m) of viscosity η (Pa s) whose pressure falls to ambient a distance L (m) either
+// side of the slice, across it: the out-of-plane Reynolds flow with a uniform sink, whose pressure is
+// parabolic in z, leaves h³p/(6ηL²) per unit area of film, h²p/(6ηL²) per unit volume.
+double out_of_plane_leak_coefficient(double film, double viscosity, double leak_length);
+
 struct SideCondition {
   Side side = Side::bottom;
   SideConditionKind kind = SideConditionKind::velocity;
@@ -98,6 +122,15 @@ class NavierStokes {
   // Conditions are applied in order: where two velocity sides share a corner control point the
   // later one sets it.
   void set_conditions(std::vector<SideCondition> conditions) { conditions_ = std::move(conditions); }
+  // The leak of the next solves (an empty coefficient: none).
+  void set_leak(PressureLeak leak) { leak_ = std::move(leak); }
+  // ∫ κ (p − p_a) dΩ of the current state, m²/s per unit depth: the liquid leaving the plane (0 without
+  // a leak, and to round-off with LeakTarget::mean).
+  double leak_rate() const;
+  // ½ ∫ κ |p − p_a| dΩ: the liquid moving out of the plane in one direction, m²/s per unit depth.
+  double leak_exchange_rate() const;
+  // The leak's target pressure p_a at the current state (Pa): the ambient one, or p̄.
+  double leak_target_pressure() const;
   // The mesh of the end of the next step: displacement from the reference net and mesh velocity,
   // 2 per control point (ALE; zero for a fixed mesh).
   void set_mesh(const Eigen::VectorXd& displacement, const Eigen::VectorXd& mesh_velocity);
@@ -140,18 +173,25 @@ class NavierStokes {
   FluidSpace space_;
   NavierStokesOptions options_;
   std::vector<SideCondition> conditions_;
+  PressureLeak leak_;
   Eigen::VectorXd state_, old_state_, mesh_velocity_;
   solid::LinearSolver solver_{solid::LinearSolverKind::lu};
 
   // Empty, or why the velocity given on an enclosed fluid's whole boundary admits no solution (its
   // net flux does not vanish: the incompressibility dilemma of a Dirichlet–Neumann coupling).
   std::string enclosed_flux_violation() const;
+  // ∫ integrand(κ, p) dΩ over the quadrature points (a leak is set).
+  double integrate_over_leak(const std::function<double(double, double)>& integrand) const;
   // The prescribed dofs (velocity sides, pinned pressure) and their values.
   void prescribed(std::vector<char>& fixed, Eigen::VectorXd& values) const;
   // Residual and Jacobian of the discrete equations at state_; a prescribed row is u − ū with a unit
   // diagonal.
+  // With LeakTarget::mean the Jacobian is the sparse part plus the rank-one −a bᵀ of p̄'s dependence on
+  // every pressure: a = ∂R/∂p̄ (column), b = ∂p̄/∂p (row); both empty otherwise.
   void assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values, Eigen::VectorXd& residual,
-                Eigen::SparseMatrix<double>& jacobian) const;
+                Eigen::SparseMatrix<double>& jacobian, Eigen::VectorXd* rank_one_a = nullptr,
+                Eigen::VectorXd* rank_one_b = nullptr) const;
+
 };
 
 }  // namespace mufric::fluid

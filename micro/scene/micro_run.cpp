@@ -153,6 +153,8 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                       {"min_relative_jacobian", lubricant->min_relative_jacobian},
                       {"film_area_m2_per_m", {lubricant->initial_film_area, lubricant->final_film_area}},
                       {"liquid_area_m2_per_m", {lubricant->initial_liquid_area, lubricant->final_liquid_area}},
+                      {"leaked_area_m2_per_m", lubricant->leaked_area},
+                      {"exchanged_area_m2_per_m", lubricant->exchanged_area},
                       {"final_pocket_areas_m2_per_m", lubricant->final_pocket_areas},
                       {"fluid_dofs", lubricant->fluid_dofs}};
   }
@@ -173,6 +175,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"cavitated_fraction", s.cavitated_fraction},
                  {"cavity_area_m2_per_m", s.cavity_area},
                  {"liquid_area_m2_per_m", s.liquid_area},
+                 {"leaked_area_m2_per_m", s.leaked_area},
                  {"film_volume_error", s.film_volume_error},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
@@ -269,6 +272,8 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.shortest_weight_step = scene.dt;
   o.film_from = l.fill == "after-pressing" ? slide_start : 0.0;
   o.contact_fade = l.contact_fade;
+  if (l.leak != "none") o.leak = l.leak == "ambient" ? fluid::LeakTarget::ambient : fluid::LeakTarget::mean;
+  o.leak_length = l.leak_length;
   if (l.cavitation == "mass-conserving") o.cavitation_pressure = l.cavitation_pressure;
   o.coupling.acceleration = l.acceleration == "aitken"       ? coupling::Acceleration::aitken
                             : l.acceleration == "relaxation" ? coupling::Acceleration::constant_relaxation
@@ -408,6 +413,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       step.cavity_area = l.cavity_area;
       step.liquid_area = l.liquid_area;
       step.film_volume_error = l.volume_error;
+      step.leaked_area = l.leaked_area;
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last.contact_length / last.surface_length;
@@ -429,6 +435,8 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       l.coupling_restarts += h.coupling_restarts;
       l.max_coupling_iterations = std::max(l.max_coupling_iterations, h.coupling_iterations);
       l.fluid_newton_iterations += h.fluid_newton_iterations;
+      l.leaked_area += h.leaked_area;
+      l.exchanged_area += h.exchanged_area;
       l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);
     }
     l.initial_film_area = lubricant->formed_film_area();

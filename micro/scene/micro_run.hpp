@@ -29,6 +29,7 @@ struct MicroStep {
   double cavitated_fraction = 0.0;                  // lubricated: of the interface, cavitated pockets
   double cavity_area = 0.0;                         // lubricated: their space not filled by liquid, m² per unit depth
   double liquid_area = 0.0;                         // lubricated: the liquid's volume, m² per unit depth (film less cavities)
+  double leaked_area = 0.0;                         // lubricated: liquid that left the plane in the step, m² per unit depth
   double film_volume_error = 0.0;                   // lubricated: liquid moved through the film's wall by the coupling's mismatch, of the film
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
@@ -45,6 +46,8 @@ struct LubricantRecord {
   double initial_film_area = 0.0, final_film_area = 0.0;  // m² per unit depth, when formed and at the end
   double initial_liquid_area = 0.0, final_liquid_area = 0.0;  // the same of the liquid (film less cavities)
   std::vector<double> final_pocket_areas;                  // m² per unit depth
+  double leaked_area = 0.0;     // m² per unit depth, summed over the steps: the liquid that left the plane, net
+  double exchanged_area = 0.0;  // the same of the liquid that moved out of the plane in one direction
   int fluid_dofs = 0;
 };
 

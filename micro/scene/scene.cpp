@@ -288,6 +288,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     }
     l.cavitation = f.text("cavitation", l.cavitation, {"none", "mass-conserving"});
     l.cavitation_pressure = f.quantity("cavitation_pressure", QuantityKind::pressure, l.cavitation_pressure, -1e9, 1e9);
+    l.leak = f.text("leak", s.protocol.name == Protocol::press_slide ? l.leak : "none", {"none", "ambient", "cell-mean"});
+    l.leak_length = f.quantity("leak_length", QuantityKind::length, l.leak_length, 1e-9, 1.0);
     l.contact_fade = f.number("contact_fade", l.contact_fade, 1.01, 100.0);
     l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
     l.robin_stiffness = f.number("robin_stiffness", l.robin_stiffness, 0.0, 1e25);

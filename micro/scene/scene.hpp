@@ -70,6 +70,13 @@ struct LubricantSpec {
   // liquid would pull the chip below cavitation_pressure a cavity opens (micro/coupling/cavitation.hpp).
   std::string cavitation = "mass-conserving";
   double cavitation_pressure = 0.0;  // Pa, relative to the ambient zero of the applied load
+  // Liquid flowing out of the plane of the cell (coupling::LubricantOptions::leak): "none", sealed in
+  // it (seed 000's protocol's default); "ambient" (press-slide's default), draining toward the ambient
+  // zero; "cell-mean", moving between the film's parts toward its mean pressure (the film keeps its
+  // liquid). Over leak_length either side of the slice. Decided from a study (README, "The lubricant";
+  // bench/RESULTS.md, "The lubricant, eighth pass").
+  std::string leak = "ambient";
+  double leak_length = 1e-6;  // m: about the roughness' correlation length (tool 0.8 µm, chip 1 µm)
   // Minimum films over which the fluid's load fades out into a contact spot (a continuous switch).
   double contact_fade = 2.0;
   // α_R, Pa s/m; 0: the automatic ρ_chip h_chip / max(Δt, time.step) + robin_stiffness Δt.
