@@ -784,4 +784,3 @@ TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
 
 }  // namespace
 }  // namespace mufric::coupling
-

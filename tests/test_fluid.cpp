@@ -3,6 +3,7 @@
 // through traction and Robin sides, Kovasznay flow (exact solution, convergence rates), Ghia et al.'s
 // lid-driven cavity, and a uniform flow on a moving mesh (geometric conservation).
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <vector>
 
@@ -28,6 +29,14 @@ NavierStokes channel(int nx, int ny, NavierStokesOptions options = {}) {
   options.fluid = kOil;
   return NavierStokes(FluidSpace(rectangle_patch(2, nx, ny, Eigen::Vector2d::Zero(), Eigen::Vector2d(kLength, kHeight), true)),
                       options);
+}
+
+// Starts `ns` from the flow whose velocity is `field` at every control point, pressure 0 (a flow in
+// the space: linear, so its interpolant is itself).
+void start_from(NavierStokes& ns, const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& field) {
+  Eigen::VectorXd state = Eigen::VectorXd::Zero(3 * ns.space().node_count());
+  for (int a = 0; a < ns.space().node_count(); ++a) state.segment<2>(3 * a) = field(ns.space().node_position(a));
+  ns.set_state(state);
 }
 
 // Largest deviation of the nodal velocities from a profile u(y) (a linear or quadratic profile is in
@@ -222,9 +231,7 @@ TEST(FluidChannel, ACompressibleLiquidTakesTheInflowAsUniformCompression) {
   const auto walls = [&](NavierStokes& ns) {
     ns.set_conditions({{Side::bottom, SideConditionKind::velocity, [&](const Eigen::Vector2d& x, double) { return exact(x); }, {}, 0.0},
                        {Side::top, SideConditionKind::velocity, constant(Eigen::Vector2d::Zero()), {}, 0.0}});
-    Eigen::VectorXd state = Eigen::VectorXd::Zero(3 * ns.space().node_count());
-    for (int a = 0; a < ns.space().node_count(); ++a) state.segment<2>(3 * a) = exact(ns.space().node_position(a));
-    ns.set_state(state);
+    start_from(ns, exact);
   };
   NavierStokes incompressible = channel(6, 4);
   walls(incompressible);
@@ -266,9 +273,7 @@ TEST(FluidChannel, ALeakingLiquidTakesTheInflowAtTheLeakPressure) {
                      {Side::top, SideConditionKind::velocity, constant(Eigen::Vector2d::Zero()), {}, 0.0}});
   ns.set_leak({[leak](const Eigen::Vector2d&, double) { return leak; }, ambient});
   const double expected = ambient + speed / (leak * kHeight);
-  Eigen::VectorXd state = Eigen::VectorXd::Zero(3 * ns.space().node_count());  // the steady flow from the start
-  for (int a = 0; a < ns.space().node_count(); ++a) state.segment<2>(3 * a) = exact(ns.space().node_position(a));
-  ns.set_state(state);
+  start_from(ns, exact);  // the steady flow from the start
   for (int n = 1; n <= 2; ++n) {
     const FluidStepReport r = ns.step(dt);
     ASSERT_TRUE(r.converged) << r.reason;
@@ -362,9 +367,7 @@ TEST(FluidAle, ShearFlowOnAMovingMeshStaysExact) {
   const auto exact = [&](const Eigen::Vector2d& x) { return Eigen::Vector2d(slip + lid * x.y() / kHeight, 0.0); };
   ns.set_conditions({{Side::bottom, SideConditionKind::velocity, [&](const Eigen::Vector2d& x, double) { return exact(x); }, {}, 0.0},
                      {Side::top, SideConditionKind::velocity, [&](const Eigen::Vector2d& x, double) { return exact(x); }, {}, 0.0}});
-  Eigen::VectorXd state = Eigen::VectorXd::Zero(3 * ns.space().node_count());
-  for (int a = 0; a < ns.space().node_count(); ++a) state.segment<2>(3 * a) = exact(ns.space().node_position(a));
-  ns.set_state(state);
+  start_from(ns, exact);
   const double dt = 1e-9, shear_stress = kOil.viscosity * lid / kHeight;
   Eigen::VectorXd previous = Eigen::VectorXd::Zero(2 * ns.space().node_count());
   const auto reference = ns.space().patch().points();

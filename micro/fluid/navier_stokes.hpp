@@ -191,7 +191,6 @@ class NavierStokes {
   void assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values, Eigen::VectorXd& residual,
                 Eigen::SparseMatrix<double>& jacobian, Eigen::VectorXd* rank_one_a = nullptr,
                 Eigen::VectorXd* rank_one_b = nullptr) const;
-
 };
 
 }  // namespace mufric::fluid
