@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/error.hpp"
 #include "micro/coupling/cavitation.hpp"
 #include "micro/coupling/chip_interface.hpp"
 #include "micro/coupling/lubricated_chip.hpp"
@@ -170,7 +171,7 @@ struct PistonPocket {
         [this](const Eigen::VectorXd& d, const Eigen::VectorXd& load, Eigen::VectorXd& new_load, std::string& why) {
           return fluid(d, load, new_load, why);
         },
-        {}};  // the piston's pocket is checked after the run
+        {}, {}};  // the piston's pocket is checked after the run
     Outcome out;
     Eigen::VectorXd delta = Eigen::VectorXd::Zero(1);
     Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(ns.space().side_points(Side::top).size()));
@@ -655,7 +656,7 @@ struct ScalarInterface {
           next = Eigen::VectorXd::Constant(1, map(d(0)));
           return true;
         },
-        kinematic};
+        kinematic, {}};
     InterfaceAccelerator accelerator(options);
     Eigen::VectorXd start = Eigen::VectorXd::Zero(1), d = Eigen::VectorXd::Zero(1);
     const CouplingStepReport report = coupled_step(solvers, start, d, accelerator, options);
@@ -709,6 +710,69 @@ TEST(CoupledStep, AStalledIterationFailsEarlyAndASlowOneConverges) {
   EXPECT_NE(stalled.reason.find("stalled"), std::string::npos) << stalled.reason;
   scalar.options.stall_iterations = 0;  // off: the oscillation runs to max_iterations
   EXPECT_EQ(run(1.0).iterations, scalar.options.max_iterations);
+}
+
+// n independent copies of λ̃ = 1 + λ/2 from λ = 0 by plain relaxation: each component's change is
+// 2^(1−k) at exchange k (closed form), the load's |λ̃ − λ| = √n 2^(1−k). A floor of 2⁻⁶ Pa on the root
+// mean square is met at exchange 7 whatever n; a floor on the plain norm would need 7 + log₂√n (11 for n = 100).
+TEST(CoupledStep, TheLoadFloorIsARootMeanSquareOverTheComponents) {
+  const auto exchanges_for = [](Eigen::Index components) {
+    CouplingOptions options;
+    options.acceleration = Acceleration::constant_relaxation;
+    options.relaxation = 1.0;
+    options.relative_tolerance = 0.0;
+    options.load_tolerance = 1.01 * std::ldexp(1.0, -6);  // just above 2⁻⁶, so that rounding cannot decide the exchange
+    options.displacement_tolerance = 1.0;
+    options.max_iterations = 40;
+    const PartitionedSolvers solvers{
+        [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) { return d = load, true; },
+        [](const Eigen::VectorXd&, const Eigen::VectorXd& load, Eigen::VectorXd& next, std::string&) {
+          next = (1.0 + 0.5 * load.array()).matrix();
+          return true;
+        },
+        {}, {}};
+    InterfaceAccelerator accelerator(options);
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(components), d = Eigen::VectorXd::Zero(components);
+    const CouplingStepReport report = coupled_step(solvers, load, d, accelerator, options);
+    EXPECT_TRUE(report.converged) << report.reason;
+    return report.iterations;
+  };
+  EXPECT_EQ(exchanges_for(1), 7);
+  EXPECT_EQ(exchanges_for(100), 7);
+}
+
+// Two load components: the first λ̃ = 1 + λ/2 (converges, as above), the second λ̃ = 1 − λ (an
+// oscillation of constant size 1 under plain relaxation: it never converges). A share of 0 on the
+// second — a film's traction over a contact spot, which the chip never receives — leaves the first to
+// decide: 2^(1−k) ≤ 1e-3 |λ̃| (λ̃ → 2) at k = 10. Shared by both, the step runs out of its exchanges.
+TEST(CoupledStep, TheLoadConvergesOnTheShareThatReachesTheStructure) {
+  const auto run = [](const Eigen::VectorXd& share) {
+    CouplingOptions options;
+    options.acceleration = Acceleration::constant_relaxation;
+    options.relaxation = 1.0;
+    options.relative_tolerance = 1e-3;
+    options.load_tolerance = 0.0;
+    options.displacement_tolerance = 1.0;
+    options.max_iterations = 30;
+    PartitionedSolvers solvers{
+        [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) { return d = load, true; },
+        [](const Eigen::VectorXd&, const Eigen::VectorXd& load, Eigen::VectorXd& next, std::string&) {
+          next.resize(2);
+          next << 1.0 + 0.5 * load(0), 1.0 - load(1);
+          return true;
+        },
+        {}, {}};
+    if (share.size() != 0) solvers.load_share = [share] { return share; };
+    InterfaceAccelerator accelerator(options);
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(2), d = Eigen::VectorXd::Zero(2);
+    return coupled_step(solvers, load, d, accelerator, options);
+  };
+  const CouplingStepReport first_only = run(Eigen::Vector2d(1.0, 0.0));
+  ASSERT_TRUE(first_only.converged) << first_only.reason;
+  EXPECT_EQ(first_only.iterations, 10);
+  EXPECT_FALSE(run(Eigen::VectorXd()).converged);
+  EXPECT_FALSE(run(Eigen::Vector2d(1.0, 1.0)).converged);
+  EXPECT_THROW(run(Eigen::VectorXd::Ones(3)), Error);
 }
 
 // A solver failing on an iterate restarts the step from the last solved iterate with half the

@@ -115,6 +115,23 @@ double LubricatedChip::liquid_area() const {
   return fluid_->space().area() - (cavitation_ ? cavitation_->cavity_area() : 0.0);
 }
 
+double LubricatedChip::contact_share(double film) const {
+  // At a contact spot (the film at its minimum) the contact carries the chip; the fluid's share
+  // fades out linearly between contact_fade and one minimum film, so that the transferred
+  // load is continuous in the chip's position (a switch would make the coupling's map jump).
+  const double h = options_.mesh.min_film;
+  return std::clamp((film - h) / ((options_.contact_fade - 1.0) * h), 0.0, 1.0);
+}
+
+Eigen::VectorXd LubricatedChip::load_share() const {
+  const auto& points = fluid_->space().side_points(Side::bottom);
+  Eigen::VectorXd share(2 * static_cast<Eigen::Index>(points.size()));
+  for (size_t q = 0; q < points.size(); ++q) {
+    share.segment<2>(2 * static_cast<Eigen::Index>(q)).setConstant(contact_share(film_thickness(points[q])));
+  }
+  return share;
+}
+
 Eigen::VectorXd LubricatedChip::transfer(const Eigen::VectorXd& traction) const {
   const fluid::FluidSpace& space = fluid_->space();
   const auto& points = space.side_points(Side::bottom);
@@ -123,12 +140,7 @@ Eigen::VectorXd LubricatedChip::transfer(const Eigen::VectorXd& traction) const 
   for (size_t q = 0; q < points.size(); ++q) {
     const Side bottom = Side::bottom;
     const fluid::PhysicalPoint at = space.map(points[q], &bottom);
-    const double film = film_thickness(points[q]);
-    // At a contact spot (the film at its minimum) the contact carries the chip; the fluid's share
-    // fades out linearly between contact_fade and one minimum film, so that the transferred
-    // load is continuous in the chip's position (a switch would make the coupling's map jump).
-    const double h = options_.mesh.min_film;
-    const double share = std::clamp((film - h) / ((options_.contact_fade - 1.0) * h), 0.0, 1.0);
+    const double share = contact_share(film_thickness(points[q]));
     if (share == 0.0) continue;
     positions.push_back(at.position);
     loads.push_back(-share * traction.segment<2>(2 * static_cast<Eigen::Index>(q)));  // the chip receives −σn
@@ -266,7 +278,8 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
       [&](const Eigen::VectorXd& d, const Eigen::VectorXd& traction, Eigen::VectorXd& next, std::string& why) {
         return film(d, traction, dt, next, why);
       },
-      [&] { return volume_error_; }};
+      [&] { return volume_error_; },
+      [&] { return load_share(); }};
   Eigen::VectorXd traction = traction_, displacement;
   CouplingStepReport report;
   try {

@@ -117,6 +117,8 @@ class LubricatedChip {
   // The film's net onto new bottom and top rows (gap_boundary_rows), by the options' mesh motion.
   fluid::MeshMoveReport move_film_mesh(const Eigen::MatrixX2d& rows);
   Eigen::VectorXd transfer(const Eigen::VectorXd& traction) const;  // the film's traction → chip nodal forces
+  double contact_share(double film) const;  // of the film's traction that reaches the chip, at this thickness
+  Eigen::VectorXd load_share() const;       // per traction component of the bottom side, of the current film mesh
   std::vector<FilmSample> film_samples() const;  // the film's bottom side, for pockets and cavitation
   size_t sample_at(double parameter) const;      // the bottom side sample at a curve parameter
   static std::vector<double> pocket_areas(const std::vector<FilmSample>& samples);

@@ -153,7 +153,12 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
     lambda_tilde_solved = lambda_tilde;
     if (lambda_tilde.size() != lambda.size()) throw Error("coupling: the fluid returned a load of another size");
     report.iterations = it;
-    const double load_residual = (lambda_tilde - lambda).norm();
+    const Eigen::VectorXd share = solvers.load_share ? solvers.load_share() : Eigen::VectorXd();
+    if (share.size() != 0 && share.size() != lambda.size()) throw Error("coupling: the load share has another size than the load");
+    const auto shared = [&share](const Eigen::VectorXd& x) {
+      return share.size() == 0 ? Eigen::VectorXd(x) : Eigen::VectorXd(share.cwiseProduct(x));
+    };
+    const double load_residual = shared(lambda_tilde - lambda).norm();
     const double displacement_change = d_previous.size() == d.size() ? (d - d_previous).norm() : d.norm();
     report.load_residuals.push_back(load_residual);
     report.displacement_changes.push_back(displacement_change);
@@ -161,7 +166,9 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
       report.reason = "the interface iteration diverged (non-finite) at iteration " + std::to_string(it);
       break;
     }
-    const bool load_converged = load_residual <= options.load_tolerance + options.relative_tolerance * lambda_tilde.norm();
+    const double components = static_cast<double>(std::max<Eigen::Index>(lambda_tilde.size(), 1));
+    const bool load_converged = load_residual <= options.load_tolerance * std::sqrt(components) +
+                                                     options.relative_tolerance * shared(lambda_tilde).norm();
     const bool displacement_converged =
         displacement_change <= options.displacement_tolerance +
                                    options.relative_tolerance * (start.size() == d.size() ? (d - start).norm() : d.norm());

@@ -29,7 +29,11 @@ struct CouplingOptions {
   int reuse_steps = 8;          // IQN-ILS: past steps whose secant pairs are kept
   double qr_filter = 1e-8;      // IQN-ILS: a pair keeping less of its norm than this, after the newer ones, is dropped
   double relative_tolerance = 1e-8;       // of |λ̃| for the load, of the step's motion |d − d_start| for the displacement
-  double load_tolerance = 1e-3;           // Pa: |λ̃ − λ| below this (plus the relative part) is converged
+  // Pa: |λ̃ − λ| / √n (its root mean square over the n components) below this, plus the relative
+  // part, is converged. A film beside contact spots carries a small share of the load: its traction
+  // measured against itself asks for more than the chip's forces can show (the scene sets this from
+  // lubricant.traction_tolerance and the applied pressure).
+  double load_tolerance = 1e-3;
   double displacement_tolerance = 1e-15;  // m: |d_k − d_(k−1)| below this (plus the relative part) is converged
   double kinematic_tolerance = 1e-4;      // of the solvers' kinematic residual, when they report one
   int max_iterations = 50;
@@ -80,6 +84,10 @@ struct PartitionedSolvers {
   // solve, as a dimensionless measure (a Robin condition meets the velocities only at the fixed
   // point: v − g = (λ − λ̃)/α). Checked against kinematic_tolerance besides load and displacement.
   std::function<double()> kinematic_residual;
+  // Optional: per load component, how much of it reaches the structure (in [0, 1]; empty: all). The
+  // load's convergence is measured on the part that does (a film's traction over a contact spot, which
+  // the contact carries instead, is the fluid's own business, checked by its kinematic residual).
+  std::function<Eigen::VectorXd()> load_share;
 };
 
 struct CouplingStepReport {

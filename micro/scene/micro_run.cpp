@@ -282,6 +282,9 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   o.coupling.reuse_steps = l.reuse_steps;
   o.coupling.qr_filter = l.qr_filter;
   o.coupling.relative_tolerance = l.coupling_tolerance;
+  if (scene.pressure_controlled && l.traction_tolerance > 0.0) {
+    o.coupling.load_tolerance = l.traction_tolerance * std::abs(scene.pressure);
+  }
   o.coupling.kinematic_tolerance = l.volume_tolerance;
   o.coupling.max_iterations = l.max_coupling_iterations;
   o.coupling.stall_iterations = l.stall_iterations;

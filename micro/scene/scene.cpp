@@ -300,6 +300,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     l.reuse_steps = f.integer("reuse_steps", l.reuse_steps, 0, 100);
     l.qr_filter = f.number("qr_filter", l.qr_filter, 0.0, 0.999);
     l.coupling_tolerance = f.number("coupling_tolerance", l.coupling_tolerance, 1e-14, 1e-1);
+    l.traction_tolerance = f.number("traction_tolerance", l.traction_tolerance, 0.0, 1e-1);
     l.volume_tolerance = f.number("volume_tolerance", l.volume_tolerance, 1e-14, 1.0);
     l.max_coupling_iterations = f.integer("max_coupling_iterations", l.max_coupling_iterations, 1, 10000);
     l.stall_iterations = f.integer("stall_iterations", l.stall_iterations, 0, 10000);

@@ -95,6 +95,11 @@ struct LubricantSpec {
   // opening and closing beside the film the iteration stalls near 1e-3 at some points of the box, and
   // 3e-3 moves μ by 0.4 % where both converge (bench/RESULTS.md).
   double coupling_tolerance = 3e-3;
+  // Of load.pressure: the interface traction's change, as a root mean square over the film's wall
+  // samples, below this is converged whatever the film's own traction (CouplingOptions::load_tolerance).
+  // Its force on the chip then errs by at most this share of the applied load. 0: the relative
+  // coupling_tolerance alone. Ignored with a displacement-controlled load (no pressure to scale by).
+  double traction_tolerance = 3e-4;
   // The liquid a step's mismatch of interface velocities (fluid against film wall, (λ − λ̃)/α_R)
   // moves through the wall, over the film's volume. The traction tolerance alone left it at up to
   // 2 % per step and μ 8 % off; 1e-3 puts μ within 0.6 % of 1e-5 (bench/RESULTS.md).
