@@ -21,6 +21,10 @@ constexpr Eigen::Index kParallelThreshold = 2 * kQueryBlock;
 // Up to this many queries with a variance read L⁻¹ row by row once for all of them (memory-bound,
 // split over two cores' L2 caches); larger blocks use a triangular matrix product (compute-bound).
 constexpr Eigen::Index kRowByRowMaxQueries = 16;
+// Partial sums of the mean's dot product (GaussianProcess::mean_from_correlations): four AVX-512 or
+// eight AVX2 registers, enough independent additions to hide their latency (8 lanes cost 10 % of a
+// mean-only batch at n = 900 against Eigen's own reduction; bench/RESULTS.md).
+constexpr Eigen::Index kMeanLanes = 32;
 // An L⁻¹ larger than this (bytes of its lower half) is split over two threads for a single query,
 // so that each half stays in one core's L2 cache.
 constexpr double kSplitRowsAboveBytes = 512.0 * 1024.0;
@@ -128,6 +132,26 @@ void GaussianProcess::correlations_with_training(const Eigen::RowVectorXd& scale
   rbf_correlation_in_place(correlation);
 }
 
+double GaussianProcess::mean_from_correlations(const double* correlation) const {
+  // kMeanLanes interleaved partial sums (one fixed-size array, kept in vector registers), added
+  // pairwise at the end: nothing depends on where the data starts — Eigen's packet reduction of a
+  // dynamic vector peels up to the first aligned element, which moves with the batch.
+  using Lanes = Eigen::Array<double, kMeanLanes, 1>;
+  const double* weights = weights_.data();
+  const auto n = weights_.size();
+  Lanes lane = Lanes::Zero();
+  Eigen::Index i = 0;
+  for (; i + kMeanLanes <= n; i += kMeanLanes) {
+    lane += Eigen::Map<const Lanes>(correlation + i) * Eigen::Map<const Lanes>(weights + i);
+  }
+  for (Eigen::Index l = 0; i < n; ++i, ++l) lane(l) += correlation[i] * weights[i];
+  double* sums = lane.data();
+  for (Eigen::Index width = kMeanLanes / 2; width > 0; width /= 2) {
+    for (Eigen::Index l = 0; l < width; ++l) sums[l] += sums[l + width];
+  }
+  return state_.y_mean + sums[0];
+}
+
 void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count,
                                      const EvaluationRequest& what, Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block,
                                      Evaluation& out, long long& clamped) const {
@@ -144,18 +168,20 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
     Eigen::ArrayXd correlation(n);
     for (Eigen::Index b = 0; b < count; ++b) {
       correlations_with_training(q.row(b), correlation);
-      out.mu(first + b) = state_.y_mean + (correlation * weights_.array()).sum();
+      out.mu(first + b) = mean_from_correlations(correlation.data());
     }
     return;
   }
-  // Column b of k_block is the correlation vector of query b with every training point.
+  // Column b of k_block is the correlation vector of query b with every training point. It is
+  // computed in an aligned buffer like the mean-only path's, then copied: exp over a column that
+  // starts anywhere takes a scalar head in a portable build and would round differently.
   k_block.resize(n, count);
+  Eigen::ArrayXd correlation(n);
   for (Eigen::Index b = 0; b < count; ++b) {
-    Eigen::Map<Eigen::ArrayXd> column(k_block.col(b).data(), n);
-    correlations_with_training(q.row(b), column);
+    correlations_with_training(q.row(b), correlation);
+    out.mu(first + b) = mean_from_correlations(correlation.data());
+    k_block.col(b) = correlation.matrix();
   }
-  out.mu.segment(first, count).noalias() = k_block.transpose() * weights_;
-  out.mu.segment(first, count).array() += state_.y_mean;
 
   if (what.gradient) {
     // ∂μ/∂x_k = −Σ_i w_i k_i (q_k − s_ik) / (l_k · width_k)  with s = scaled training inputs.

@@ -89,6 +89,10 @@ class GaussianProcess final : public FrictionModel {
 
   // exp(−½ |s_i − q|²) for every scaled training input s_i and a scaled query q.
   void correlations_with_training(const Eigen::RowVectorXd& scaled_query, Eigen::Ref<Eigen::ArrayXd> correlation) const;
+  // μ = ȳ + Σ_i w_i k_i in one fixed summation order, whatever the request, batch or alignment: asking
+  // for the interval or the gradient must not change μ by a single bit (an explicit meso run and its
+  // twin would part ways). Not inlined, so that every caller runs the same instructions.
+  [[gnu::noinline]] double mean_from_correlations(const double* correlation) const;
   // |L⁻¹ k_b|² for each column k_b of a few kernel vectors, reading each row of L⁻¹ once.
   Eigen::RowVectorXd squared_norms_row_by_row(const Eigen::MatrixXd& kernels) const;
 
