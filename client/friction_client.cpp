@@ -3,6 +3,8 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <atomic>
+#include <mutex>
 #include <cstdlib>
 #include <optional>
 #include <chrono>
@@ -27,7 +29,12 @@ class InProcessClient final : public FrictionClient {
   InProcessClient(const std::string& path, bool isolate)
       : path_(path), model_(isolate ? load_model_isolated(path) : load_model(path)) {}
 
-  Answer evaluate(const Block& block, const EvaluationRequest& what) override {
+  Answer evaluate(const Block& block, const EvaluationRequest& request) override {
+    // Several threads of the caller at once (std::thread, MPI + threads: an OpenMP caller is caught
+    // by the model itself): each evaluates on its own thread instead of starting a team per call.
+    const CallsInFlight call(in_flight_);
+    EvaluationRequest what = request;
+    if (call.others_in_flight()) what.max_threads = 1;
     const auto& inputs = model_->inputs();
     QueryBatch x(static_cast<Eigen::Index>(block.points), static_cast<Eigen::Index>(inputs.size()));
     for (size_t j = 0; j < inputs.size(); ++j) {
@@ -58,8 +65,22 @@ class InProcessClient final : public FrictionClient {
   }
 
  private:
+  class CallsInFlight {
+   public:
+    explicit CallsInFlight(std::atomic<int>& count) : count_(count), before_(count_.fetch_add(1)) {}
+    ~CallsInFlight() { count_.fetch_sub(1); }
+    CallsInFlight(const CallsInFlight&) = delete;
+    CallsInFlight& operator=(const CallsInFlight&) = delete;
+    bool others_in_flight() const { return before_ > 0; }
+
+   private:
+    std::atomic<int>& count_;
+    int before_;
+  };
+
   std::string path_;
-  std::unique_ptr<FrictionModel> model_;
+  std::unique_ptr<FrictionModel> model_;  // evaluation is const and keeps no state: safe from many threads
+  std::atomic<int> in_flight_{0};
 };
 
 struct ServerUri {
@@ -226,6 +247,9 @@ class GrpcClient final : public FrictionClient {
   // One request, one response on the open stream; the stream is (re)opened as needed, and a stream
   // that ends with UNAVAILABLE is retried with backoff like a unary call.
   void exchange_on_stream(const mufric::v1::EvaluateRequest& request, mufric::v1::EvaluateResponse& response) {
+    // One stream per handle carries one request at a time: threads sharing the handle take turns
+    // (a thread that wants its own stream opens its own handle).
+    const std::lock_guard<std::mutex> lock(stream_mutex_);
     double backoff = options_.first_backoff_seconds;
     for (int attempt = 0;; ++attempt) {
       if (!stream_) {
@@ -253,6 +277,7 @@ class GrpcClient final : public FrictionClient {
   std::string model_;
   Options options_;
   std::string token_;
+  std::mutex stream_mutex_;  // guards stream_context_ and stream_
   std::unique_ptr<grpc::ClientContext> stream_context_;
   std::unique_ptr<grpc::ClientReaderWriter<mufric::v1::EvaluateRequest, mufric::v1::EvaluateResponse>> stream_;
   std::shared_ptr<grpc::Channel> channel_;

@@ -76,6 +76,12 @@ struct Options {
   bool isolate_file_parsing = false;
 };
 
+// Threads: evaluate() and describe() may be called from many threads at once on one client (an
+// OpenMP or MPI + OpenMP meso code sharing one handle). In-process, every call evaluates on its
+// calling thread when called from inside a parallel region of two or more threads or while another
+// call is running, so the caller's cores are not oversubscribed; over gRPC, unary calls run concurrently and a
+// streaming client serialises its one stream (open one client per thread for parallel streams).
+// Creating and destroying a client is not concurrent with its use.
 class FrictionClient {
  public:
   virtual ~FrictionClient() = default;

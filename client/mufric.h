@@ -6,6 +6,15 @@
  *   if (mufric_open("grpc://127.0.0.1:50051/gp", &c) != MUFRIC_OK) puts(mufric_last_error());
  *   mufric_evaluate(c, n, p, v, T, NULL, 0.95, mu, NULL, lo, hi, status);
  *   mufric_close(c);
+ *
+ * Threads: mufric_evaluate may be called on one handle from many threads at once (an OpenMP or
+ * MPI + OpenMP meso code's contact loop); tested under ThreadSanitizer. A handle evaluating
+ * in-process (file://) then answers each call on its calling thread: called inside an OpenMP
+ * parallel region of two or more threads, or while another thread's call is running, it starts no
+ * threads of its own.
+ * Outside one it may use OMP_NUM_THREADS threads for a large block. Over grpc:// the calls run
+ * concurrently. mufric_open and mufric_close must not race with calls on the same handle;
+ * mufric_last_error is per thread.
  */
 #ifndef MUFRIC_H
 #define MUFRIC_H

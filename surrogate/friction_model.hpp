@@ -22,6 +22,9 @@ struct EvaluationRequest {
   bool std = false;         // predictive standard deviation
   double ci_level = 0.0;    // 0: no interval; else two-sided level in (0, 1), e.g. 0.95
   bool gradient = false;    // dμ/dinput, SI
+  // Threads this evaluation may use; 0: as many as OpenMP allows. Never more than 1 inside a
+  // parallel region of the caller (evaluation_team_size).
+  int max_threads = 0;
 };
 
 // A batch of query points, structure-of-arrays: column j of an m × d column-major matrix is the

@@ -200,7 +200,7 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
     // the micro-model's own scatter (GaussianProcess::State::micro_std_error).
     Eigen::RowVectorXd norms2;
     if (count <= kRowByRowMaxQueries) {
-      norms2 = squared_norms_row_by_row(k_block);
+      norms2 = squared_norms_row_by_row(k_block, what.max_threads);
     } else {
       v_block.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * k_block;
       norms2 = v_block.colwise().squaredNorm();
@@ -219,7 +219,17 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
   }
 }
 
-Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::MatrixXd& kernels) const {
+int evaluation_team_size(int max_threads) {
+  // Called from a thread of the caller's own parallel region (a meso code's OpenMP loop over its
+  // contact blocks), a team of our own would oversubscribe the cores: evaluate on the calling thread.
+  // A region of one thread is not active (OpenMP's own rule): the other cores are idle and a team
+  // may use them (1.9× faster at n = 900 in examples/c/meso_loop.c; bench/RESULTS.md).
+  if (omp_in_parallel()) return 1;
+  const int available = omp_get_max_threads();
+  return max_threads > 0 ? std::min(max_threads, available) : available;
+}
+
+Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::MatrixXd& kernels, int max_threads) const {
   const Eigen::Index n = scaled_train_.rows();
   const Eigen::Index count = kernels.cols();
   auto rows = [&](Eigen::Index begin, Eigen::Index end) {
@@ -239,7 +249,7 @@ Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::Matrix
     return sums;
   };
   const double bytes = 4.0 * static_cast<double>(n) * static_cast<double>(n);
-  if (bytes <= kSplitRowsAboveBytes || omp_in_parallel() || omp_get_max_threads() < 2) return rows(0, n);
+  if (bytes <= kSplitRowsAboveBytes || evaluation_team_size(max_threads) < 2) return rows(0, n);
   Eigen::RowVectorXd halves[2];
 #pragma omp parallel num_threads(2)
   {
@@ -255,7 +265,8 @@ void GaussianProcess::evaluate_valid(const QueryBatch& x, const EvaluationReques
   if (what.std || what.ci_level > 0.0) out.std.resize(m);
   if (what.gradient) out.gradient.resize(m, x.cols());
   const Eigen::Index blocks = (m + kQueryBlock - 1) / kQueryBlock;
-  if (m < kParallelThreshold) {
+  const int team = evaluation_team_size(what.max_threads);
+  if (m < kParallelThreshold || team < 2) {
     Eigen::MatrixXd k_block, v_block;
     for (Eigen::Index block = 0; block < blocks; ++block) {
       const Eigen::Index first = block * kQueryBlock;
@@ -264,7 +275,7 @@ void GaussianProcess::evaluate_valid(const QueryBatch& x, const EvaluationReques
     return;
   }
   long long clamped = 0;
-#pragma omp parallel reduction(+ : clamped)
+#pragma omp parallel num_threads(team) reduction(+ : clamped)
   {
     Eigen::MatrixXd k_block, v_block;
     // Each block writes disjoint rows of `out`; the clamp counter is per thread.

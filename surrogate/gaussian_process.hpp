@@ -22,6 +22,11 @@ struct GpHyperParameters {
   Eigen::Index count() const { return length_scales.size() + (noise_term ? 2 : 1); }
 };
 
+// Threads one evaluation may use: OpenMP's current limit, or 1 when called from inside an active
+// parallel region (a meso code's OpenMP loop calling at once from several threads), so that no team of our
+// own is started inside the caller's and the cores are not oversubscribed; at most max_threads if > 0.
+int evaluation_team_size(int max_threads = 0);
+
 // What a GP's standard deviation and interval mean, for DescribeModel and `describe`.
 std::string gp_interval_meaning(bool with_micro_scatter);
 
@@ -94,7 +99,7 @@ class GaussianProcess final : public FrictionModel {
   // twin would part ways). Not inlined, so that every caller runs the same instructions.
   [[gnu::noinline]] double mean_from_correlations(const double* correlation) const;
   // |L⁻¹ k_b|² for each column k_b of a few kernel vectors, reading each row of L⁻¹ once.
-  Eigen::RowVectorXd squared_norms_row_by_row(const Eigen::MatrixXd& kernels) const;
+  Eigen::RowVectorXd squared_norms_row_by_row(const Eigen::MatrixXd& kernels, int max_threads) const;
 
   State state_;
   // L⁻¹, row-major. The same n²/2 multiply-adds per query as a triangular solve with L, but without
