@@ -3,6 +3,8 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <atomic>
 #include <mutex>
 #include <cstdlib>
@@ -302,11 +304,86 @@ ServerStatus server_status(const std::string& uri, const Options& options) {
   ServerStatus out{s.code_version(), s.uptime_seconds(), static_cast<long long>(s.requests()),
                    static_cast<long long>(s.points()), static_cast<long long>(s.errors()),
                    static_cast<long long>(s.in_flight()), static_cast<long long>(s.abandoned()),
-                   static_cast<int>(s.evaluation_threads()),
+                   static_cast<long long>(s.streams()), static_cast<int>(s.evaluation_threads()),
                    {s.latency_bounds_us().begin(), s.latency_bounds_us().end()},
                    {s.latency_counts().begin(), s.latency_counts().end()}, {}};
   for (const auto& m : s.models()) out.models.push_back(m.name() + " " + m.version() + " " + m.kind());
   return out;
+}
+
+namespace {
+
+double number_option(const std::string& key, const std::string& value, double lo, double hi) {
+  double x = 0.0;
+  const auto end = value.data() + value.size();
+  const auto [ptr, ec] = std::from_chars(value.data(), end, x);
+  if (ec != std::errc() || ptr != end || !std::isfinite(x)) {
+    throw InvalidArgument("option " + key + ": '" + value + "' is not a number");
+  }
+  if (x < lo || x > hi) {
+    throw InvalidArgument("option " + key + ": " + value + " is outside [" + std::to_string(lo) + ", " +
+                          std::to_string(hi) + "]");
+  }
+  return x;
+}
+
+long long whole_option(const std::string& key, const std::string& value, long long lo, long long hi) {
+  const double x = number_option(key, value, static_cast<double>(lo), static_cast<double>(hi));
+  if (x != std::floor(x)) throw InvalidArgument("option " + key + ": '" + value + "' is not a whole number");
+  return static_cast<long long>(x);
+}
+
+bool flag_option(const std::string& key, const std::string& value) {
+  if (value == "1" || value == "true" || value == "yes" || value == "on") return true;
+  if (value == "0" || value == "false" || value == "no" || value == "off") return false;
+  throw InvalidArgument("option " + key + ": '" + value + "' is not 0/1, true/false, yes/no or on/off");
+}
+
+}  // namespace
+
+Options parse_options(std::string_view text, Options base) {
+  Options o = std::move(base);
+  size_t at = 0;
+  const auto separator = [](char c) { return c == ',' || c == ';' || c == ' ' || c == '\t' || c == '\n'; };
+  while (at < text.size()) {
+    while (at < text.size() && separator(text[at])) ++at;
+    size_t end = at;
+    while (end < text.size() && !separator(text[end])) ++end;
+    if (end == at) break;
+    const std::string item(text.substr(at, end - at));
+    at = end;
+    const auto equals = item.find('=');
+    if (equals == std::string::npos || equals == 0) {
+      throw InvalidArgument("option '" + item + "': expected key=value");
+    }
+    const std::string key = item.substr(0, equals), value = item.substr(equals + 1);
+    if (key == "deadline") {
+      o.deadline_seconds = number_option(key, value, 1e-6, 1e7);
+    } else if (key == "retries") {
+      o.retries = static_cast<int>(whole_option(key, value, 0, 30));
+    } else if (key == "backoff") {
+      o.first_backoff_seconds = number_option(key, value, 0.0, 60.0);
+    } else if (key == "chunk_points") {
+      o.chunk_points = whole_option(key, value, 1, 1'000'000'000);
+    } else if (key == "max_message_mb") {
+      o.max_message_mb = static_cast<int>(whole_option(key, value, 1, 2000));
+    } else if (key == "stream") {
+      o.streaming = flag_option(key, value);
+    } else if (key == "token") {
+      o.token = value;
+    } else if (key == "tls_ca") {
+      o.tls_ca_file = value;
+    } else if (key == "tls_cert") {
+      o.tls_cert_file = value;
+    } else if (key == "tls_key") {
+      o.tls_key_file = value;
+    } else {
+      throw InvalidArgument("option '" + key +
+                            "' is unknown (known: deadline, retries, backoff, chunk_points, max_message_mb, stream, "
+                            "token, tls_ca, tls_cert, tls_key)");
+    }
+  }
+  return o;
 }
 
 std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& options) {

@@ -76,6 +76,13 @@ struct Options {
   bool isolate_file_parsing = false;
 };
 
+// Options from text, for the C ABI and Fortran (and configuration files): "key=value" pairs separated
+// by commas, semicolons or blanks, e.g. "deadline=2, retries=1, stream=1, token=abc".
+// Keys: deadline (s), retries, backoff (s, the first), chunk_points, max_message_mb, stream (0/1),
+// token, tls_ca, tls_cert, tls_key (PEM file paths). Starts from `base`; throws InvalidArgument
+// naming the key or value it cannot use.
+Options parse_options(std::string_view text, Options base = {});
+
 // Threads: evaluate() and describe() may be called from many threads at once on one client (an
 // OpenMP or MPI + OpenMP meso code sharing one handle). In-process, every call evaluates on its
 // calling thread when called from inside a parallel region of two or more threads or while another
@@ -98,6 +105,7 @@ struct ServerStatus {
   double uptime_seconds = 0.0;
   long long requests = 0, points = 0, errors = 0, in_flight = 0;
   long long abandoned = 0;          // evaluations stopped because the caller's deadline passed
+  long long streams = 0;            // EvaluateStream calls opened (their messages are in requests)
   int evaluation_threads = 0;       // cores one batch may use when it runs alone
   std::vector<double> latency_bounds_us;  // histogram of server-side evaluation time
   std::vector<long long> latency_counts;  // one more than bounds: the last is unbounded

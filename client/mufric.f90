@@ -1,7 +1,7 @@
 ! mufric for modern Fortran: ISO_C_BINDING interfaces to the C ABI (mufric.h). SI units throughout.
 !   use mufric
 !   type(c_ptr) :: client
-!   if (mufric_connect('grpc://127.0.0.1:50051/gp', client) /= MUFRIC_OK) print *, mufric_error()
+!   if (mufric_connect('grpc://127.0.0.1:50051/gp', client, 'stream=1') /= MUFRIC_OK) print *, mufric_error()
 !   status = mufric_evaluate(client, n, p, v, t, c_null_ptr, 0.95d0, mu, c_null_ptr, lo, hi, c_null_ptr)
 module mufric
   use, intrinsic :: iso_c_binding
@@ -16,6 +16,12 @@ module mufric
     function c_mufric_open(uri, client) bind(C, name="mufric_open") result(status)
       import :: c_char, c_ptr, c_int
       character(kind=c_char), dimension(*), intent(in) :: uri
+      type(c_ptr), intent(out) :: client
+      integer(c_int) :: status
+    end function
+    function c_mufric_open_with_options(uri, options, client) bind(C, name="mufric_open_with_options") result(status)
+      import :: c_char, c_ptr, c_int
+      character(kind=c_char), dimension(*), intent(in) :: uri, options
       type(c_ptr), intent(out) :: client
       integer(c_int) :: status
     end function
@@ -42,12 +48,18 @@ module mufric
 
 contains
 
-  ! Opens a model by URI (Fortran string, trailing blanks ignored).
-  function mufric_connect(uri, client) result(status)
+  ! Opens a model by URI (Fortran string, trailing blanks ignored). options: as mufric_open_with_options
+  ! in mufric.h, e.g. 'stream=1, deadline=2, token=abc'.
+  function mufric_connect(uri, client, options) result(status)
     character(len=*), intent(in) :: uri
     type(c_ptr), intent(out) :: client
+    character(len=*), intent(in), optional :: options
     integer(c_int) :: status
-    status = c_mufric_open(trim(uri) // c_null_char, client)
+    if (present(options)) then
+      status = c_mufric_open_with_options(trim(uri) // c_null_char, trim(options) // c_null_char, client)
+    else
+      status = c_mufric_open(trim(uri) // c_null_char, client)
+    end if
   end function
 
   ! The last error message of this thread.

@@ -38,6 +38,17 @@ enum mufric_point_status { MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, M
 
 /* uri: "grpc://host:port/model", "file:///path/model.h5" or a path. */
 int mufric_open(const char* uri, mufric_client** client);
+
+/* The same with options, "key=value" pairs separated by commas, semicolons or blanks (NULL or ""
+ * for none); an unknown key or bad value is MUFRIC_INVALID_ARGUMENT naming it. For grpc(s)://:
+ *   deadline=S        seconds per call (default 30)       retries=N    on UNAVAILABLE (default 4)
+ *   backoff=S         first retry pause (default 0.05)    chunk_points=N, max_message_mb=N
+ *   stream=1          every mufric_evaluate on one long-lived stream of this handle (an explicit
+ *                     code's increments: ~5x less overhead per call than unary calls; no deadline)
+ *   token=T           bearer token (else $MUFRIC_TOKEN)
+ *   tls_ca=F, tls_cert=F, tls_key=F   PEM files for grpcs:// (else $MUFRIC_TLS_CA, ...)
+ * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
+int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);
 void mufric_close(mufric_client* client);
 
 /* n points. Inputs: NULL for inputs not sent (the model's own inputs are required). Outputs: NULL
@@ -57,6 +68,9 @@ const char* mufric_last_error(void);
  *   call mufric_evaluate(handle, n, p, v, t, angle, mu, status)   ! all four input arrays, length n
  *   call mufric_close(handle) */
 void mufric_open_(const char* uri, int64_t* handle, int32_t* status, size_t uri_length);
+/*   call mufric_open_with_options('grpc://node7:50051/gp', 'stream=1', handle, status) */
+void mufric_open_with_options_(const char* uri, const char* options, int64_t* handle, int32_t* status,
+                               size_t uri_length, size_t options_length);
 void mufric_evaluate_(const int64_t* handle, const int32_t* n, const double* contact_pressure,
                       const double* sliding_velocity, const double* temperature, const double* fibre_angle, double* mu,
                       int32_t* status);

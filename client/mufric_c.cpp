@@ -20,16 +20,31 @@ int fail(int code, std::string message) {
   return code;
 }
 
+// A Fortran CHARACTER argument: its hidden length, blank padding removed.
+std::string fortran_string(const char* text, size_t length) {
+  std::string s(text, length);
+  s.erase(s.find_last_not_of(' ') + 1);
+  return s;
+}
+
 }  // namespace
 
 extern "C" {
 
-int mufric_open(const char* uri, mufric_client** client) {
+int mufric_open(const char* uri, mufric_client** client) { return mufric_open_with_options(uri, nullptr, client); }
+
+int mufric_open_with_options(const char* uri, const char* options, mufric_client** client) {
   if (uri == nullptr || client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_open: uri and client must not be NULL");
   *client = nullptr;
+  mufric::client::Options parsed;
+  try {
+    parsed = mufric::client::parse_options(options ? options : "");
+  } catch (const std::exception& e) {
+    return fail(MUFRIC_INVALID_ARGUMENT, std::string("mufric_open: ") + e.what());
+  }
   try {
     auto handle = std::make_unique<mufric_client>();
-    handle->impl = mufric::client::connect(uri);
+    handle->impl = mufric::client::connect(uri, parsed);
     handle->impl->describe();  // fail now, not at the first evaluation, if the model is not there
     *client = handle.release();
     last_error.clear();
@@ -73,10 +88,18 @@ int mufric_evaluate(mufric_client* client, size_t n, const double* contact_press
 const char* mufric_last_error(void) { return last_error.c_str(); }
 
 void mufric_open_(const char* uri, int64_t* handle, int32_t* status, size_t uri_length) {
-  std::string text(uri, uri_length);
-  text.erase(text.find_last_not_of(' ') + 1);  // Fortran pads with blanks
+  const std::string text = fortran_string(uri, uri_length);
   mufric_client* client = nullptr;
   *status = mufric_open(text.c_str(), &client);
+  *handle = reinterpret_cast<int64_t>(client);
+}
+
+void mufric_open_with_options_(const char* uri, const char* options, int64_t* handle, int32_t* status,
+                               size_t uri_length, size_t options_length) {
+  const std::string text = fortran_string(uri, uri_length);
+  const std::string option_text = fortran_string(options, options_length);
+  mufric_client* client = nullptr;
+  *status = mufric_open_with_options(text.c_str(), option_text.c_str(), &client);
   *handle = reinterpret_cast<int64_t>(client);
 }
 

@@ -245,6 +245,7 @@ class FrictionService::StreamReactor final
  public:
   StreamReactor(FrictionService& service, const grpc::CallbackServerContext& context, const grpc::Status& authorised)
       : service_(service), context_(context) {
+    ++service_.counters_.streams;
     if (authorised.ok()) {
       StartRead(&request_);
     } else {
@@ -315,6 +316,7 @@ grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerC
   response->set_errors(static_cast<uint64_t>(counters_.errors.load()));
   response->set_in_flight(static_cast<uint64_t>(counters_.in_flight.load()));
   response->set_abandoned(static_cast<uint64_t>(counters_.abandoned.load()));
+  response->set_streams(static_cast<uint64_t>(counters_.streams.load()));
   response->set_evaluation_threads(static_cast<uint32_t>(limits_.evaluation_threads));
   for (const double bound : kLatencyBoundsUs) response->add_latency_bounds_us(bound);
   for (const auto& count : counters_.latency) response->add_latency_counts(static_cast<uint64_t>(count.load()));

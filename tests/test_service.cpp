@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "client/friction_client.hpp"
+#include "client/mufric.h"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "corrupt_files.hpp"
@@ -465,6 +466,76 @@ TEST_F(Service, StandardHealthServiceAnswersServing) {
   std::string bytes;
   for (const auto& s : slices) bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
   EXPECT_EQ(bytes, std::string("\x08\x01", 2));
+}
+
+}  // namespace
+}  // namespace mufric
+
+namespace mufric {
+namespace {
+
+TEST(ClientOptions, ParsedFromTextNamingWhatIsWrong) {
+  const client::Options o = client::parse_options(
+      " deadline=2.5, retries=1;backoff=0.01 chunk_points=4096, max_message_mb=8, stream=yes, token=abc, "
+      "tls_ca=/ca.pem, tls_cert=/c.pem, tls_key=/k.pem");
+  EXPECT_EQ(o.deadline_seconds, 2.5);
+  EXPECT_EQ(o.retries, 1);
+  EXPECT_EQ(o.first_backoff_seconds, 0.01);
+  EXPECT_EQ(o.chunk_points, 4096);
+  EXPECT_EQ(o.max_message_mb, 8);
+  EXPECT_TRUE(o.streaming);
+  EXPECT_EQ(o.token, "abc");
+  EXPECT_EQ(o.tls_ca_file, "/ca.pem");
+  EXPECT_EQ(o.tls_cert_file, "/c.pem");
+  EXPECT_EQ(o.tls_key_file, "/k.pem");
+  EXPECT_EQ(client::parse_options("").deadline_seconds, client::Options{}.deadline_seconds);
+
+  auto refusal = [](const std::string& text) {
+    try {
+      client::parse_options(text);
+    } catch (const client::InvalidArgument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal("deadlin=2").find("'deadlin' is unknown"), std::string::npos) << refusal("deadlin=2");
+  EXPECT_NE(refusal("deadline=soon").find("deadline: 'soon' is not a number"), std::string::npos);
+  EXPECT_NE(refusal("deadline=0").find("outside"), std::string::npos);
+  EXPECT_NE(refusal("retries=1.5").find("not a whole number"), std::string::npos);
+  EXPECT_NE(refusal("stream=maybe").find("stream: 'maybe'"), std::string::npos);
+  EXPECT_NE(refusal("stream").find("expected key=value"), std::string::npos);
+}
+
+// The C ABI's options reach the connection: the token authorises, stream=1 sends every evaluation
+// over one stream (the server counts the streams opened), and a misspelt key is refused by name.
+// (A deadline cannot be shown to bite on loopback without a slow model: a 1 µs call sometimes
+// completes; parse_options is checked above and the C++ client's deadlines in their own tests.)
+TEST_F(Service, CAbiOptionsReachTheConnection) {
+  LoopbackServer server(dir_, 0, {.max_points_per_request = 1000000, .bearer_token = "s3cret"});
+  const std::string uri = "grpc://" + server.address() + "/coulomb";
+  mufric_client* c = nullptr;
+  EXPECT_EQ(mufric_open_with_options(uri.c_str(), "retries=0", &c), MUFRIC_FAILED);
+  EXPECT_NE(std::string(mufric_last_error()).find("UNAUTHENTICATED"), std::string::npos) << mufric_last_error();
+  EXPECT_EQ(mufric_open_with_options(uri.c_str(), "token=s3cret, deadlin=2", &c), MUFRIC_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(mufric_last_error()).find("'deadlin' is unknown"), std::string::npos) << mufric_last_error();
+
+  const Points pts = random_points(5);
+  std::vector<double> mu(5);
+  for (const char* options : {"token=s3cret", "token=s3cret stream=1"}) {
+    ASSERT_EQ(mufric_open_with_options(uri.c_str(), options, &c), MUFRIC_OK) << mufric_last_error();
+    for (int increment = 0; increment < 3; ++increment) {
+      ASSERT_EQ(mufric_evaluate(c, 5, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, mu.data(), nullptr,
+                                nullptr, nullptr, nullptr),
+                MUFRIC_OK)
+          << mufric_last_error();
+      EXPECT_EQ(mu[4], 0.3);
+    }
+    mufric_close(c);
+  }
+  client::Options authorised;
+  authorised.token = "s3cret";
+  EXPECT_EQ(client::server_status("grpc://" + server.address(), authorised).streams, 1)
+      << "stream=1 opens one stream for its three increments";
 }
 
 }  // namespace

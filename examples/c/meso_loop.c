@@ -4,7 +4,9 @@
  * traction tau = mu * p goes into the force, and a point whose 95 % interval is wide (half-width
  * above a fraction of mu) is flagged, as a meso code would log it for the next dataset campaign.
  *
- *   meso_loop URI [increments] [points_per_domain] [wide_fraction]
+ *   meso_loop URI [increments] [points_per_domain] [wide_fraction] [options]
+ *
+ * options as mufric_open_with_options, e.g. "stream=1" for grpc:// (one stream per increment loop).
  *
  * The contact field is synthetic (pressure falling, sliding speed and temperature rising along a
  * 0.2 mm contact length, breathing with the increment) and inside seed 000's box. The run is done
@@ -88,7 +90,7 @@ static void reset(struct domain* domains) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    fprintf(stderr, "usage: %s URI [increments] [points_per_domain] [wide_fraction]\n", argv[0]);
+    fprintf(stderr, "usage: %s URI [increments] [points_per_domain] [wide_fraction] [options]\n", argv[0]);
     return 2;
   }
   const long increments = argc > 2 ? atol(argv[2]) : 50;
@@ -99,7 +101,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   mufric_client* client = NULL;
-  if (mufric_open(argv[1], &client) != MUFRIC_OK) {
+  if (mufric_open_with_options(argv[1], argc > 5 ? argv[5] : NULL, &client) != MUFRIC_OK) {
     fprintf(stderr, "%s\n", mufric_last_error());
     return 2;
   }

@@ -2,7 +2,7 @@
 ! thread gathers its sub-domain's contact points into one block, makes one call on the handle all
 ! threads share, applies tau = mu * p and flags points whose 95 % interval is wide. Run with one
 ! thread and with two at once; checks lo <= mu <= hi, status OK, and that both runs agree to the
-! last bit.   meso_loop URI [increments] [points_per_domain]
+! last bit.   meso_loop URI [increments] [points_per_domain] [options, e.g. 'stream=1']
 program meso_loop
   use, intrinsic :: iso_c_binding
   use omp_lib
@@ -15,7 +15,7 @@ program meso_loop
   real(c_double) :: force(domains), total(2), seconds
   integer :: flagged(domains), bad(domains), flags(2), bads(2)
   type(c_ptr) :: client
-  character(len=512) :: uri, argument
+  character(len=512) :: uri, argument, options
   integer :: n, increments, pass, increment, i, k, failed
   real(c_double) :: s, breathing, dx
 
@@ -30,7 +30,9 @@ program meso_loop
     call get_command_argument(3, argument)
     read (argument, *) n
   end if
-  if (mufric_connect(uri, client) /= MUFRIC_OK) then
+  options = ''
+  if (command_argument_count() >= 4) call get_command_argument(4, options)
+  if (mufric_connect(uri, client, options) /= MUFRIC_OK) then
     print *, 'mufric_connect: ', mufric_error()
     stop 2
   end if
