@@ -1,12 +1,45 @@
 #!/usr/bin/env bash
-# Installs mufric into a temporary prefix and builds tests/package_consumer from scratch against
-# it with find_package(mufric), then runs it on a seed-001 law file.
+# Installs mufric into a temporary prefix and builds meso-side consumers from scratch against it, as
+# their authors would: CMake projects in C++ only (the C++ client), C only and Fortran only
+# (mufric::mufric = libmufric.so), and a plain Makefile with pkg-config (C and Fortran). Each runs.
 set -euo pipefail
 build_dir=$1 source_dir=$2 mufric=$3
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-cmake --install "$build_dir" --prefix "$work/prefix" >/dev/null
-cmake -S "$source_dir/tests/package_consumer" -B "$work/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
-cmake --build "$work/build" >/dev/null
+prefix="$work/prefix"
+cmake --install "$build_dir" --prefix "$prefix" >/dev/null
+
+echo "== installed layout: headers only under include/mufric/"
+ls "$prefix/include"
+test "$(ls "$prefix/include")" = mufric
+test -f "$prefix/include/mufric/mufric.h"
+test -f "$prefix/lib/pkgconfig/mufric.pc"
+
+echo "== models: a seed-001 law file, and a GP on seed 000's box"
 "$mufric" law seward --table 4 --out "$work/law.h5" >/dev/null
-"$work/build/meso" "$work/law.h5"
+"$mufric" law coulomb --mu 0.3 --out "$work/coulomb.h5" >/dev/null
+"$mufric" dataset from-model --model "$work/coulomb.h5" --samples 60 --noise 0.01 --out "$work/data.h5" >/dev/null
+"$mufric" train --data "$work/data.h5" --out "$work/gp.h5" --restarts 1 >/dev/null
+
+echo "== CMake, C++ only: mufric::client"
+cmake -S "$source_dir/tests/package_consumer" -B "$work/cxx" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+cmake --build "$work/cxx" >/dev/null
+"$work/cxx/meso" "$work/law.h5"
+
+for language in c fortran; do
+  if [ "$language" = fortran ] && ! command -v gfortran >/dev/null; then echo "no gfortran: Fortran consumer skipped"; continue; fi
+  echo "== CMake, $language only: mufric::mufric"
+  cmake -S "$source_dir/tests/package_consumer/$language" -B "$work/$language" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" \
+    -DMUFRIC_EXAMPLES="$source_dir/examples" >/dev/null
+  cmake --build "$work/$language" >/dev/null
+  OMP_WAIT_POLICY=passive "$work/$language/meso_loop" "file://$work/gp.h5" 5 200
+done
+
+echo "== Makefile + pkg-config (C and Fortran)"
+mkdir "$work/make"
+PKG_CONFIG_PATH="$prefix/lib/pkgconfig" make -s -C "$work/make" -f "$source_dir/tests/package_consumer/Makefile" \
+  EXAMPLES="$source_dir/examples" FC=gfortran
+for program in meso_loop_c meso_loop_fortran; do
+  OMP_WAIT_POLICY=passive "$work/make/$program" "file://$work/gp.h5" 5 200
+done
+echo "== every consumer built and ran"

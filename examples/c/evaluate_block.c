@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "client/mufric.h"
+#include <mufric/mufric.h>
 
 int main(int argc, char** argv) {
   if (argc < 2) {

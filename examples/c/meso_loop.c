@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "client/mufric.h"
+#include <mufric/mufric.h>
 
 enum { DOMAINS = 2 };
 

@@ -4,7 +4,7 @@
 #include <numbers>
 
 #include "client/friction_client.hpp"
-#include "client/mufric.h"
+#include <mufric/mufric.h>
 
 int main(int argc, char** argv) {
   if (argc < 2) return 2;
