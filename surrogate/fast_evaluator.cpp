@@ -1,0 +1,254 @@
+#include "surrogate/fast_evaluator.hpp"
+
+#include <nlopt.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <random>
+
+#include "common/error.hpp"
+#include "surrogate/vector_exp.hpp"
+
+namespace mufric {
+namespace {
+
+// Grid sizes: cells per input = clamp(ceil(resolution / length scale in unit-box coordinates)).
+constexpr double kFirstResolution = 4.0;
+constexpr int kMaximumCellsPerInput = 4096;
+// Between refinements the resolution grows by the O(h⁴) prediction, within these factors.
+constexpr double kLeastGrowth = 1.25;
+constexpr double kMostGrowth = 3.0;
+constexpr double kGrowthMargin = 1.1;
+// The local searches for the worst error: evaluations each (BOBYQA, Powell 2009).
+constexpr int kLocalSearchEvaluations = 60;
+// log σ is tabulated; σ below this (no noise term, at a training point) cannot be.
+constexpr double kSmallestStd = 1e-300;
+
+std::vector<int> cells_for(const GaussianProcess& gp, double resolution) {
+  std::vector<int> cells;
+  const Eigen::VectorXd& l = gp.state().hyper.length_scales;
+  for (Eigen::Index k = 0; k < l.size(); ++k) {
+    const double wanted = std::ceil(resolution / l(k));
+    cells.push_back(static_cast<int>(
+        std::clamp(wanted, static_cast<double>(TensorCubicGrid::kMinimumCells), static_cast<double>(kMaximumCellsPerInput))));
+  }
+  return cells;
+}
+
+double grid_megabytes(const std::vector<int>& cells) {
+  return static_cast<double>(TensorCubicGrid::node_count(cells)) * 2.0 * sizeof(double) / 1e6;
+}
+
+Eigen::MatrixXd to_si(const Eigen::MatrixXd& u, const InputSpace& box) {
+  Eigen::MatrixXd x(u.rows(), u.cols());
+  for (Eigen::Index k = 0; k < u.cols(); ++k) {
+    const auto& in = box[static_cast<size_t>(k)];
+    x.col(k) = (in.lo + u.col(k).array() * (in.hi - in.lo)).matrix();
+  }
+  return x;
+}
+
+// The exact μ and log σ at every node of a grid.
+TensorCubicGrid tabulate(const GaussianProcess& gp, const std::vector<int>& cells) {
+  const Eigen::MatrixXd x = to_si(TensorCubicGrid::nodes(cells), gp.inputs());
+  const Evaluation e = gp.evaluate(x, {.std = true});
+  Eigen::MatrixXd values(x.rows(), 2);
+  values.col(0) = e.mu;
+  values.col(1) = e.std.array().max(kSmallestStd).log().matrix();
+  return TensorCubicGrid(cells, values);
+}
+
+// Errors of one point, each over its tolerance: the larger one is what the searches maximise.
+struct PointError {
+  double mu_absolute = 0.0, std_relative = 0.0;
+  double score(const FastEvaluatorOptions& o) const {
+    return std::max(mu_absolute / o.mu_tolerance, std_relative / o.std_relative_tolerance);
+  }
+};
+
+PointError error_at(const FastEvaluator& fast, double mu, double std, const double* x) {
+  double mu_fast = 0.0, std_fast = 0.0;
+  fast.evaluate(x, mu_fast, std_fast);
+  return {std::abs(mu_fast - mu), std::abs(std_fast - std) / std::max(std, kSmallestStd)};
+}
+
+struct SearchContext {
+  const FastEvaluator* fast;
+  const GaussianProcess* gp;
+  const FastEvaluatorOptions* options;
+  PointError worst;
+};
+
+double search_objective(unsigned d, const double* u, double*, void* data) {
+  auto* c = static_cast<SearchContext*>(data);
+  Eigen::RowVectorXd x(d);
+  for (unsigned k = 0; k < d; ++k) {
+    const auto& in = c->fast->box()[k];
+    x(k) = in.lo + std::clamp(u[k], 0.0, 1.0) * (in.hi - in.lo);
+  }
+  const Evaluation e = c->gp->evaluate(x, {.std = true});
+  const PointError p = error_at(*c->fast, e.mu(0), e.std(0), x.data());
+  c->worst.mu_absolute = std::max(c->worst.mu_absolute, p.mu_absolute);
+  c->worst.std_relative = std::max(c->worst.std_relative, p.std_relative);
+  return p.score(*c->options);
+}
+
+// Measured on a fresh random set, then (final grid only) local searches from its worst points.
+FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianProcess& gp,
+                                    const FastEvaluatorOptions& o, unsigned seed, bool search) {
+  const auto d = static_cast<Eigen::Index>(gp.inputs().size());
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  Eigen::MatrixXd u(o.check_points, d);
+  for (Eigen::Index i = 0; i < u.rows(); ++i) {
+    for (Eigen::Index k = 0; k < d; ++k) u(i, k) = uniform(rng);
+  }
+  const Eigen::MatrixXd x = to_si(u, gp.inputs());
+  const Evaluation exact = gp.evaluate(x, {.std = true});
+  std::vector<PointError> errors(static_cast<size_t>(x.rows()));
+  PointError worst;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const Eigen::RowVectorXd row = x.row(i);
+    errors[static_cast<size_t>(i)] = error_at(fast, exact.mu(i), exact.std(i), row.data());
+    worst.mu_absolute = std::max(worst.mu_absolute, errors[static_cast<size_t>(i)].mu_absolute);
+    worst.std_relative = std::max(worst.std_relative, errors[static_cast<size_t>(i)].std_relative);
+  }
+  if (search && o.local_searches > 0) {
+    std::vector<size_t> order(errors.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    const size_t starts = std::min(order.size(), static_cast<size_t>(o.local_searches));
+    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(starts), order.end(),
+                      [&](size_t a, size_t b) { return errors[a].score(o) > errors[b].score(o); });
+    SearchContext context{&fast, &gp, &o, worst};
+    for (size_t s = 0; s < starts; ++s) {
+      nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, static_cast<unsigned>(d));
+      const std::vector<double> lower(static_cast<size_t>(d), 0.0), upper(static_cast<size_t>(d), 1.0);
+      nlopt_set_lower_bounds(opt, lower.data());
+      nlopt_set_upper_bounds(opt, upper.data());
+      nlopt_set_max_objective(opt, search_objective, &context);
+      nlopt_set_maxeval(opt, kLocalSearchEvaluations);
+      // A step of a fraction of the smallest cell: the error varies within one cell.
+      std::vector<double> step(static_cast<size_t>(d));
+      for (Eigen::Index k = 0; k < d; ++k) step[static_cast<size_t>(k)] = 0.25 / fast.grid().cells()[static_cast<size_t>(k)];
+      nlopt_set_initial_step(opt, step.data());
+      const Eigen::RowVectorXd row = u.row(static_cast<Eigen::Index>(order[s]));
+      std::vector<double> start(row.data(), row.data() + d);
+      double best = 0.0;
+      nlopt_optimize(opt, start.data(), &best);  // the worst seen is in the context, whatever the outcome
+      nlopt_destroy(opt);
+    }
+    worst = context.worst;
+  }
+  return {FastEvaluator::kBoundSafetyFactor * worst.mu_absolute, FastEvaluator::kBoundSafetyFactor * worst.std_relative};
+}
+
+}  // namespace
+
+FastEvaluator::FastEvaluator(InputSpace box, TensorCubicGrid grid, FastEvaluatorBounds bounds)
+    : box_(std::move(box)), grid_(std::move(grid)), bounds_(bounds) {
+  if (static_cast<int>(box_.size()) != grid_.inputs() || grid_.outputs() != 2) {
+    throw Error("fast evaluator: a grid of " + std::to_string(grid_.inputs()) + " inputs and " +
+                std::to_string(grid_.outputs()) + " outputs for a box of " + std::to_string(box_.size()) +
+                " inputs (expected 2 outputs: mu, log std)");
+  }
+  if (!(bounds_.mu_absolute >= 0.0) || !(bounds_.std_relative >= 0.0)) {
+    throw Error("fast evaluator: error bounds must be >= 0");
+  }
+  const auto d = static_cast<Eigen::Index>(box_.size());
+  lo_.resize(d);
+  inverse_width_.resize(d);
+  for (Eigen::Index k = 0; k < d; ++k) {
+    lo_(k) = box_[static_cast<size_t>(k)].lo;
+    inverse_width_(k) = 1.0 / (box_[static_cast<size_t>(k)].hi - box_[static_cast<size_t>(k)].lo);
+  }
+}
+
+bool FastEvaluator::inside(const double* x) const {
+  for (size_t k = 0; k < box_.size(); ++k) {
+    if (!box_[k].contains(x[k])) return false;
+  }
+  return true;
+}
+
+void FastEvaluator::evaluate(const double* x, double& mu, double& std) const {
+  double u[TensorCubicGrid::kMaximumInputs];
+  const auto d = static_cast<Eigen::Index>(box_.size());
+  for (Eigen::Index k = 0; k < d; ++k) u[k] = (x[k] - lo_(k)) * inverse_width_(k);
+  double out[2];
+  grid_.evaluate(u, out);
+  mu = out[0];
+  std = std::exp(out[1]);
+}
+
+void FastEvaluator::evaluate(const Eigen::MatrixXd& x, double* mu, double* std) const {
+  const Eigen::Index d = x.cols();
+  double u[TensorCubicGrid::kMaximumInputs];
+  double out[2];
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    for (Eigen::Index k = 0; k < d; ++k) u[k] = (x(i, k) - lo_(k)) * inverse_width_(k);
+    grid_.evaluate(u, out);
+    mu[i] = out[0];
+    std[i] = out[1];
+  }
+  exp_in_place(std, x.rows());  // σ from log σ, vectorised over the batch
+}
+
+FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
+  const Evaluation exact = gp.evaluate(x, {.std = true});
+  FastEvaluatorBounds worst{0.0, 0.0};
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const Eigen::RowVectorXd row = x.row(i);
+    const PointError p = error_at(fast, exact.mu(i), exact.std(i), row.data());
+    worst.mu_absolute = std::max(worst.mu_absolute, p.mu_absolute);
+    worst.std_relative = std::max(worst.std_relative, p.std_relative);
+  }
+  return worst;
+}
+
+FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluatorOptions& o) {
+  if (!(o.mu_tolerance > 0.0) || !(o.std_relative_tolerance > 0.0)) {
+    throw Error("fast evaluator: tolerances must be > 0");
+  }
+  if (o.check_points < 1) throw Error("fast evaluator: check_points must be >= 1");
+  auto say = [&](const std::string& line) {
+    if (o.progress) o.progress(line);
+  };
+  double resolution = kFirstResolution;
+  std::vector<int> cells = cells_for(gp, resolution);
+  if (grid_megabytes(cells) > o.max_megabytes) {
+    throw Error("fast evaluator: the coarsest grid needs " + std::to_string(grid_megabytes(cells)) +
+                " MB, more than the cap of " + std::to_string(o.max_megabytes) + " MB");
+  }
+  for (unsigned round = 0;; ++round) {
+    FastEvaluator fast(gp.inputs(), tabulate(gp, cells), {});
+    const FastEvaluatorBounds sampled = measured_bounds(fast, gp, o, o.seed + round, false);
+    const double score = std::max(sampled.mu_absolute / o.mu_tolerance, sampled.std_relative / o.std_relative_tolerance);
+    std::string shape;
+    for (const int c : cells) {
+      if (!shape.empty()) shape += 'x';
+      shape += std::to_string(c);
+    }
+    char line[256];
+    std::snprintf(line, sizeof line, "grid %s cells (%.1f MB): mu within %.2e, std within %.2e relative (sampled)",
+                  shape.c_str(), grid_megabytes(cells), sampled.mu_absolute, sampled.std_relative);
+    say(line);
+    const double growth = std::clamp(std::pow(score, 0.25) * kGrowthMargin, kLeastGrowth, kMostGrowth);
+    const std::vector<int> finer = cells_for(gp, resolution * growth);
+    const bool capped = grid_megabytes(finer) > o.max_megabytes || finer == cells;
+    if (score <= 1.0 || capped) {
+      // Certify this grid: a fresh check set and local searches from its worst points.
+      fast.bounds_ = measured_bounds(fast, gp, o, o.seed + 1000 + round, true);
+      const bool meets = fast.meets(o.mu_tolerance, o.std_relative_tolerance);
+      std::snprintf(line, sizeof line, "certified: mu within %.2e, std within %.2e relative (%s)", fast.bounds_.mu_absolute,
+                    fast.bounds_.std_relative, meets ? "meets the tolerances" : capped ? "memory cap reached" : "refining");
+      say(line);
+      if (meets || capped) return fast;
+    }
+    resolution *= growth;
+    cells = finer;
+  }
+}
+
+}  // namespace mufric

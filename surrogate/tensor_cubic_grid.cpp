@@ -1,0 +1,140 @@
+#include "surrogate/tensor_cubic_grid.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "common/error.hpp"
+
+namespace mufric {
+namespace {
+
+constexpr int kMaximumInputs = TensorCubicGrid::kMaximumInputs;
+
+struct Stencil {
+  long long offset;            // of the first node, in doubles
+  std::array<double, 4> weight;
+};
+
+// The four nodes around u ∈ [0, 1] on `cells` intervals and their cubic Lagrange weights.
+Stencil stencil(double u, int cells, long long stride) {
+  const double x = std::clamp(u, 0.0, 1.0) * cells;
+  const int first = std::clamp(static_cast<int>(std::floor(x)) - 1, 0, cells - 3);
+  const double r = x - first;  // in [0, 3] within the stencil
+  Stencil s;
+  s.offset = first * stride;
+  s.weight = {-(r - 1.0) * (r - 2.0) * (r - 3.0) / 6.0, r * (r - 2.0) * (r - 3.0) / 2.0,
+              -r * (r - 1.0) * (r - 3.0) / 2.0, r * (r - 1.0) * (r - 2.0) / 6.0};
+  return s;
+}
+
+}  // namespace
+
+long long TensorCubicGrid::node_count(const std::vector<int>& cells) {
+  long long count = 1;
+  for (const int c : cells) count *= c + 1;
+  return count;
+}
+
+Eigen::MatrixXd TensorCubicGrid::nodes(const std::vector<int>& cells) {
+  const auto d = static_cast<Eigen::Index>(cells.size());
+  const long long count = node_count(cells);
+  Eigen::MatrixXd u(count, d);
+  for (long long i = 0; i < count; ++i) {
+    long long rest = i;
+    for (Eigen::Index k = d - 1; k >= 0; --k) {
+      const int per = cells[static_cast<size_t>(k)] + 1;
+      u(i, k) = static_cast<double>(rest % per) / cells[static_cast<size_t>(k)];
+      rest /= per;
+    }
+  }
+  return u;
+}
+
+TensorCubicGrid::TensorCubicGrid(std::vector<int> cells, const Eigen::MatrixXd& values)
+    : cells_(std::move(cells)), outputs_(static_cast<int>(values.cols())) {
+  if (cells_.empty() || static_cast<int>(cells_.size()) > kMaximumInputs) {
+    throw Error("cubic grid: " + std::to_string(cells_.size()) + " inputs (1 to " + std::to_string(kMaximumInputs) +
+                " supported)");
+  }
+  for (const int c : cells_) {
+    if (c < kMinimumCells) throw Error("cubic grid: " + std::to_string(c) + " cells along an input (at least 3)");
+  }
+  if (values.rows() != node_count(cells_) || outputs_ < 1) {
+    throw Error("cubic grid: " + std::to_string(values.rows()) + " node values for " +
+                std::to_string(node_count(cells_)) + " nodes");
+  }
+  if (!values.allFinite()) throw Error("cubic grid: non-finite node values");
+  stride_.assign(cells_.size(), outputs_);
+  for (int k = static_cast<int>(cells_.size()) - 2; k >= 0; --k) {
+    stride_[static_cast<size_t>(k)] = stride_[static_cast<size_t>(k) + 1] * (cells_[static_cast<size_t>(k) + 1] + 1);
+  }
+  values_.resize(static_cast<size_t>(values.size()));
+  for (Eigen::Index i = 0; i < values.rows(); ++i) {
+    for (Eigen::Index o = 0; o < values.cols(); ++o) values_[static_cast<size_t>(i * outputs_ + o)] = values(i, o);
+  }
+}
+
+namespace {
+
+// Three inputs, any outputs: the loops the compiler can unroll (the common case: p, v, T).
+template <int Outputs>
+void evaluate_three(const std::array<Stencil, kMaximumInputs>& s, const long long* stride, const double* v,
+                    double* out) {
+  double acc[Outputs] = {};
+  for (int a = 0; a < 4; ++a) {
+    for (int b = 0; b < 4; ++b) {
+      const double wab = s[0].weight[static_cast<size_t>(a)] * s[1].weight[static_cast<size_t>(b)];
+      const double* node = v + a * stride[0] + b * stride[1];
+      for (int c = 0; c < 4; ++c) {
+        const double w = wab * s[2].weight[static_cast<size_t>(c)];
+        for (int o = 0; o < Outputs; ++o) acc[o] += w * node[c * Outputs + o];
+      }
+    }
+  }
+  for (int o = 0; o < Outputs; ++o) out[o] = acc[o];
+}
+
+}  // namespace
+
+void TensorCubicGrid::evaluate(const double* u, double* out) const {
+  const int d = inputs();
+  std::array<Stencil, kMaximumInputs> s;
+  long long base = 0;
+  for (int k = 0; k < d; ++k) {
+    s[static_cast<size_t>(k)] = stencil(u[k], cells_[static_cast<size_t>(k)], stride_[static_cast<size_t>(k)]);
+    base += s[static_cast<size_t>(k)].offset;
+  }
+  const double* v = values_.data() + base;
+  if (d == 3 && outputs_ == 2) {
+    evaluate_three<2>(s, stride_.data(), v, out);
+    return;
+  }
+  for (int o = 0; o < outputs_; ++o) out[o] = 0.0;
+  const long long last = stride_[static_cast<size_t>(d - 1)];  // = outputs: the last input's nodes are adjacent
+  const auto& w_last = s[static_cast<size_t>(d - 1)].weight;
+  // Odometer over the first d − 1 inputs' stencils; the last input's four nodes in the inner loop.
+  std::array<int, kMaximumInputs> digit{};
+  for (;;) {
+    double w = 1.0;
+    long long offset = 0;
+    for (int k = 0; k + 1 < d; ++k) {
+      w *= s[static_cast<size_t>(k)].weight[static_cast<size_t>(digit[static_cast<size_t>(k)])];
+      offset += digit[static_cast<size_t>(k)] * stride_[static_cast<size_t>(k)];
+    }
+    const double* node = v + offset;
+    for (int j = 0; j < 4; ++j) {
+      const double wj = w * w_last[static_cast<size_t>(j)];
+      for (int o = 0; o < outputs_; ++o) out[o] += wj * node[j * last + o];
+    }
+    int k = d - 2;
+    for (; k >= 0; --k) {
+      if (++digit[static_cast<size_t>(k)] < 4) break;
+      digit[static_cast<size_t>(k)] = 0;
+    }
+    if (k < 0) break;
+  }
+}
+
+}  // namespace mufric

@@ -1,0 +1,121 @@
+// The tensor cubic grid against closed forms, and the fast evaluator's measured bound against the
+// exact GP on points it never saw.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "common/error.hpp"
+#include "gp_test_data.hpp"
+#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/gp_training.hpp"
+#include "surrogate/tensor_cubic_grid.hpp"
+
+namespace mufric {
+namespace {
+
+Eigen::MatrixXd values_at_nodes(const std::vector<int>& cells, double (*f)(const Eigen::RowVectorXd&)) {
+  const Eigen::MatrixXd u = TensorCubicGrid::nodes(cells);
+  Eigen::MatrixXd v(u.rows(), 1);
+  for (Eigen::Index i = 0; i < u.rows(); ++i) v(i, 0) = f(u.row(i));
+  return v;
+}
+
+double cubic_in_each_input(const Eigen::RowVectorXd& u) {
+  return std::pow(1.0 + u(0), 3) * (2.0 - u(1)) * (2.0 - u(1)) * (0.5 + u(2) * u(2) * u(2));
+}
+
+double smooth(const Eigen::RowVectorXd& u) { return std::sin(3.0 * u(0)) * std::cos(2.0 * u(1)) * std::exp(u(2)); }
+
+// Cubic Lagrange interpolation is exact for cubics in each input: everywhere, faces and corners
+// included (there the stencil is shifted inward).
+TEST(TensorCubicGrid, ReproducesCubicsExactly) {
+  const std::vector<int> cells{5, 3, 7};
+  const TensorCubicGrid grid(cells, values_at_nodes(cells, cubic_in_each_input));
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::RowVectorXd u =
+        i < 8 ? Eigen::RowVectorXd(Eigen::Vector3d(i & 1, (i >> 1) & 1, (i >> 2) & 1))
+              : Eigen::RowVectorXd(Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)));
+    double out = 0.0;
+    grid.evaluate(u.data(), &out);
+    ASSERT_NEAR(out, cubic_in_each_input(u), 1e-12) << u;
+  }
+}
+
+// The error of a smooth function falls as h⁴: halving every cell divides it by about 16.
+TEST(TensorCubicGrid, ErrorFallsAsTheFourthPowerOfTheCellSize) {
+  auto max_error = [](int n) {
+    const std::vector<int> cells{n, n, n};
+    const TensorCubicGrid grid(cells, values_at_nodes(cells, smooth));
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    double worst = 0.0;
+    for (int i = 0; i < 20000; ++i) {
+      const Eigen::RowVectorXd u = Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)).transpose();
+      double out = 0.0;
+      grid.evaluate(u.data(), &out);
+      worst = std::max(worst, std::abs(out - smooth(u)));
+    }
+    return worst;
+  };
+  const double coarse = max_error(8), fine = max_error(16);
+  EXPECT_GT(coarse / fine, 11.0) << coarse << " " << fine;
+  EXPECT_LT(coarse / fine, 22.0) << coarse << " " << fine;
+}
+
+TEST(TensorCubicGrid, RefusesShapesThatDoNotFit) {
+  EXPECT_THROW(TensorCubicGrid({2, 4}, Eigen::MatrixXd::Zero(15, 1)), Error);   // fewer than 3 cells
+  EXPECT_THROW(TensorCubicGrid({3, 4}, Eigen::MatrixXd::Zero(19, 1)), Error);   // 20 nodes
+  Eigen::MatrixXd nan = Eigen::MatrixXd::Zero(20, 1);
+  nan(3, 0) = std::nan("");
+  EXPECT_THROW(TensorCubicGrid({3, 4}, nan), Error);
+}
+
+GaussianProcess small_gp() {
+  GpTrainingOptions o;
+  o.optimise = false;
+  o.initial.signal_variance = 1.0;
+  o.initial.length_scales = Eigen::Vector3d(0.4, 0.6, 0.5);
+  o.initial.noise_variance = 1e-3;
+  return train_gaussian_process(test::smooth_training_set(120, 7), o);
+}
+
+// The stored bound is never exceeded on fresh random points (10⁶ in the optimised build).
+TEST(FastEvaluator, TheMeasuredBoundHoldsOnFreshPoints) {
+  const GaussianProcess gp = small_gp();
+  FastEvaluatorOptions o;
+  o.check_points = 5000;
+  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  ASSERT_TRUE(fast.meets(o.mu_tolerance, o.std_relative_tolerance))
+      << fast.bounds().mu_absolute << " " << fast.bounds().std_relative;
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  constexpr Eigen::Index kFresh = 20000;
+#else
+  constexpr Eigen::Index kFresh = 1000000;
+#endif
+  const TrainingSet fresh = test::smooth_training_set(kFresh, 99);
+  const FastEvaluatorBounds seen = measure_errors(fast, gp, fresh.x);
+  EXPECT_LE(seen.mu_absolute, fast.bounds().mu_absolute);
+  EXPECT_LE(seen.std_relative, fast.bounds().std_relative);
+  EXPECT_GT(seen.mu_absolute, 0.0);  // an interpolant, not the model itself
+}
+
+// A grid held to a memory cap too small for the tolerance reports the bound it reached, and does
+// not claim to meet the tolerance.
+TEST(FastEvaluator, ACappedGridSaysItDoesNotMeetTheTolerance) {
+  const GaussianProcess gp = small_gp();
+  FastEvaluatorOptions o;
+  o.check_points = 2000;
+  o.max_megabytes = 0.05;
+  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  EXPECT_FALSE(fast.meets(o.mu_tolerance, o.std_relative_tolerance));
+  EXPECT_LE(static_cast<double>(fast.grid().bytes()) / 1e6, o.max_megabytes);
+  const FastEvaluatorBounds seen = measure_errors(fast, gp, test::smooth_training_set(20000, 98).x);
+  EXPECT_LE(seen.mu_absolute, fast.bounds().mu_absolute);
+  EXPECT_LE(seen.std_relative, fast.bounds().std_relative);
+}
+
+}  // namespace
+}  // namespace mufric
