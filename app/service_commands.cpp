@@ -16,9 +16,10 @@ void add_status_command(CLI::App& app) {
   cmd->callback([uri] {
     const client::ServerStatus s = client::server_status(*uri);
     std::printf("mufric %s, up %.1f s, %d evaluation threads: %lld requests, %lld points, %lld errors "
-                "(%lld abandoned at their deadline), %lld in flight, %lld streams opened\n",
+                "(%lld abandoned at their deadline), %lld in flight, %lld streams opened; %lld points answered by "
+                "fast evaluators\n",
                 s.code_version.c_str(), s.uptime_seconds, s.evaluation_threads, s.requests, s.points, s.errors,
-                s.abandoned, s.in_flight, s.streams);
+                s.abandoned, s.in_flight, s.streams, s.fast_points);
     std::printf("server-side evaluation time:\n");
     for (size_t i = 0; i < s.latency_counts.size(); ++i) {
       if (i < s.latency_bounds_us.size()) {

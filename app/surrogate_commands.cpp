@@ -1,4 +1,5 @@
 // train, eval, predict, describe, law, dataset from-model.
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "common/units.hpp"
 #include "surrogate/accuracy.hpp"
 #include "surrogate/empirical_laws.hpp"
+#include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 
@@ -73,11 +75,46 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
   for (const auto& w : report.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
+// --fast-* options of train and upgrade.
+struct FastOptions {
+  FastEvaluatorOptions build;
+  bool skip = false;
+};
+
+void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
+  cmd->add_option("--fast-mu-tolerance", o.build.mu_tolerance,
+                  "Fast evaluator: refine until its measured bound on mu is within this (absolute)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--fast-std-tolerance", o.build.std_relative_tolerance,
+                  "Fast evaluator: ... and its bound on std within this (relative)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--fast-max-mb", o.build.max_megabytes, "Fast evaluator: largest grid, MB")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
+}
+
+// Builds, reports and attaches a fast evaluator (a model whose grid cannot reach the tolerances keeps
+// it with the bound it reached: requests with tighter tolerances get the exact model).
+void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o) {
+  if (o.skip) return;
+  FastEvaluatorOptions build = o.build;
+  build.progress = [](const std::string& line) { std::printf("  fast evaluator: %s\n", line.c_str()); };
+  const auto start = std::chrono::steady_clock::now();
+  auto fast = std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, build));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("fast evaluator: %.1f MB, built in %.1f s; %s\n", static_cast<double>(fast->grid().bytes()) / 1e6, seconds,
+              fast->meets(o.build.mu_tolerance, o.build.std_relative_tolerance)
+                  ? "meets the tolerances: it answers default requests inside the box"
+                  : "does NOT meet the tolerances within the memory cap: default requests get the exact model");
+  gp.attach_fast_evaluator(std::move(fast));
+}
+
 void add_train(CLI::App& app) {
   struct Options {
     std::string data, out;
     GpTrainingOptions gp;
     bool no_noise = false;
+    FastOptions fast;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("train", "Fit a Gaussian-process surrogate (RBF-ARD kernel) to a dataset");
@@ -99,9 +136,12 @@ void add_train(CLI::App& app) {
                 "Put each sample's own variance (/samples/mu_std squared) on the covariance diagonal beside the\n"
                 "learned noise. For samples whose errors are independent; a micro-model plan's samples share\n"
                 "their tool draws, so their errors are correlated and this is off by default");
+  add_fast_evaluator_options(cmd, o->fast);
   cmd->footer("Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
               "cross-validated error. Bounds: signal variance 1e-3..1e5, length scales 1e-2..1e3 box widths,\n"
-              "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).");
+              "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).\n"
+              "Then builds the certified fast evaluator (a grid of mu and log std with a measured error bound;\n"
+              "`mufric describe` shows it): requests whose tolerances its bound meets get it inside the box.");
   cmd->callback([o] {
     o->gp.noise_term = !o->no_noise;
     const Dataset dataset = read_dataset_isolated(o->data);
@@ -114,8 +154,9 @@ void add_train(CLI::App& app) {
     }
     if (!dataset.note.empty()) std::printf("note: %s\n", dataset.note.c_str());
     GpTrainingReport report;
-    const GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
+    GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
     print_training_report(gp, report);
+    attach_fast_evaluator(gp, o->fast);
     save_model(o->out, gp);
     std::printf("wrote %s (gp, %lld training points) in %.2f s\n", o->out.c_str(),
                 static_cast<long long>(data.x.rows()), report.seconds);
@@ -196,8 +237,9 @@ void add_predict(CLI::App& app) {
     for (size_t j = 0; j < inputs.size(); ++j) {
       std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(values[j], inputs[j].kind()).c_str());
     }
-    std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s\n", a.mu[0], a.std[0], 100 * o->level,
-                a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str());
+    std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s  (%s)\n", a.mu[0], a.std[0],
+                100 * o->level, a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str(),
+                a.fast_points > 0 ? "fast evaluator" : "exact model");
     if (o->gradient) {
       for (size_t j = 0; j < inputs.size(); ++j) {
         std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(), a.gradient[j],
@@ -292,8 +334,37 @@ void add_dataset_from_model(CLI::App& app) {
 
 }  // namespace
 
+void add_upgrade(CLI::App& app) {
+  struct Options {
+    std::string model, out;
+    bool rebuild = false;
+    FastOptions fast;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("upgrade", "Rewrite a model file in the current schema, adding a GP's fast evaluator");
+  cmd->add_option("model", o->model, "Model file (any readable schema version)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--out", o->out, "Where to write (default: replace the file, atomically)");
+  cmd->add_flag("--rebuild", o->rebuild, "Rebuild a GP's fast evaluator even if the file has one");
+  add_fast_evaluator_options(cmd, o->fast);
+  cmd->callback([o] {
+    auto model = load_model_isolated(o->model);
+    if (auto* gp = dynamic_cast<GaussianProcess*>(model.get())) {
+      if (gp->fast_evaluator() == nullptr || o->rebuild) {
+        attach_fast_evaluator(*gp, o->fast);
+      } else {
+        std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
+      }
+    }
+    const std::string out = o->out.empty() ? o->model : o->out;
+    save_model(out, *model);
+    std::printf("wrote %s (%s, schema version %lld)\n", out.c_str(), std::string(model->kind()).c_str(),
+                kModelSchemaVersion);
+  });
+}
+
 void add_surrogate_commands(CLI::App& app) {
   add_train(app);
+  add_upgrade(app);
   add_eval(app);
   add_predict(app);
   add_describe(app);

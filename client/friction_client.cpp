@@ -59,6 +59,7 @@ class InProcessClient final : public FrictionClient {
       for (const auto& input : inputs) a.gradient_inputs.push_back(input.name);
     }
     a.status = e.status;
+    a.fast_points = e.fast_points;
     return a;
   }
 
@@ -231,6 +232,13 @@ class GrpcClient final : public FrictionClient {
     request.set_std(what.std);
     request.set_ci_level(what.ci_level);
     request.set_gradient(what.gradient);
+    if (what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0) {
+      request.set_mu_tolerance(-1.0);  // the exact model only
+      request.set_std_tolerance(-1.0);
+    } else {
+      request.set_mu_tolerance(what.mu_tolerance);
+      request.set_std_tolerance(what.std_relative_tolerance);
+    }
     return request;
   }
 
@@ -244,6 +252,7 @@ class GrpcClient final : public FrictionClient {
     answer.gradient.insert(answer.gradient.end(), response.gradient().begin(), response.gradient().end());
     answer.gradient_inputs.assign(response.gradient_inputs().begin(), response.gradient_inputs().end());
     for (const int s : response.status()) answer.status.push_back(static_cast<PointStatus>(s));
+    answer.fast_points += static_cast<long long>(response.fast_points());
   }
 
   // One request, one response on the open stream; the stream is (re)opened as needed, and a stream
@@ -304,7 +313,8 @@ ServerStatus server_status(const std::string& uri, const Options& options) {
   ServerStatus out{s.code_version(), s.uptime_seconds(), static_cast<long long>(s.requests()),
                    static_cast<long long>(s.points()), static_cast<long long>(s.errors()),
                    static_cast<long long>(s.in_flight()), static_cast<long long>(s.abandoned()),
-                   static_cast<long long>(s.streams()), static_cast<int>(s.evaluation_threads()),
+                   static_cast<long long>(s.streams()), static_cast<long long>(s.fast_points()),
+                   static_cast<int>(s.evaluation_threads()),
                    {s.latency_bounds_us().begin(), s.latency_bounds_us().end()},
                    {s.latency_counts().begin(), s.latency_counts().end()}, {}};
   for (const auto& m : s.models()) out.models.push_back(m.name() + " " + m.version() + " " + m.kind());
@@ -377,10 +387,14 @@ Options parse_options(std::string_view text, Options base) {
       o.tls_cert_file = value;
     } else if (key == "tls_key") {
       o.tls_key_file = value;
+    } else if (key == "mu_tolerance") {
+      o.mu_tolerance = number_option(key, value, 0.0, 1.0);
+    } else if (key == "std_tolerance") {
+      o.std_tolerance = number_option(key, value, 0.0, 1.0);
     } else {
       throw InvalidArgument("option '" + key +
                             "' is unknown (known: deadline, retries, backoff, chunk_points, max_message_mb, stream, "
-                            "token, tls_ca, tls_cert, tls_key)");
+                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance)");
     }
   }
   return o;

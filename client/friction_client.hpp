@@ -46,6 +46,7 @@ struct Answer {
   std::vector<double> gradient;         // row-major points × gradient_inputs, if requested
   std::vector<std::string> gradient_inputs;
   std::vector<PointStatus> status;
+  long long fast_points = 0;  // answered by the model's fast evaluator; the rest by the exact model
 };
 
 struct ModelInfo {
@@ -74,12 +75,16 @@ struct Options {
   // load_model_isolated), so a corrupt file is an Error instead of a crash of this process. For
   // command-line tools; a meso code's own process (MPI, many threads) should not fork.
   bool isolate_file_parsing = false;
+  // For the C ABI's and Fortran's calls (C++ callers set them per call in EvaluationRequest): the
+  // tolerances a fast evaluator must meet to answer; 0 (either): the exact model only.
+  double mu_tolerance = EvaluationRequest{}.mu_tolerance;
+  double std_tolerance = EvaluationRequest{}.std_relative_tolerance;
 };
 
 // Options from text, for the C ABI and Fortran (and configuration files): "key=value" pairs separated
 // by commas, semicolons or blanks, e.g. "deadline=2, retries=1, stream=1, token=abc".
 // Keys: deadline (s), retries, backoff (s, the first), chunk_points, max_message_mb, stream (0/1),
-// token, tls_ca, tls_cert, tls_key (PEM file paths). Starts from `base`; throws InvalidArgument
+// token, tls_ca, tls_cert, tls_key (PEM file paths), mu_tolerance, std_tolerance (0: exact model). Starts from `base`; throws InvalidArgument
 // naming the key or value it cannot use.
 Options parse_options(std::string_view text, Options base = {});
 
@@ -106,6 +111,7 @@ struct ServerStatus {
   long long requests = 0, points = 0, errors = 0, in_flight = 0;
   long long abandoned = 0;          // evaluations stopped because the caller's deadline passed
   long long streams = 0;            // EvaluateStream calls opened (their messages are in requests)
+  long long fast_points = 0;        // points answered by a fast evaluator
   int evaluation_threads = 0;       // cores one batch may use when it runs alone
   std::vector<double> latency_bounds_us;  // histogram of server-side evaluation time
   std::vector<long long> latency_counts;  // one more than bounds: the last is unbounded

@@ -47,6 +47,9 @@ int mufric_open(const char* uri, mufric_client** client);
  *                     code's increments: ~5x less overhead per call than unary calls; no deadline)
  *   token=T           bearer token (else $MUFRIC_TOKEN)
  *   tls_ca=F, tls_cert=F, tls_key=F   PEM files for grpcs:// (else $MUFRIC_TLS_CA, ...)
+ *   mu_tolerance=E, std_tolerance=R   a model's certified fast evaluator answers (inside its box)
+ *                     only if its measured bound is within these (defaults 1e-6 absolute on mu,
+ *                     1e-3 relative on std); 0: the exact model for every point
  * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
 int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);
 void mufric_close(mufric_client* client);

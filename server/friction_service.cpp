@@ -135,7 +135,16 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   const auto n = static_cast<int>(batch.rows());
   response.set_model(served->name);
   response.set_version(served->version);
-  const EvaluationRequest what{.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()};
+  if (!std::isfinite(request.mu_tolerance()) || !std::isfinite(request.std_tolerance())) {
+    return {grpc::StatusCode::INVALID_ARGUMENT, "fields mu_tolerance and std_tolerance must be finite"};
+  }
+  EvaluationRequest what{.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()};
+  if (request.mu_tolerance() < 0.0 || request.std_tolerance() < 0.0) {
+    what.mu_tolerance = what.std_relative_tolerance = 0.0;  // the exact model only
+  } else {
+    if (request.mu_tolerance() > 0.0) what.mu_tolerance = request.mu_tolerance();
+    if (request.std_tolerance() > 0.0) what.std_relative_tolerance = request.std_tolerance();
+  }
   UncertainQueryLog* const log = model.has_uncertainty() ? limits_.uncertain_log : nullptr;
   EvaluationRequest computed = what;
   computed.std = what.std || log != nullptr;
@@ -151,7 +160,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   }
   auto* statuses = response.mutable_status();
   statuses->Reserve(n);
-  uint64_t extrapolated = 0, invalid = 0;
+  uint64_t extrapolated = 0, invalid = 0, fast = 0;
   // Chunks, so that a call whose caller has given up (deadline passed, cancelled) stops within a
   // few milliseconds instead of computing an answer nobody reads.
   for (int first = 0; first < n; first += static_cast<int>(kPointsBetweenDeadlineChecks)) {
@@ -163,6 +172,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
     const Evaluation e = count == n ? model.evaluate(batch, computed)
                                     : model.evaluate(QueryBatch(batch.middleRows(first, count)), computed);
     if (log != nullptr) log->record(served->name, model.inputs(), batch.middleRows(first, count), e.std);
+    fast += static_cast<uint64_t>(e.fast_points);
     response.mutable_mu()->Add(e.mu.data(), e.mu.data() + count);
     if (what.std) response.mutable_std()->Add(e.std.data(), e.std.data() + count);
     if (what.ci_level > 0.0) {
@@ -181,6 +191,8 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   }
   response.set_extrapolated_points(extrapolated);
   response.set_invalid_points(invalid);
+  response.set_fast_points(fast);
+  counters_.fast_points += static_cast<long long>(fast);
   for (auto& name : ignored) response.add_ignored_inputs(std::move(name));
   counters_.points += n;
   return grpc::Status::OK;
@@ -317,6 +329,7 @@ grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerC
   response->set_in_flight(static_cast<uint64_t>(counters_.in_flight.load()));
   response->set_abandoned(static_cast<uint64_t>(counters_.abandoned.load()));
   response->set_streams(static_cast<uint64_t>(counters_.streams.load()));
+  response->set_fast_points(static_cast<uint64_t>(counters_.fast_points.load()));
   response->set_evaluation_threads(static_cast<uint32_t>(limits_.evaluation_threads));
   for (const double bound : kLatencyBoundsUs) response->add_latency_bounds_us(bound);
   for (const auto& count : counters_.latency) response->add_latency_counts(static_cast<uint64_t>(count.load()));

@@ -63,6 +63,7 @@ class FrictionService final : public mufric::v1::FrictionService::CallbackServic
     std::atomic<int> in_flight{0};  // handlers running now; a drain waits for zero
     std::atomic<long long> abandoned{0};  // stopped part-way: deadline passed or call cancelled
     std::atomic<long long> streams{0};    // EvaluateStream calls opened
+    std::atomic<long long> fast_points{0};  // answered by a fast evaluator
     std::array<std::atomic<long long>, kLatencyBoundsUs.size() + 1> latency{};
   };
   const Counters& counters() const { return counters_; }

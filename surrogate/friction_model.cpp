@@ -96,6 +96,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
   }
   if (!what.std && what.ci_level > 0.0) out.std.resize(0);
   out.clamped_variances = inner.clamped_variances;
+  out.fast_points = inner.fast_points;
   return out;
 }
 

@@ -25,6 +25,10 @@ struct EvaluationRequest {
   // Threads this evaluation may use; 0: as many as OpenMP allows. Never more than 1 inside a
   // parallel region of the caller (evaluation_team_size).
   int max_threads = 0;
+  // A model's certified fast evaluator (FastEvaluator) answers only where its measured error bound
+  // is within these; 0 (either): the exact model answers everywhere.
+  double mu_tolerance = 1e-6;             // absolute, μ units
+  double std_relative_tolerance = 1e-3;   // of σ, i.e. of the interval's half-width
 };
 
 // A batch of query points, structure-of-arrays: column j of an m × d column-major matrix is the
@@ -38,6 +42,7 @@ struct Evaluation {
   Eigen::MatrixXd gradient;       // m × d, or empty
   std::vector<PointStatus> status;  // m
   long long clamped_variances = 0;  // negative predictive variances clamped to zero
+  long long fast_points = 0;        // points answered by the fast evaluator (the rest: the exact model)
 };
 
 class FrictionModel {

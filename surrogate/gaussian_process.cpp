@@ -8,6 +8,7 @@
 
 #include "common/error.hpp"
 #include "surrogate/cholesky.hpp"
+#include "surrogate/fast_evaluator.hpp"
 #include "surrogate/vector_exp.hpp"
 
 namespace mufric {
@@ -259,7 +260,65 @@ Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::Matrix
   return halves[0] + halves[1];
 }
 
+void GaussianProcess::attach_fast_evaluator(std::shared_ptr<const FastEvaluator> fast) {
+  if (fast) {
+    const InputSpace& box = fast->box();
+    bool same = box.size() == inputs().size();
+    for (size_t k = 0; same && k < box.size(); ++k) {
+      same = box[k].name == inputs()[k].name && box[k].lo == inputs()[k].lo && box[k].hi == inputs()[k].hi;
+    }
+    if (!same) throw Error("fast evaluator: its box is not the model's training box");
+  }
+  fast_ = std::move(fast);
+}
+
 void GaussianProcess::evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const {
+  if (!fast_ || !fast_->meets(what.mu_tolerance, what.std_relative_tolerance)) {
+    evaluate_exact(x, what, out);
+    return;
+  }
+  const Eigen::Index m = x.rows(), d = x.cols();
+  std::vector<Eigen::Index> inside, outside;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    double point[TensorCubicGrid::kMaximumInputs];
+    for (Eigen::Index k = 0; k < d; ++k) point[k] = x(i, k);
+    (fast_->inside(point) ? inside : outside).push_back(i);
+  }
+  auto rows = [&](const std::vector<Eigen::Index>& which) {
+    QueryBatch part(static_cast<Eigen::Index>(which.size()), d);
+    for (size_t r = 0; r < which.size(); ++r) part.row(static_cast<Eigen::Index>(r)) = x.row(which[r]);
+    return part;
+  };
+  const bool need_std = what.std || what.ci_level > 0.0;
+  // The gradient is the exact model's at every point; μ and σ inside the box are the fast
+  // evaluator's whatever else is asked, so that asking for the gradient does not move μ.
+  if (what.gradient) {
+    evaluate_exact(x, what, out);
+  } else {
+    out.mu.resize(m);
+    if (need_std) out.std.resize(m);
+    if (!outside.empty()) {
+      Evaluation exact;
+      evaluate_exact(rows(outside), what, exact);
+      for (size_t r = 0; r < outside.size(); ++r) {
+        out.mu(outside[r]) = exact.mu(static_cast<Eigen::Index>(r));
+        if (need_std) out.std(outside[r]) = exact.std(static_cast<Eigen::Index>(r));
+      }
+      out.clamped_variances += exact.clamped_variances;
+    }
+  }
+  const QueryBatch in_box = outside.empty() ? QueryBatch() : rows(inside);
+  const QueryBatch& fast_rows = outside.empty() ? x : in_box;
+  Eigen::VectorXd mu(fast_rows.rows()), sd(fast_rows.rows());
+  fast_->evaluate(fast_rows, mu.data(), sd.data());
+  for (size_t r = 0; r < inside.size(); ++r) {
+    out.mu(inside[r]) = mu(static_cast<Eigen::Index>(r));
+    if (need_std) out.std(inside[r]) = sd(static_cast<Eigen::Index>(r));
+  }
+  out.fast_points += static_cast<long long>(inside.size());
+}
+
+void GaussianProcess::evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const {
   const Eigen::Index m = x.rows();
   out.mu.resize(m);
   if (what.std || what.ci_level > 0.0) out.std.resize(m);
@@ -319,6 +378,15 @@ std::string GaussianProcess::summary() const {
   s << "  leave-one-out: mean relative error " << 100.0 * t.loo_mean_relative_error << " %, max "
     << 100.0 * t.loo_max_relative_error << " %, RMSE " << t.loo_rmse << ", 95 % coverage "
     << 100.0 * t.loo_coverage_95 << " %";
+  if (fast_) {
+    s << "\n  fast evaluator: grid ";
+    for (size_t k = 0; k < fast_->grid().cells().size(); ++k) s << (k ? "x" : "") << fast_->grid().cells()[k];
+    s << " cells (" << static_cast<double>(fast_->grid().bytes()) / 1e6 << " MB); measured bound: mu "
+      << fast_->bounds().mu_absolute << " absolute, std " << fast_->bounds().std_relative
+      << " relative; it answers requests whose tolerances are at least these, inside the box";
+  } else {
+    s << "\n  fast evaluator: none (the exact model answers; `mufric upgrade` adds one)";
+  }
   return s.str();
 }
 

@@ -2,6 +2,7 @@
 // Gaussian-process regression (Rasmussen & Williams 2006, Algorithm 2.1) with the scikit-learn
 // kernel convention k(x, x') = σ² exp(−½ Σᵢ ((xᵢ − x'ᵢ)/lᵢ)²) + σn² δ(x, x'), inputs scaled to the
 // unit box of the declared training box, outputs normalised by mean and (population) std.
+#include <memory>
 #include <string>
 
 #include <Eigen/Dense>
@@ -9,6 +10,8 @@
 #include "surrogate/friction_model.hpp"
 
 namespace mufric {
+
+class FastEvaluator;
 
 struct GpHyperParameters {
   double signal_variance = 1.0;      // σ², in normalised-output units
@@ -81,6 +84,12 @@ class GaussianProcess final : public FrictionModel {
   // Rebuilds a model from the file's groups; refuses inconsistent contents (names the field).
   static GaussianProcess read(const h5::Reader& in, InputSpace inputs);
 
+  // The certified fast evaluator (surrogate/fast_evaluator.hpp) answers, instead of the exact
+  // model, the points inside the box when its bound is within the request's tolerances; μ is then
+  // the same whatever else is asked (the gradient, always exact, does not move μ). Stored in the model file.
+  void attach_fast_evaluator(std::shared_ptr<const FastEvaluator> fast);
+  const FastEvaluator* fast_evaluator() const { return fast_.get(); }
+
   // Store the n × n factor in model files up to this size; larger models refactorise on load.
   static constexpr Eigen::Index kStoreCholeskyUpTo = 2000;
 
@@ -89,6 +98,7 @@ class GaussianProcess final : public FrictionModel {
   void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const override;
 
  private:
+  void evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const;
   void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
                       Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block, Evaluation& out, long long& clamped) const;
 
@@ -107,6 +117,7 @@ class GaussianProcess final : public FrictionModel {
   // is a streaming matrix–vector product whose rows two cores split between their own L2 caches.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse_factor_;
   Eigen::Index row_split_ = 0;  // rows [0, split) and [split, n) hold equal halves of the entries
+  std::shared_ptr<const FastEvaluator> fast_;
   Eigen::RowVectorXd box_lo_;
   Eigen::RowVectorXd inverse_box_width_;
   Eigen::MatrixXd scaled_train_;       // x_unit / l, n × d

@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
 
+#include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "common/isolation.hpp"
 #include "common/version.hpp"
 #include "surrogate/cholesky.hpp"
 #include "surrogate/empirical_laws.hpp"
+#include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gaussian_process.hpp"
 
 namespace mufric {
@@ -60,6 +65,23 @@ constexpr std::pair<const char*, std::string GpTrainingSummary::*> kSummaryTexts
     {"code_version", &GpTrainingSummary::code_version},
     {"created_utc", &GpTrainingSummary::created_utc}};
 constexpr const char* kSummaryGroup = "/gp/training";
+constexpr const char* kFastGroup = "/gp/fast_evaluator";
+// Nodes of a stored fast evaluator recomputed with the exact model at load, and how close they must be
+// (they are the exact model's values: only the summation order of a batch may differ).
+constexpr long long kFastSpotChecks = 64;
+constexpr double kFastNodeTolerance = 1e-9;
+
+// What the stored checksum covers: the grid's shape, its node values' bytes and the bounds.
+std::string fast_evaluator_digest(const std::vector<long long>& cells, const std::vector<double>& values, double mu_bound,
+                                  double std_bound) {
+  std::string bytes;
+  for (const long long c : cells) bytes += std::to_string(c) + ",";
+  char bounds[64];
+  std::snprintf(bounds, sizeof bounds, "%.17g,%.17g,", mu_bound, std_bound);
+  bytes += bounds;
+  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return sha256_hex(bytes);
+}
 
 std::vector<double> column(const std::vector<MlrRow>& rows, double MlrRow::*field) {
   std::vector<double> values;
@@ -166,6 +188,76 @@ MlrLaw MlrLaw::read(const h5::Reader& in, InputSpace inputs) {
 }
 
 // ---- Gaussian process ----------------------------------------------------------------------
+namespace {
+
+// A stored fast evaluator, refused unless its checksum matches and sampled nodes are the exact model's.
+std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, const GaussianProcess& gp) {
+  const std::string group = kFastGroup;
+  const std::vector<long long> cells = in.ints(group + "/cells");
+  const std::vector<double> values = in.doubles(group + "/values");
+  const FastEvaluatorBounds bounds{in.double_attribute(kFastGroup, "bound_mu_absolute"),
+                                   in.double_attribute(kFastGroup, "bound_std_relative")};
+  if (fast_evaluator_digest(cells, values, bounds.mu_absolute, bounds.std_relative) !=
+      in.string_attribute(kFastGroup, "sha256")) {
+    in.fail(group, "checksum mismatch: the interpolant or its bounds changed after it was certified");
+  }
+  if (cells.size() != gp.inputs().size()) {
+    in.fail(group + "/cells", "has " + std::to_string(cells.size()) + " entries for " +
+                                  std::to_string(gp.inputs().size()) + " inputs");
+  }
+  std::vector<int> shape;
+  for (const long long c : cells) {
+    if (c < TensorCubicGrid::kMinimumCells || c > std::numeric_limits<int>::max()) in.fail(group + "/cells", "out of range");
+    shape.push_back(static_cast<int>(c));
+  }
+  long long nodes = 0;
+  try {
+    nodes = TensorCubicGrid::node_count(shape);
+  } catch (const Error& e) {
+    in.fail(group + "/cells", e.what());
+  }
+  if (static_cast<long long>(values.size()) != 2 * nodes) {
+    in.fail(group + "/values", "has " + std::to_string(values.size()) + " values for " +
+                                   std::to_string(TensorCubicGrid::node_count(shape)) + " nodes of 2 outputs");
+  }
+  const Eigen::MatrixXd node_values =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(values.data(),
+                                                                                   static_cast<Eigen::Index>(values.size() / 2), 2);
+  std::shared_ptr<const FastEvaluator> fast;
+  try {
+    fast = std::make_shared<const FastEvaluator>(gp.inputs(), TensorCubicGrid(shape, node_values), bounds);
+  } catch (const Error& e) {
+    in.fail(group, e.what());
+  }
+  // Spot check: evenly spaced nodes against the exact model (a grid from another model fails here).
+  const Eigen::MatrixXd all_nodes = TensorCubicGrid::nodes(shape);
+  const long long count = all_nodes.rows(), checks = std::min(count, kFastSpotChecks);
+  Eigen::MatrixXd x(checks, all_nodes.cols());
+  std::vector<long long> which;
+  for (long long c = 0; c < checks; ++c) {
+    which.push_back(c * (count - 1) / std::max(1LL, checks - 1));
+    for (Eigen::Index k = 0; k < x.cols(); ++k) {
+      const auto& input = gp.inputs()[static_cast<size_t>(k)];
+      x(c, k) = input.lo + all_nodes(which.back(), k) * (input.hi - input.lo);
+    }
+  }
+  EvaluationRequest exact{.std = true};
+  exact.mu_tolerance = 0.0;
+  const Evaluation e = gp.evaluate(x, exact);
+  for (long long c = 0; c < checks; ++c) {
+    const double mu = values[static_cast<size_t>(2 * which[static_cast<size_t>(c)])];
+    const double log_std = values[static_cast<size_t>(2 * which[static_cast<size_t>(c)] + 1)];
+    if (std::abs(mu - e.mu(c)) > kFastNodeTolerance || std::abs(log_std - std::log(std::max(e.std(c), 1e-300))) > kFastNodeTolerance) {
+      in.fail(group + "/values", "node " + std::to_string(which[static_cast<size_t>(c)]) +
+                                     " is not the model's value there (mu " + std::to_string(mu) + " against " +
+                                     std::to_string(e.mu(c)) + ")");
+    }
+  }
+  return fast;
+}
+
+}  // namespace
+
 void GaussianProcess::write(h5::Writer& out) const {
   const auto& s = state_;
   out.group("/gp");
@@ -187,6 +279,20 @@ void GaussianProcess::write(h5::Writer& out) const {
   for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(kSummaryGroup, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryCounts) out.int_attribute(kSummaryGroup, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryTexts) out.string_attribute(kSummaryGroup, name, s.summary.*field);
+  if (fast_) {
+    const std::vector<long long> cells(fast_->grid().cells().begin(), fast_->grid().cells().end());
+    const FastEvaluatorBounds& b = fast_->bounds();
+    out.group(kFastGroup);
+    out.string_attribute(kFastGroup, "interpolation",
+                         "piecewise-cubic tensor Lagrange on a uniform grid over the unit box; node values (mu, log std), "
+                         "node-major, last input fastest; bounds measured against the exact GP");
+    out.ints(std::string(kFastGroup) + "/cells", cells);
+    out.doubles(std::string(kFastGroup) + "/values", fast_->grid().values());
+    out.double_attribute(kFastGroup, "bound_mu_absolute", b.mu_absolute);
+    out.double_attribute(kFastGroup, "bound_std_relative", b.std_relative);
+    out.string_attribute(kFastGroup, "sha256",
+                         fast_evaluator_digest(cells, fast_->grid().values(), b.mu_absolute, b.std_relative));
+  }
 }
 
 GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
@@ -274,7 +380,9 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
     for (const auto& [name, field] : kSummaryCounts) s.summary.*field = in.int_attribute(kSummaryGroup, name);
     for (const auto& [name, field] : kSummaryTexts) s.summary.*field = in.string_attribute(kSummaryGroup, name);
   }
-  return GaussianProcess(std::move(s));
+  GaussianProcess gp(std::move(s));
+  if (in.has(kFastGroup)) gp.attach_fast_evaluator(read_fast_evaluator(in, gp));
+  return gp;
 }
 
 }  // namespace mufric

@@ -13,7 +13,9 @@ namespace mufric {
 
 // Version 2 added a GP's optional /gp/known_noise and its micro_std_error attribute (the micro-model's
 // scatter, part of the interval); version-1 files still load (no scatter: the interval as before).
-inline constexpr long long kModelSchemaVersion = 2;
+// Version 3 added a GP's optional /gp/fast_evaluator (cells, values, bounds, sha256): the certified
+// fast evaluator; older files load without one (`mufric upgrade` adds it).
+inline constexpr long long kModelSchemaVersion = 3;
 inline constexpr long long kOldestReadableModelSchema = 1;
 inline constexpr const char* kModelFormat = "mufric-model";
 

@@ -32,8 +32,15 @@ Stencil stencil(double u, int cells, long long stride) {
 }  // namespace
 
 long long TensorCubicGrid::node_count(const std::vector<int>& cells) {
+  // A grid this large could not be stored anyway; the check keeps a hostile shape from overflowing.
+  constexpr long long kMostNodes = 1LL << 40;
   long long count = 1;
-  for (const int c : cells) count *= c + 1;
+  for (const int c : cells) {
+    if (c < 0 || count > kMostNodes / (static_cast<long long>(c) + 1)) {
+      throw Error("cubic grid: more than 2^40 nodes");
+    }
+    count *= c + 1;
+  }
   return count;
 }
 

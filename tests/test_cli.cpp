@@ -125,6 +125,26 @@ TEST_F(Cli, LawPredictTrainEvalChain) {
   r = run("predict --model " + path("gp.h5") + " --p 80MPa --v 10m/min --angle 90deg");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("95 % interval ["), std::string::npos);
+  EXPECT_NE(r.output.find("(fast evaluator)"), std::string::npos) << r.output;  // train builds it
+}
+
+// A model trained without a fast evaluator gets one from `upgrade`; describe and predict say so.
+TEST_F(Cli, UpgradeAddsAFastEvaluator) {
+  ASSERT_EQ(run("law seward --table 4 --out " + path("law.h5")).exit_code, 0);
+  ASSERT_EQ(run("dataset from-model --model " + path("law.h5") + " --samples 80 --out " + path("db.h5")).exit_code, 0);
+  ASSERT_EQ(run("train --data " + path("db.h5") + " --out " + path("gp.h5") + " --restarts 0 --no-fast-evaluator").exit_code, 0);
+  CommandResult r = run("describe " + path("gp.h5"));
+  EXPECT_NE(r.output.find("fast evaluator: none"), std::string::npos) << r.output;
+  r = run("predict --model " + path("gp.h5") + " --p 80MPa --v 10m/min --angle 90deg");
+  EXPECT_NE(r.output.find("(exact model)"), std::string::npos) << r.output;
+  r = run("upgrade " + path("gp.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("meets the tolerances"), std::string::npos) << r.output;
+  r = run("describe " + path("gp.h5"));
+  EXPECT_NE(r.output.find("measured bound: mu"), std::string::npos) << r.output;
+  r = run("predict --model " + path("gp.h5") + " --p 80MPa --v 10m/min --angle 90deg");
+  EXPECT_NE(r.output.find("(fast evaluator)"), std::string::npos) << r.output;
+  EXPECT_NE(run("upgrade " + path("nope.h5")).exit_code, 0);
 }
 
 TEST_F(Cli, NumberWithoutUnitNamesTheFlag) {

@@ -119,3 +119,69 @@ TEST(FastEvaluator, ACappedGridSaysItDoesNotMeetTheTolerance) {
 
 }  // namespace
 }  // namespace mufric
+
+namespace mufric {
+namespace {
+
+std::shared_ptr<const FastEvaluator> fast_for(const GaussianProcess& gp) {
+  FastEvaluatorOptions o;
+  o.check_points = 3000;
+  return std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, o));
+}
+
+// Points with their coordinates outside the box in every fifth row.
+Eigen::MatrixXd queries_with_some_outside(Eigen::Index count) {
+  Eigen::MatrixXd x = test::smooth_training_set(count, 31).x;
+  for (Eigen::Index i = 0; i < count; i += 5) x(i, 0) = 2000e6;  // above the box (300–1300 MPa)
+  return x;
+}
+
+// Inside the box and within the request's tolerances the fast evaluator answers (and says so);
+// outside the box, or with tighter tolerances than its bound, the exact model does.
+TEST(FastEvaluator, AnswersInsideTheBoxWhenItsBoundMeetsTheRequest) {
+  GaussianProcess gp = small_gp();
+  const auto fast = fast_for(gp);
+  gp.attach_fast_evaluator(fast);
+  const Eigen::MatrixXd x = queries_with_some_outside(1000);
+  EvaluationRequest exact_only{.std = true};
+  exact_only.mu_tolerance = 0.0;
+  const Evaluation exact = gp.evaluate(x, exact_only);
+  EXPECT_EQ(exact.fast_points, 0);
+  const Evaluation e = gp.evaluate(x, {.std = true});
+  long long inside = 0;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const Eigen::RowVectorXd row = x.row(i);
+    if (fast->inside(row.data())) {
+      ++inside;
+      double mu = 0.0, sd = 0.0;
+      fast->evaluate(row.data(), mu, sd);
+      EXPECT_EQ(e.mu(i), mu) << i;
+      EXPECT_NEAR(e.std(i), sd, 1e-14 * sd) << i;  // batch and single exp may differ in the last ulps
+      EXPECT_LE(std::abs(e.mu(i) - exact.mu(i)), fast->bounds().mu_absolute) << i;
+    } else {
+      EXPECT_EQ(e.mu(i), exact.mu(i)) << i;
+      EXPECT_NEAR(e.std(i), exact.std(i), 1e-12 * exact.std(i)) << i;  // other batch blocks: other rounding
+    }
+  }
+  EXPECT_EQ(e.fast_points, inside);
+  EXPECT_EQ(inside, 800);
+  EvaluationRequest tighter{.std = true};
+  tighter.mu_tolerance = fast->bounds().mu_absolute / 2.0;
+  EXPECT_EQ(gp.evaluate(x, tighter).fast_points, 0);
+}
+
+// With the fast evaluator too, μ does not move by a bit when the interval or the gradient is asked.
+TEST(FastEvaluator, MuIsTheSameBitsWhateverElseIsAsked) {
+  GaussianProcess gp = small_gp();
+  gp.attach_fast_evaluator(fast_for(gp));
+  const Eigen::MatrixXd x = queries_with_some_outside(500);
+  const Evaluation mean_only = gp.evaluate(x, {});
+  for (const EvaluationRequest& what :
+       {EvaluationRequest{.std = true}, EvaluationRequest{.ci_level = 0.95}, EvaluationRequest{.gradient = true}}) {
+    const Evaluation e = gp.evaluate(x, what);
+    for (Eigen::Index i = 0; i < x.rows(); ++i) ASSERT_EQ(e.mu(i), mean_only.mu(i)) << i;
+  }
+}
+
+}  // namespace
+}  // namespace mufric

@@ -9,6 +9,7 @@
 #include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
 #include "surrogate/empirical_laws.hpp"
+#include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 
@@ -276,6 +277,84 @@ TEST(ModelFile, UriSchemes) {
   EXPECT_EQ(model_path_from_uri("file:///tmp/m.h5"), "/tmp/m.h5");
   EXPECT_EQ(model_path_from_uri("m.h5"), "m.h5");
   EXPECT_THROW(model_path_from_uri("s3://bucket/m.h5"), Error);
+}
+
+
+GaussianProcess gp_with_fast_evaluator(unsigned data_seed) {
+  GpTrainingOptions o;
+  o.optimise = false;
+  o.initial.signal_variance = 1.0;
+  o.initial.length_scales = Eigen::Vector3d(0.5, 0.6, 0.7);
+  o.initial.noise_variance = 1e-3;
+  GaussianProcess gp = train_gaussian_process(test::smooth_training_set(80, data_seed), o);
+  FastEvaluatorOptions f;
+  f.check_points = 2000;
+  gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, f)));
+  return gp;
+}
+
+// The fast evaluator is stored and read back as it was: same grid, same bounds, same answers.
+TEST(ModelFile, FastEvaluatorRoundTrips) {
+  const std::string path = temp_path("fast.h5");
+  const GaussianProcess gp = gp_with_fast_evaluator(4);
+  save_model(path, gp);
+  const auto loaded = load_model(path);
+  const auto* back = dynamic_cast<const GaussianProcess*>(loaded.get());
+  ASSERT_NE(back, nullptr);
+  ASSERT_NE(back->fast_evaluator(), nullptr);
+  EXPECT_EQ(back->fast_evaluator()->grid().values(), gp.fast_evaluator()->grid().values());
+  EXPECT_EQ(back->fast_evaluator()->bounds().mu_absolute, gp.fast_evaluator()->bounds().mu_absolute);
+  EXPECT_EQ(back->fast_evaluator()->bounds().std_relative, gp.fast_evaluator()->bounds().std_relative);
+  const Eigen::MatrixXd x = test::smooth_training_set(50, 8).x;
+  const Evaluation a = gp.evaluate(x, {.std = true}), b = back->evaluate(x, {.std = true});
+  EXPECT_EQ(a.fast_points, 50);
+  EXPECT_EQ(b.fast_points, 50);
+  for (Eigen::Index i = 0; i < 50; ++i) EXPECT_EQ(a.mu(i), b.mu(i));
+  std::filesystem::remove(path);
+}
+
+// One changed node value, or a looser stored bound, breaks the checksum; a grid of another model
+// (a valid checksum) fails the spot check against the exact model. Each is refused naming the group.
+TEST(ModelFile, ATamperedOrForeignFastEvaluatorIsRefused) {
+  const std::string path = temp_path("fast_bad.h5");
+  const GaussianProcess gp = gp_with_fast_evaluator(4);
+  save_model(path, gp);
+  std::vector<double> values = gp.fast_evaluator()->grid().values();
+  values[values.size() / 2] += 1e-6;
+  overwrite_doubles(path, "/gp/fast_evaluator/values", values);
+  EXPECT_NE(load_error(path).find("/gp/fast_evaluator: checksum mismatch"), std::string::npos) << load_error(path);
+
+  save_model(path, gp);
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    const double looser = 1.0;
+    file.openGroup("/gp/fast_evaluator").openAttribute("bound_mu_absolute").write(H5::PredType::NATIVE_DOUBLE, &looser);
+  }
+  EXPECT_NE(load_error(path).find("checksum mismatch"), std::string::npos) << load_error(path);
+
+  GaussianProcess other = gp_with_fast_evaluator(5);  // other data, same box
+  GaussianProcess mixed = gp;
+  mixed.attach_fast_evaluator(std::make_shared<const FastEvaluator>(*other.fast_evaluator()));
+  save_model(path, mixed);
+  EXPECT_NE(load_error(path).find("is not the model's value there"), std::string::npos) << load_error(path);
+  std::filesystem::remove(path);
+}
+
+// A schema-2 file (before fast evaluators) still loads, with none: the exact model answers.
+TEST(ModelFile, AnOlderSchemaLoadsWithoutAFastEvaluator) {
+  const std::string path = temp_path("schema2.h5");
+  GaussianProcess gp = gp_with_fast_evaluator(4);
+  gp.attach_fast_evaluator(nullptr);
+  save_model(path, gp);
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    const long long version = 2;
+    file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
+  }
+  const auto loaded = load_model(path);
+  EXPECT_EQ(dynamic_cast<const GaussianProcess&>(*loaded).fast_evaluator(), nullptr);
+  EXPECT_EQ(loaded->evaluate(test::smooth_training_set(10, 8).x, {}).fast_points, 0);
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "server/friction_service.hpp"
 #include "server/server.hpp"
 #include "surrogate/empirical_laws.hpp"
+#include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 
@@ -504,6 +505,39 @@ TEST(ClientOptions, ParsedFromTextNamingWhatIsWrong) {
   EXPECT_NE(refusal("retries=1.5").find("not a whole number"), std::string::npos);
   EXPECT_NE(refusal("stream=maybe").find("stream: 'maybe'"), std::string::npos);
   EXPECT_NE(refusal("stream").find("expected key=value"), std::string::npos);
+}
+
+// A served model with a fast evaluator: the response and the status count the points it answered;
+// a negative tolerance (the C ABI's mu_tolerance=0) asks for the exact model.
+TEST_F(Service, FastEvaluatorPointsAreCountedAndCanBeRefused) {
+  {
+    auto gp = std::unique_ptr<FrictionModel>(load_model((dir_ / "gp.h5").string()));
+    auto& trained = dynamic_cast<GaussianProcess&>(*gp);
+    FastEvaluatorOptions o;
+    o.check_points = 2000;
+    trained.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(trained, o)));
+    save_model((dir_ / "fast.h5").string(), trained);
+  }
+  LoopbackServer server(dir_);
+  const Points pts = random_points(40);
+  const std::string uri = "grpc://" + server.address() + "/fast";
+  const auto client = client::connect(uri);
+  EXPECT_EQ(client->evaluate(pts.block(), {.ci_level = 0.95}).fast_points, 40);
+  EvaluationRequest exact{.ci_level = 0.95};
+  exact.mu_tolerance = 0.0;
+  EXPECT_EQ(client->evaluate(pts.block(), exact).fast_points, 0);
+  EXPECT_EQ(client::server_status("grpc://" + server.address()).fast_points, 40);
+
+  mufric_client* c = nullptr;
+  std::vector<double> mu(40), lo(40), hi(40);
+  for (const char* options : {"", "mu_tolerance=0"}) {
+    ASSERT_EQ(mufric_open_with_options(uri.c_str(), options, &c), MUFRIC_OK) << mufric_last_error();
+    ASSERT_EQ(mufric_evaluate(c, 40, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.95, mu.data(), nullptr,
+                              lo.data(), hi.data(), nullptr),
+              MUFRIC_OK);
+    mufric_close(c);
+  }
+  EXPECT_EQ(client::server_status("grpc://" + server.address()).fast_points, 80) << "the C ABI's default uses it once";
 }
 
 // The C ABI's options reach the connection: the token authorises, stream=1 sends every evaluation
