@@ -5,6 +5,7 @@
 #include <random>
 
 #include "common/dataset_file.hpp"
+#include "surrogate/gp_training.hpp"
 
 namespace mufric::test {
 
@@ -30,6 +31,17 @@ inline TrainingSet smooth_training_set(Eigen::Index n, unsigned seed) {
   }
   t.source_path = "synthetic";
   return t;
+}
+
+// A GP with these hyper-parameters (not optimised) on smooth_training_set(n, seed).
+inline GaussianProcess fixed_hyper_gp(Eigen::Index n, unsigned seed, double signal_variance,
+                                      const Eigen::Vector3d& length_scales, double noise_variance) {
+  GpTrainingOptions o;
+  o.optimise = false;
+  o.initial.signal_variance = signal_variance;
+  o.initial.length_scales = length_scales;
+  o.initial.noise_variance = noise_variance;
+  return train_gaussian_process(smooth_training_set(n, seed), o);
 }
 
 }  // namespace mufric::test

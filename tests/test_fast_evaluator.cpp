@@ -73,14 +73,7 @@ TEST(TensorCubicGrid, RefusesShapesThatDoNotFit) {
   EXPECT_THROW(TensorCubicGrid({3, 4}, nan), Error);
 }
 
-GaussianProcess small_gp() {
-  GpTrainingOptions o;
-  o.optimise = false;
-  o.initial.signal_variance = 1.0;
-  o.initial.length_scales = Eigen::Vector3d(0.4, 0.6, 0.5);
-  o.initial.noise_variance = 1e-3;
-  return train_gaussian_process(test::smooth_training_set(120, 7), o);
-}
+GaussianProcess small_gp() { return test::fixed_hyper_gp(120, 7, 1.0, {0.4, 0.6, 0.5}, 1e-3); }
 
 // The stored bound is never exceeded on fresh random points (10⁶ in the optimised build).
 TEST(FastEvaluator, TheMeasuredBoundHoldsOnFreshPoints) {

@@ -13,14 +13,7 @@
 namespace mufric {
 namespace {
 
-GaussianProcess small_gp() {
-  GpTrainingOptions o;
-  o.optimise = false;
-  o.initial.signal_variance = 2.0;
-  o.initial.length_scales = Eigen::Vector3d(0.5, 0.5, 0.5);
-  o.initial.noise_variance = 1e-4;
-  return train_gaussian_process(test::smooth_training_set(400, 4), o);
-}
+GaussianProcess small_gp() { return test::fixed_hyper_gp(400, 4, 2.0, {0.5, 0.5, 0.5}, 1e-4); }
 
 // Threads of this process right now (Linux: the "Threads:" line of /proc/self/status).
 int process_threads() {

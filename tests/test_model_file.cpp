@@ -281,12 +281,7 @@ TEST(ModelFile, UriSchemes) {
 
 
 GaussianProcess gp_with_fast_evaluator(unsigned data_seed) {
-  GpTrainingOptions o;
-  o.optimise = false;
-  o.initial.signal_variance = 1.0;
-  o.initial.length_scales = Eigen::Vector3d(0.5, 0.6, 0.7);
-  o.initial.noise_variance = 1e-3;
-  GaussianProcess gp = train_gaussian_process(test::smooth_training_set(80, data_seed), o);
+  GaussianProcess gp = test::fixed_hyper_gp(80, data_seed, 1.0, {0.5, 0.6, 0.7}, 1e-3);
   FastEvaluatorOptions f;
   f.check_points = 2000;
   gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, f)));

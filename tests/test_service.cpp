@@ -67,12 +67,7 @@ class Service : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("mufric_service_" + std::to_string(::getpid()) + "_" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
-    GpTrainingOptions options;
-    options.optimise = false;
-    options.initial.signal_variance = 2.0;
-    options.initial.length_scales = Eigen::Vector3d(0.6, 0.7, 0.8);
-    options.initial.noise_variance = 1e-4;
-    save_model((dir_ / "gp.h5").string(), train_gaussian_process(test::smooth_training_set(200, 3), options));
+    save_model((dir_ / "gp.h5").string(), test::fixed_hyper_gp(200, 3, 2.0, {0.6, 0.7, 0.8}, 1e-4));
     save_model((dir_ / "coulomb.h5").string(), CoulombLaw(0.3));
   }
   void TearDown() override { fs::remove_all(dir_); }
