@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "client/friction_client.hpp"
@@ -75,6 +76,26 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
   for (const auto& w : report.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
+// --extrapolation and --mu-range of train and upgrade: what the model file declares.
+struct BoxOptions {
+  std::string extrapolation;
+  std::vector<double> mu_range;
+};
+
+void add_box_options(CLI::App* cmd, BoxOptions& o) {
+  cmd->add_option("--extrapolation", o.extrapolation,
+                  "The model's policy outside its training box: clamp (default: the model at the nearest point\n"
+                  "of the box, flagged EXTRAPOLATED), raw (the model itself) or refuse (OUT_OF_BOX, no answer)")
+      ->check(CLI::IsMember({"raw", "clamp", "refuse"}));
+  cmd->add_option("--mu-range", o.mu_range, "Physical range of mu: answers and intervals are clipped to it (default 0 1)")
+      ->expected(2);
+}
+
+void apply_box_options(FrictionModel& model, const BoxOptions& o) {
+  if (!o.extrapolation.empty()) model.set_default_extrapolation(extrapolation_from_string(o.extrapolation));
+  if (!o.mu_range.empty()) model.set_mu_range(o.mu_range[0], o.mu_range[1]);
+}
+
 // --fast-* options of train and upgrade.
 struct FastOptions {
   FastEvaluatorOptions build;
@@ -115,6 +136,7 @@ void add_train(CLI::App& app) {
     GpTrainingOptions gp;
     bool no_noise = false;
     FastOptions fast;
+    BoxOptions box;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("train", "Fit a Gaussian-process surrogate (RBF-ARD kernel) to a dataset");
@@ -137,6 +159,7 @@ void add_train(CLI::App& app) {
                 "learned noise. For samples whose errors are independent; a micro-model plan's samples share\n"
                 "their tool draws, so their errors are correlated and this is off by default");
   add_fast_evaluator_options(cmd, o->fast);
+  add_box_options(cmd, o->box);
   cmd->footer("Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
               "cross-validated error. Bounds: signal variance 1e-3..1e5, length scales 1e-2..1e3 box widths,\n"
               "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).\n"
@@ -156,6 +179,7 @@ void add_train(CLI::App& app) {
     GpTrainingReport report;
     GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
     print_training_report(gp, report);
+    apply_box_options(gp, o->box);  // before the grid: it tabulates μ as served (clipped to the range)
     attach_fast_evaluator(gp, o->fast);
     save_model(o->out, gp);
     std::printf("wrote %s (gp, %lld training points) in %.2f s\n", o->out.c_str(),
@@ -201,6 +225,7 @@ void add_predict(CLI::App& app) {
     std::map<std::string, std::string> values;  // flag → text
     double level = 0.95;
     bool gradient = false;
+    std::string extrapolation;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("predict", "One friction coefficient with its confidence interval, human units");
@@ -212,6 +237,9 @@ void add_predict(CLI::App& app) {
   cmd->add_option("--level", o->level, "Confidence level of the interval")->capture_default_str()
       ->check(CLI::Range(0.5, 0.9999));
   cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput");
+  cmd->add_option("--extrapolation", o->extrapolation,
+                  "Outside the training box: raw, clamp or refuse (default: the model file's policy)")
+      ->check(CLI::IsMember({"raw", "clamp", "refuse"}));
   cmd->callback([o] {
     client::Options options;
     options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
@@ -233,7 +261,9 @@ void add_predict(CLI::App& app) {
       const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });
       if (!used && !o->values[flag].empty()) throw Error(flag + " was given but the model has no input " + input);
     }
-    const client::Answer a = client->evaluate(block, {.std = true, .ci_level = o->level, .gradient = o->gradient});
+    EvaluationRequest what{.std = true, .ci_level = o->level, .gradient = o->gradient};
+    if (!o->extrapolation.empty()) what.extrapolation = extrapolation_from_string(o->extrapolation);
+    const client::Answer a = client->evaluate(block, what);
     for (size_t j = 0; j < inputs.size(); ++j) {
       std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(values[j], inputs[j].kind()).c_str());
     }
@@ -260,6 +290,8 @@ void add_describe(CLI::App& app) {
       std::printf("  %-18s [%s, %s]  stored in %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
                   format_human(input.hi, input.kind()).c_str(), input.unit.c_str());
     }
+    std::printf("outside the box: %s (a request may choose raw, clamp or refuse); mu kept in [%g, %g]\n",
+                std::string(to_string(model->default_extrapolation())).c_str(), model->mu_min(), model->mu_max());
     std::printf("%s\n", model->summary().c_str());
   });
 }
@@ -339,6 +371,7 @@ void add_upgrade(CLI::App& app) {
     std::string model, out;
     bool rebuild = false;
     FastOptions fast;
+    BoxOptions box;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("upgrade", "Rewrite a model file in the current schema, adding a GP's fast evaluator");
@@ -346,10 +379,13 @@ void add_upgrade(CLI::App& app) {
   cmd->add_option("--out", o->out, "Where to write (default: replace the file, atomically)");
   cmd->add_flag("--rebuild", o->rebuild, "Rebuild a GP's fast evaluator even if the file has one");
   add_fast_evaluator_options(cmd, o->fast);
+  add_box_options(cmd, o->box);
   cmd->callback([o] {
     auto model = load_model_isolated(o->model);
+    const bool range_changed = !o->box.mu_range.empty();
+    apply_box_options(*model, o->box);
     if (auto* gp = dynamic_cast<GaussianProcess*>(model.get())) {
-      if (gp->fast_evaluator() == nullptr || o->rebuild) {
+      if (gp->fast_evaluator() == nullptr || o->rebuild || range_changed) {
         attach_fast_evaluator(*gp, o->fast);
       } else {
         std::printf("keeps its fast evaluator (--rebuild to build it again)\n");

@@ -232,6 +232,7 @@ class GrpcClient final : public FrictionClient {
     request.set_std(what.std);
     request.set_ci_level(what.ci_level);
     request.set_gradient(what.gradient);
+    request.set_extrapolation(static_cast<mufric::v1::Extrapolation>(what.extrapolation));
     if (what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0) {
       request.set_mu_tolerance(-1.0);  // the exact model only
       request.set_std_tolerance(-1.0);
@@ -387,6 +388,12 @@ Options parse_options(std::string_view text, Options base) {
       o.tls_cert_file = value;
     } else if (key == "tls_key") {
       o.tls_key_file = value;
+    } else if (key == "extrapolation") {
+      try {
+        o.extrapolation = extrapolation_from_string(value);
+      } catch (const Error& e) {
+        throw InvalidArgument(std::string("option extrapolation: ") + e.what());
+      }
     } else if (key == "mu_tolerance") {
       o.mu_tolerance = number_option(key, value, 0.0, 1.0);
     } else if (key == "std_tolerance") {
@@ -394,7 +401,7 @@ Options parse_options(std::string_view text, Options base) {
     } else {
       throw InvalidArgument("option '" + key +
                             "' is unknown (known: deadline, retries, backoff, chunk_points, max_message_mb, stream, "
-                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance)");
+                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation)");
     }
   }
   return o;

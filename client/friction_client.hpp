@@ -79,12 +79,14 @@ struct Options {
   // tolerances a fast evaluator must meet to answer; 0 (either): the exact model only.
   double mu_tolerance = EvaluationRequest{}.mu_tolerance;
   double std_tolerance = EvaluationRequest{}.std_relative_tolerance;
+  Extrapolation extrapolation = Extrapolation::model_default;  // raw, clamp or refuse outside the box
 };
 
 // Options from text, for the C ABI and Fortran (and configuration files): "key=value" pairs separated
 // by commas, semicolons or blanks, e.g. "deadline=2, retries=1, stream=1, token=abc".
 // Keys: deadline (s), retries, backoff (s, the first), chunk_points, max_message_mb, stream (0/1),
-// token, tls_ca, tls_cert, tls_key (PEM file paths), mu_tolerance, std_tolerance (0: exact model). Starts from `base`; throws InvalidArgument
+// token, tls_ca, tls_cert, tls_key (PEM file paths), mu_tolerance, std_tolerance (0: exact model),
+// extrapolation (raw, clamp or refuse; default: the model's own). Starts from `base`; throws InvalidArgument
 // naming the key or value it cannot use.
 Options parse_options(std::string_view text, Options base = {});
 

@@ -10,7 +10,7 @@ module mufric
   public :: mufric_connect, mufric_error, c_mufric_evaluate, c_mufric_close
   integer(c_int), parameter, public :: MUFRIC_OK = 0, MUFRIC_INVALID_ARGUMENT = 1, MUFRIC_FAILED = 2
   integer(c_int), parameter, public :: MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, &
-                                       MUFRIC_POINT_INVALID_INPUT = 2
+                                       MUFRIC_POINT_INVALID_INPUT = 2, MUFRIC_POINT_OUT_OF_BOX = 3
 
   interface
     function c_mufric_open(uri, client) bind(C, name="mufric_open") result(status)

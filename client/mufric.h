@@ -34,7 +34,14 @@ enum mufric_status_code {
   MUFRIC_FAILED = 2            /* model not found, server unreachable, file unreadable: see mufric_last_error */
 };
 
-enum mufric_point_status { MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, MUFRIC_POINT_INVALID_INPUT = 2 };
+/* EXTRAPOLATED: outside the model's training box, answered (raw or clamp policy); OUT_OF_BOX: outside
+ * it under the refuse policy, NaN outputs. */
+enum mufric_point_status {
+  MUFRIC_POINT_OK = 0,
+  MUFRIC_POINT_EXTRAPOLATED = 1,
+  MUFRIC_POINT_INVALID_INPUT = 2,
+  MUFRIC_POINT_OUT_OF_BOX = 3
+};
 
 /* uri: "grpc://host:port/model", "file:///path/model.h5" or a path. */
 int mufric_open(const char* uri, mufric_client** client);
@@ -50,6 +57,9 @@ int mufric_open(const char* uri, mufric_client** client);
  *   mu_tolerance=E, std_tolerance=R   a model's certified fast evaluator answers (inside its box)
  *                     only if its measured bound is within these (defaults 1e-6 absolute on mu,
  *                     1e-3 relative on std); 0: the exact model for every point
+ *   extrapolation=P   points outside the model's training box: raw (the model itself), clamp (the
+ *                     model at the nearest point of the box) or refuse (OUT_OF_BOX, NaN); default:
+ *                     the model file's policy (clamp unless it says otherwise)
  * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
 int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);
 void mufric_close(mufric_client* client);

@@ -10,6 +10,7 @@
 struct mufric_client {
   std::unique_ptr<mufric::client::FrictionClient> impl;
   double mu_tolerance = 0.0, std_tolerance = 0.0;  // from the options (a fast evaluator's admission)
+  mufric::Extrapolation extrapolation = mufric::Extrapolation::model_default;
 };
 
 namespace {
@@ -48,6 +49,7 @@ int mufric_open_with_options(const char* uri, const char* options, mufric_client
     handle->impl = mufric::client::connect(uri, parsed);
     handle->mu_tolerance = parsed.mu_tolerance;
     handle->std_tolerance = parsed.std_tolerance;
+    handle->extrapolation = parsed.extrapolation;
     handle->impl->describe();  // fail now, not at the first evaluation, if the model is not there
     *client = handle.release();
     last_error.clear();
@@ -73,6 +75,7 @@ int mufric_evaluate(mufric_client* client, size_t n, const double* contact_press
     mufric::EvaluationRequest what{.std = std != nullptr, .ci_level = want_interval ? ci_level : 0.0, .gradient = false};
     what.mu_tolerance = client->mu_tolerance;
     what.std_relative_tolerance = client->std_tolerance;
+    what.extrapolation = client->extrapolation;
     const auto answer = client->impl->evaluate(block, what);
     for (size_t i = 0; i < n; ++i) {
       mu[i] = answer.mu[i];

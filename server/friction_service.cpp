@@ -9,6 +9,12 @@
 #include "common/version.hpp"
 #include "surrogate/gaussian_process.hpp"
 
+// The wire's enums are the model's, value for value.
+static_assert(static_cast<int>(mufric::Extrapolation::raw) == mufric::v1::EXTRAPOLATION_RAW);
+static_assert(static_cast<int>(mufric::Extrapolation::clamp) == mufric::v1::EXTRAPOLATION_CLAMP);
+static_assert(static_cast<int>(mufric::Extrapolation::refuse) == mufric::v1::EXTRAPOLATION_REFUSE);
+static_assert(static_cast<int>(mufric::PointStatus::out_of_box) == mufric::v1::POINT_STATUS_OUT_OF_BOX);
+
 namespace mufric::server {
 namespace {
 
@@ -97,6 +103,9 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
     d->set_hi(input.hi);
   }
   out.set_has_uncertainty(model.has_uncertainty());
+  out.set_extrapolation(static_cast<mufric::v1::Extrapolation>(model.default_extrapolation()));
+  out.set_mu_min(model.mu_min());
+  out.set_mu_max(model.mu_max());
   if (const auto* gp = dynamic_cast<const GaussianProcess*>(&model)) {
     const auto& state = gp->state();
     out.set_training_points(static_cast<uint64_t>(state.x_train.rows()));
@@ -139,6 +148,11 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
     return {grpc::StatusCode::INVALID_ARGUMENT, "fields mu_tolerance and std_tolerance must be finite"};
   }
   EvaluationRequest what{.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()};
+  if (!mufric::v1::Extrapolation_IsValid(request.extrapolation())) {
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            "field extrapolation: unknown value " + std::to_string(static_cast<int>(request.extrapolation()))};
+  }
+  what.extrapolation = static_cast<Extrapolation>(request.extrapolation());
   if (request.mu_tolerance() < 0.0 || request.std_tolerance() < 0.0) {
     what.mu_tolerance = what.std_relative_tolerance = 0.0;  // the exact model only
   } else {
@@ -160,7 +174,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   }
   auto* statuses = response.mutable_status();
   statuses->Reserve(n);
-  uint64_t extrapolated = 0, invalid = 0, fast = 0;
+  uint64_t extrapolated = 0, invalid = 0, fast = 0, out_of_box = 0, clipped = 0;
   // Chunks, so that a call whose caller has given up (deadline passed, cancelled) stops within a
   // few milliseconds instead of computing an answer nobody reads.
   for (int first = 0; first < n; first += static_cast<int>(kPointsBetweenDeadlineChecks)) {
@@ -173,6 +187,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
                                     : model.evaluate(QueryBatch(batch.middleRows(first, count)), computed);
     if (log != nullptr) log->record(served->name, model.inputs(), batch.middleRows(first, count), e.std);
     fast += static_cast<uint64_t>(e.fast_points);
+    clipped += static_cast<uint64_t>(e.range_clipped);
     response.mutable_mu()->Add(e.mu.data(), e.mu.data() + count);
     if (what.std) response.mutable_std()->Add(e.std.data(), e.std.data() + count);
     if (what.ci_level > 0.0) {
@@ -187,11 +202,14 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
       statuses->Add(static_cast<int>(s));
       extrapolated += s == PointStatus::extrapolated;
       invalid += s == PointStatus::invalid_input;
+      out_of_box += s == PointStatus::out_of_box;
     }
   }
   response.set_extrapolated_points(extrapolated);
   response.set_invalid_points(invalid);
   response.set_fast_points(fast);
+  response.set_out_of_box_points(out_of_box);
+  response.set_range_clipped_points(clipped);
   counters_.fast_points += static_cast<long long>(fast);
   for (auto& name : ignored) response.add_ignored_inputs(std::move(name));
   counters_.points += n;

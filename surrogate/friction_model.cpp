@@ -1,6 +1,7 @@
 #include "surrogate/friction_model.hpp"
 
 #include <boost/math/distributions/normal.hpp>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -20,6 +21,10 @@ bool physically_valid(const InputSpec& input, double value) {
   }
 }
 
+// An angle is periodic (a ply at θ and θ + 180° is the same ply): the laws wrap it, so the clamp
+// policy leaves it as given.
+bool clamped_input(const InputSpec& input) { return input.kind() != QuantityKind::angle; }
+
 }  // namespace
 
 std::string_view to_string(PointStatus status) {
@@ -27,8 +32,39 @@ std::string_view to_string(PointStatus status) {
     case PointStatus::ok: return "OK";
     case PointStatus::extrapolated: return "EXTRAPOLATED";
     case PointStatus::invalid_input: return "INVALID_INPUT";
+    case PointStatus::out_of_box: return "OUT_OF_BOX";
   }
   return "UNKNOWN";
+}
+
+std::string_view to_string(Extrapolation policy) {
+  switch (policy) {
+    case Extrapolation::model_default: return "model default";
+    case Extrapolation::raw: return "raw";
+    case Extrapolation::clamp: return "clamp";
+    case Extrapolation::refuse: return "refuse";
+  }
+  return "unknown";
+}
+
+Extrapolation extrapolation_from_string(std::string_view word) {
+  if (word == "raw") return Extrapolation::raw;
+  if (word == "clamp") return Extrapolation::clamp;
+  if (word == "refuse") return Extrapolation::refuse;
+  throw Error("extrapolation policy '" + std::string(word) + "' is unknown (raw, clamp or refuse)");
+}
+
+void FrictionModel::set_default_extrapolation(Extrapolation policy) {
+  if (policy == Extrapolation::model_default) throw Error("a model's default extrapolation must be raw, clamp or refuse");
+  default_extrapolation_ = policy;
+}
+
+void FrictionModel::set_mu_range(double lo, double hi) {
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi)) {
+    throw Error("mu range [" + std::to_string(lo) + ", " + std::to_string(hi) + "] must be finite with lo < hi");
+  }
+  mu_min_ = lo;
+  mu_max_ = hi;
 }
 
 double normal_quantile_two_sided(double level) {
@@ -44,11 +80,14 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
     throw Error("query has " + std::to_string(x.cols()) + " inputs, the model expects " + std::to_string(d));
   }
   const double z = what.ci_level > 0.0 ? normal_quantile_two_sided(what.ci_level) : 0.0;
+  const Extrapolation policy =
+      what.extrapolation == Extrapolation::model_default ? default_extrapolation_ : what.extrapolation;
   const Eigen::Index m = x.rows();
   Evaluation out;
   out.status.assign(static_cast<size_t>(m), PointStatus::ok);
   std::vector<Eigen::Index> valid;
   valid.reserve(static_cast<size_t>(m));
+  bool any_outside = false;
   for (Eigen::Index i = 0; i < m; ++i) {
     PointStatus& status = out.status[static_cast<size_t>(i)];
     for (Eigen::Index j = 0; j < d; ++j) {
@@ -57,20 +96,38 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
         status = PointStatus::invalid_input;
         break;
       }
-      if (!input.contains(x(i, j))) status = PointStatus::extrapolated;
+      if (!input.contains(x(i, j))) status = policy == Extrapolation::refuse ? PointStatus::out_of_box : PointStatus::extrapolated;
     }
-    if (status != PointStatus::invalid_input) valid.push_back(i);
+    if (status == PointStatus::invalid_input || status == PointStatus::out_of_box) continue;
+    any_outside = any_outside || status == PointStatus::extrapolated;
+    valid.push_back(i);
   }
 
   const bool need_std = what.std || what.ci_level > 0.0;
   const auto n_valid = static_cast<Eigen::Index>(valid.size());
+  const bool clamp = policy == Extrapolation::clamp && any_outside;
   Evaluation inner;
-  if (n_valid == m) {
+  if (n_valid == m && !clamp) {
     evaluate_valid(x, what, inner);
   } else if (n_valid > 0) {
     QueryBatch compact(n_valid, d);
     for (Eigen::Index k = 0; k < n_valid; ++k) compact.row(k) = x.row(valid[static_cast<size_t>(k)]);
+    if (clamp) {
+      for (Eigen::Index j = 0; j < d; ++j) {
+        const InputSpec& input = inputs_[static_cast<size_t>(j)];
+        if (clamped_input(input)) compact.col(j) = compact.col(j).cwiseMax(input.lo).cwiseMin(input.hi);
+      }
+    }
     evaluate_valid(compact, what, inner);
+    if (clamp && what.gradient) {
+      // μ is constant along a clamped input beyond the box.
+      for (Eigen::Index k = 0; k < n_valid; ++k) {
+        for (Eigen::Index j = 0; j < d; ++j) {
+          const InputSpec& input = inputs_[static_cast<size_t>(j)];
+          if (clamped_input(input) && !input.contains(x(valid[static_cast<size_t>(k)], j))) inner.gradient(k, j) = 0.0;
+        }
+      }
+    }
   }
 
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
@@ -93,6 +150,18 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
   if (what.ci_level > 0.0) {
     out.lo = out.mu - z * out.std;
     out.hi = out.mu + z * out.std;
+  }
+  // The model's physical range of μ; points without an answer (NaN) stay without.
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (std::isnan(out.mu(i))) continue;
+    bool clipped = out.mu(i) < mu_min_ || out.mu(i) > mu_max_;
+    out.mu(i) = std::clamp(out.mu(i), mu_min_, mu_max_);
+    if (what.ci_level > 0.0) {
+      clipped = clipped || out.lo(i) < mu_min_ || out.hi(i) > mu_max_;
+      out.lo(i) = std::clamp(out.lo(i), mu_min_, mu_max_);
+      out.hi(i) = std::clamp(out.hi(i), mu_min_, mu_max_);
+    }
+    out.range_clipped += clipped;
   }
   if (!what.std && what.ci_level > 0.0) out.std.resize(0);
   out.clamped_variances = inner.clamped_variances;

@@ -14,8 +14,20 @@
 
 namespace mufric {
 
-enum class PointStatus : std::uint8_t { ok = 0, extrapolated = 1, invalid_input = 2 };
+// extrapolated: outside the training box, answered under the raw or clamp policy; out_of_box: outside
+// it under the refuse policy, NaN outputs.
+enum class PointStatus : std::uint8_t { ok = 0, extrapolated = 1, invalid_input = 2, out_of_box = 3 };
 std::string_view to_string(PointStatus status);
+
+// What a model does with a point outside its training box.
+//   raw     the model itself, far from its data (a GP reverts to its prior mean, with a wide band)
+//   clamp   the model at the nearest point of the box (each input clamped to its range; the gradient
+//           along a clamped input is zero), still flagged EXTRAPOLATED — seed 001's way
+//   refuse  no answer: status OUT_OF_BOX, NaN outputs
+enum class Extrapolation : std::uint8_t { model_default = 0, raw = 1, clamp = 2, refuse = 3 };
+std::string_view to_string(Extrapolation policy);
+// "raw", "clamp" or "refuse"; throws mufric::Error naming the word otherwise.
+Extrapolation extrapolation_from_string(std::string_view word);
 
 // What the caller needs; nothing more is computed.
 struct EvaluationRequest {
@@ -29,6 +41,8 @@ struct EvaluationRequest {
   // is within these; 0 (either): the exact model answers everywhere.
   double mu_tolerance = 1e-6;             // absolute, μ units
   double std_relative_tolerance = 1e-3;   // of σ, i.e. of the interval's half-width
+  // Points outside the training box: model_default is the policy the model file declares.
+  Extrapolation extrapolation = Extrapolation::model_default;
 };
 
 // A batch of query points, structure-of-arrays: column j of an m × d column-major matrix is the
@@ -43,6 +57,7 @@ struct Evaluation {
   std::vector<PointStatus> status;  // m
   long long clamped_variances = 0;  // negative predictive variances clamped to zero
   long long fast_points = 0;        // points answered by the fast evaluator (the rest: the exact model)
+  long long range_clipped = 0;      // points whose μ (or interval) was clipped to the model's μ range
 };
 
 class FrictionModel {
@@ -53,8 +68,19 @@ class FrictionModel {
   // Whether std/CI carry information (a GP) or are identically zero (a deterministic law).
   virtual bool has_uncertainty() const = 0;
 
+  // The policy for points outside the box when a request does not choose one; and the physical
+  // range μ is kept in (μ, lo and hi are clipped to it): both declared by the model file.
+  static constexpr Extrapolation kDefaultExtrapolation = Extrapolation::clamp;
+  static constexpr double kDefaultMuMin = 0.0, kDefaultMuMax = 1.0;
+  Extrapolation default_extrapolation() const { return default_extrapolation_; }
+  void set_default_extrapolation(Extrapolation policy);
+  double mu_min() const { return mu_min_; }
+  double mu_max() const { return mu_max_; }
+  void set_mu_range(double lo, double hi);  // throws mufric::Error unless finite with lo < hi
+
   // Validates each point (non-finite, negative pressure/velocity/temperature → INVALID_INPUT with
-  // NaN outputs; outside the training box → EXTRAPOLATED, still answered) and evaluates the rest.
+  // NaN outputs; outside the training box → the extrapolation policy) and evaluates the rest; μ and
+  // the interval are then clipped to the model's μ range.
   Evaluation evaluate(const QueryBatch& x, const EvaluationRequest& what) const;
 
   // Writes the kind-specific groups; the common header is written by save_model().
@@ -71,6 +97,8 @@ class FrictionModel {
 
  private:
   InputSpace inputs_;
+  Extrapolation default_extrapolation_ = kDefaultExtrapolation;
+  double mu_min_ = kDefaultMuMin, mu_max_ = kDefaultMuMax;
 };
 
 // Two-sided normal quantile z such that P(|Z| ≤ z) = level (Boost.Math).

@@ -99,20 +99,49 @@ void save_model(const std::string& path, const FrictionModel& model) {
   out.string_attribute("/", "code_version", code_version());
   out.string_attribute("/", "created_utc", utc_timestamp());
   write_input_space(out, model.inputs());
+  out.string_attribute("/", "extrapolation", std::string(to_string(model.default_extrapolation())));
+  out.double_attribute("/", "mu_min", model.mu_min());
+  out.double_attribute("/", "mu_max", model.mu_max());
   model.write(out);
   out.commit();
 }
 
 namespace {
+// The policy for points outside the box and μ's physical range (files before them: the defaults).
+void read_extrapolation(const h5::Reader& in, FrictionModel& model) {
+  if (in.has_attribute("/", "extrapolation")) {
+    try {
+      model.set_default_extrapolation(extrapolation_from_string(in.string_attribute("/", "extrapolation")));
+    } catch (const Error& e) {
+      in.fail("/", std::string("attribute extrapolation: ") + e.what());
+    }
+  }
+  if (in.has_attribute("/", "mu_min") || in.has_attribute("/", "mu_max")) {
+    try {
+      model.set_mu_range(in.double_attribute("/", "mu_min"), in.double_attribute("/", "mu_max"));
+    } catch (const Error& e) {
+      in.fail("/", std::string("attributes mu_min, mu_max: ") + e.what());
+    }
+  }
+}
+
+std::unique_ptr<FrictionModel> read_kind(const h5::Reader& in, const std::string& kind, InputSpace inputs) {
+  if (kind == "gp") return std::make_unique<GaussianProcess>(GaussianProcess::read(in, std::move(inputs)));
+  if (kind == "mlr") return std::make_unique<MlrLaw>(MlrLaw::read(in, std::move(inputs)));
+  if (kind == "coulomb") return std::make_unique<CoulombLaw>(CoulombLaw::read(in, std::move(inputs)));
+  return nullptr;
+}
+
 std::unique_ptr<FrictionModel> read_model(const std::string& path) {
   const h5::Reader in(path, "model");
   in.require_format(kModelFormat, kOldestReadableModelSchema, kModelSchemaVersion, "mufric model");
   InputSpace inputs = read_input_space(in);
   const std::string kind = in.string_attribute("/", "kind");
   try {
-    if (kind == "gp") return std::make_unique<GaussianProcess>(GaussianProcess::read(in, std::move(inputs)));
-    if (kind == "mlr") return std::make_unique<MlrLaw>(MlrLaw::read(in, std::move(inputs)));
-    if (kind == "coulomb") return std::make_unique<CoulombLaw>(CoulombLaw::read(in, std::move(inputs)));
+    if (auto model = read_kind(in, kind, std::move(inputs))) {
+      read_extrapolation(in, *model);
+      return model;
+    }
   } catch (const H5::Exception& e) {
     in.fail("/" + kind, "unreadable (" + e.getDetailMsg() + ")");
   } catch (const Error& e) {

@@ -16,10 +16,13 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
+// The law's own formula, also outside seed 001's box (raw extrapolation: Listing 1's clamp is the law's).
 double mu_at(const FrictionModel& law, double p_mpa, double v_m_min, double angle_deg) {
   QueryBatch x(1, 3);
   x << p_mpa * 1e6, v_m_min / 60.0, angle_deg * kDeg;
-  return law.evaluate(x, {}).mu(0);
+  EvaluationRequest raw;
+  raw.extrapolation = Extrapolation::raw;
+  return law.evaluate(x, raw).mu(0);
 }
 
 TEST(EmpiricalLaws, Listing1At90DegreesFromTable2) {

@@ -136,11 +136,13 @@ TEST(FastEvaluator, AnswersInsideTheBoxWhenItsBoundMeetsTheRequest) {
   const auto fast = fast_for(gp);
   gp.attach_fast_evaluator(fast);
   const Eigen::MatrixXd x = queries_with_some_outside(1000);
-  EvaluationRequest exact_only{.std = true};
+  EvaluationRequest raw{.std = true};  // the model itself outside the box (not clamped into it)
+  raw.extrapolation = Extrapolation::raw;
+  EvaluationRequest exact_only = raw;
   exact_only.mu_tolerance = 0.0;
   const Evaluation exact = gp.evaluate(x, exact_only);
   EXPECT_EQ(exact.fast_points, 0);
-  const Evaluation e = gp.evaluate(x, {.std = true});
+  const Evaluation e = gp.evaluate(x, raw);
   long long inside = 0;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
     const Eigen::RowVectorXd row = x.row(i);
@@ -158,9 +160,11 @@ TEST(FastEvaluator, AnswersInsideTheBoxWhenItsBoundMeetsTheRequest) {
   }
   EXPECT_EQ(e.fast_points, inside);
   EXPECT_EQ(inside, 800);
-  EvaluationRequest tighter{.std = true};
+  EvaluationRequest tighter = raw;
   tighter.mu_tolerance = fast->bounds().mu_absolute / 2.0;
   EXPECT_EQ(gp.evaluate(x, tighter).fast_points, 0);
+  // Clamped (the default policy), the points outside are answered at the box's face: by the grid.
+  EXPECT_EQ(gp.evaluate(x, {.std = true}).fast_points, 1000);
 }
 
 // With the fast evaluator too, μ does not move by a bit when the interval or the gradient is asked.

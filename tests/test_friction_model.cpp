@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "common/error.hpp"
 #include "surrogate/empirical_laws.hpp"
@@ -28,6 +29,59 @@ TEST(FrictionModel, InvalidPointsGetNaNAndTheirStatusTheRestIsAnswered) {
   EXPECT_EQ(e.mu(0), 0.3);
   EXPECT_EQ(e.mu(3), 0.3);
   EXPECT_TRUE(std::isnan(e.mu(1)) && std::isnan(e.std(2)) && std::isnan(e.lo(4)) && std::isnan(e.gradient(1, 0)));
+}
+
+// μ = 0.1 + 0.01·v[m/min] + 0.001·p[MPa] at every angle, on seed 001's box (p ≤ 200 MPa).
+MlrLaw linear_law() { return MlrLaw({{90.0, 0.1, 0.01, 0.001, -10.0, 10.0, 1.0}}, "test", MlrLaw::seed001_box()); }
+
+QueryBatch at_400_mpa() {
+  QueryBatch x(1, 3);
+  x << 400e6, 10.0 / 60.0, std::numbers::pi / 2;  // p twice the box's top, v 10 m/min, 90°
+  return x;
+}
+
+// Outside the box: raw is the law itself, clamp the law at the box's face (zero slope along the
+// clamped input), refuse no answer; closed forms of the linear law.
+TEST(FrictionModel, ExtrapolationPoliciesOutsideTheBox) {
+  const MlrLaw law = linear_law();
+  const QueryBatch x = at_400_mpa();
+  EvaluationRequest what{.gradient = true};
+  what.extrapolation = Extrapolation::raw;
+  Evaluation e = law.evaluate(x, what);
+  EXPECT_EQ(e.status[0], PointStatus::extrapolated);
+  EXPECT_NEAR(e.mu(0), 0.1 + 0.1 + 0.4, 1e-12);
+  EXPECT_NEAR(e.gradient(0, 0), 0.001 / 1e6, 1e-18);
+  what.extrapolation = Extrapolation::clamp;
+  e = law.evaluate(x, what);
+  EXPECT_EQ(e.status[0], PointStatus::extrapolated);
+  EXPECT_NEAR(e.mu(0), 0.1 + 0.1 + 0.2, 1e-12);
+  EXPECT_EQ(e.gradient(0, 0), 0.0);
+  EXPECT_NEAR(e.gradient(0, 1), 0.01 * 60.0, 1e-12);  // per m/s: v is inside the box
+  what.extrapolation = Extrapolation::refuse;
+  e = law.evaluate(x, what);
+  EXPECT_EQ(e.status[0], PointStatus::out_of_box);
+  EXPECT_TRUE(std::isnan(e.mu(0)) && std::isnan(e.gradient(0, 0)));
+  // The model's own default: clamp unless the file says otherwise.
+  EXPECT_EQ(law.default_extrapolation(), Extrapolation::clamp);
+  EXPECT_NEAR(law.evaluate(x, {}).mu(0), 0.4, 1e-12);
+  MlrLaw raw_by_default = linear_law();
+  raw_by_default.set_default_extrapolation(Extrapolation::raw);
+  EXPECT_NEAR(raw_by_default.evaluate(x, {}).mu(0), 0.6, 1e-12);
+  EXPECT_THROW(extrapolation_from_string("nearest"), Error);
+}
+
+// μ and its interval stay in the model's physical range; the points clipped are counted.
+TEST(FrictionModel, MuIsKeptInTheModelsRange) {
+  MlrLaw law = linear_law();
+  law.set_mu_range(0.0, 0.5);
+  EvaluationRequest what{.ci_level = 0.95};
+  what.extrapolation = Extrapolation::raw;
+  const Evaluation e = law.evaluate(at_400_mpa(), what);
+  EXPECT_EQ(e.mu(0), 0.5);
+  EXPECT_EQ(e.hi(0), 0.5);
+  EXPECT_EQ(e.range_clipped, 1);
+  EXPECT_THROW(law.set_mu_range(0.5, 0.5), Error);
+  EXPECT_THROW(law.set_mu_range(0.0, std::numeric_limits<double>::infinity()), Error);
 }
 
 TEST(FrictionModel, WrongNumberOfInputsAndBadLevelAreErrors) {

@@ -352,5 +352,34 @@ TEST(ModelFile, AnOlderSchemaLoadsWithoutAFastEvaluator) {
   std::filesystem::remove(path);
 }
 
+
+// A model's extrapolation policy and μ range travel with its file; a bad one is refused by name.
+TEST(ModelFile, ExtrapolationPolicyAndMuRangeRoundTrip) {
+  const std::string path = temp_path("policy.h5");
+  CoulombLaw law(0.3);
+  law.set_default_extrapolation(Extrapolation::refuse);
+  law.set_mu_range(0.05, 0.8);
+  save_model(path, law);
+  const auto back = load_model(path);
+  EXPECT_EQ(back->default_extrapolation(), Extrapolation::refuse);
+  EXPECT_EQ(back->mu_min(), 0.05);
+  EXPECT_EQ(back->mu_max(), 0.8);
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    file.removeAttr("extrapolation");
+    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+    file.createAttribute("extrapolation", type, H5::DataSpace(H5S_SCALAR)).write(type, std::string("nearest"));
+  }
+  EXPECT_NE(load_error(path).find("attribute extrapolation"), std::string::npos) << load_error(path);
+  save_model(path, law);
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    const double inverted = -1.0;
+    file.openAttribute("mu_max").write(H5::PredType::NATIVE_DOUBLE, &inverted);
+  }
+  EXPECT_NE(load_error(path).find("mu_min, mu_max"), std::string::npos) << load_error(path);
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace mufric

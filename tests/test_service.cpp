@@ -535,6 +535,39 @@ TEST_F(Service, FastEvaluatorPointsAreCountedAndCanBeRefused) {
   EXPECT_EQ(client::server_status("grpc://" + server.address()).fast_points, 80) << "the C ABI's default uses it once";
 }
 
+// The extrapolation policy crosses the wire: refuse gives OUT_OF_BOX and NaN, counted in the
+// response; the C ABI takes it as an option and names a bad one.
+TEST_F(Service, ExtrapolationPolicyIsChosenPerRequest) {
+  LoopbackServer server(dir_);
+  Points pts = random_points(4);
+  pts.p[1] = 5000e6;  // far above the box
+  const std::string uri = "grpc://" + server.address() + "/gp";
+  const auto client = client::connect(uri);
+  EvaluationRequest refuse;
+  refuse.extrapolation = Extrapolation::refuse;
+  const client::Answer refused = client->evaluate(pts.block(), refuse);
+  EXPECT_EQ(refused.status[1], PointStatus::out_of_box);
+  EXPECT_TRUE(std::isnan(refused.mu[1]));
+  EXPECT_EQ(refused.status[0], PointStatus::ok);
+  const client::Answer clamped = client->evaluate(pts.block(), {});
+  EXPECT_EQ(clamped.status[1], PointStatus::extrapolated);
+  Points face = pts;
+  face.p[1] = 1300e6;  // the box's top: where clamp evaluates
+  EXPECT_EQ(clamped.mu[1], client->evaluate(face.block(), {}).mu[1]);
+
+  mufric_client* c = nullptr;
+  ASSERT_EQ(mufric_open_with_options(uri.c_str(), "extrapolation=refuse", &c), MUFRIC_OK) << mufric_last_error();
+  std::vector<double> mu(4);
+  std::vector<int> status(4);
+  ASSERT_EQ(mufric_evaluate(c, 4, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, mu.data(), nullptr, nullptr,
+                            nullptr, status.data()),
+            MUFRIC_OK);
+  EXPECT_EQ(status[1], MUFRIC_POINT_OUT_OF_BOX);
+  mufric_close(c);
+  EXPECT_EQ(mufric_open_with_options(uri.c_str(), "extrapolation=nearest", &c), MUFRIC_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(mufric_last_error()).find("extrapolation"), std::string::npos) << mufric_last_error();
+}
+
 // The C ABI's options reach the connection: the token authorises, stream=1 sends every evaluation
 // over one stream (the server counts the streams opened), and a misspelt key is refused by name.
 // (A deadline cannot be shown to bite on loopback without a slow model: a 1 µs call sometimes
