@@ -23,8 +23,6 @@ constexpr double kMostGrowth = 3.0;
 constexpr double kGrowthMargin = 1.1;
 // The local searches for the worst error: evaluations each (BOBYQA, Powell 2009).
 constexpr int kLocalSearchEvaluations = 60;
-// log σ is tabulated; σ below this (no noise term, at a training point) cannot be.
-constexpr double kSmallestStd = 1e-300;
 
 std::vector<int> cells_for(const GaussianProcess& gp, double resolution) {
   std::vector<int> cells;
@@ -56,7 +54,7 @@ TensorCubicGrid tabulate(const GaussianProcess& gp, const std::vector<int>& cell
   const Evaluation e = gp.evaluate(x, {.std = true});
   Eigen::MatrixXd values(x.rows(), 2);
   values.col(0) = e.mu;
-  values.col(1) = e.std.array().max(kSmallestStd).log().matrix();
+  values.col(1) = e.std.array().max(kSmallestTabulatedStd).log().matrix();
   return TensorCubicGrid(cells, values);
 }
 
@@ -71,7 +69,26 @@ struct PointError {
 PointError error_at(const FastEvaluator& fast, double mu, double std, const double* x) {
   double mu_fast = 0.0, std_fast = 0.0;
   fast.evaluate(x, mu_fast, std_fast);
-  return {std::abs(mu_fast - mu), std::abs(std_fast - std) / std::max(std, kSmallestStd)};
+  return {std::abs(mu_fast - mu), std::abs(std_fast - std) / std::max(std, kSmallestTabulatedStd)};
+}
+
+// Every point's error against the exact model at the points x (SI, one row each), and the largest.
+struct MeasuredErrors {
+  std::vector<PointError> per_point;
+  PointError worst;
+};
+MeasuredErrors point_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
+  const Evaluation exact = gp.evaluate(x, {.std = true});
+  MeasuredErrors m;
+  m.per_point.resize(static_cast<size_t>(x.rows()));
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const Eigen::RowVectorXd row = x.row(i);
+    const PointError p = error_at(fast, exact.mu(i), exact.std(i), row.data());
+    m.per_point[static_cast<size_t>(i)] = p;
+    m.worst.mu_absolute = std::max(m.worst.mu_absolute, p.mu_absolute);
+    m.worst.std_relative = std::max(m.worst.std_relative, p.std_relative);
+  }
+  return m;
 }
 
 struct SearchContext {
@@ -105,16 +122,9 @@ FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianPro
   for (Eigen::Index i = 0; i < u.rows(); ++i) {
     for (Eigen::Index k = 0; k < d; ++k) u(i, k) = uniform(rng);
   }
-  const Eigen::MatrixXd x = to_si(u, gp.inputs());
-  const Evaluation exact = gp.evaluate(x, {.std = true});
-  std::vector<PointError> errors(static_cast<size_t>(x.rows()));
-  PointError worst;
-  for (Eigen::Index i = 0; i < x.rows(); ++i) {
-    const Eigen::RowVectorXd row = x.row(i);
-    errors[static_cast<size_t>(i)] = error_at(fast, exact.mu(i), exact.std(i), row.data());
-    worst.mu_absolute = std::max(worst.mu_absolute, errors[static_cast<size_t>(i)].mu_absolute);
-    worst.std_relative = std::max(worst.std_relative, errors[static_cast<size_t>(i)].std_relative);
-  }
+  const MeasuredErrors measured = point_errors(fast, gp, to_si(u, gp.inputs()));
+  const std::vector<PointError>& errors = measured.per_point;
+  PointError worst = measured.worst;
   if (search && o.local_searches > 0) {
     std::vector<size_t> order(errors.size());
     std::iota(order.begin(), order.end(), size_t{0});
@@ -196,15 +206,8 @@ void FastEvaluator::evaluate(const Eigen::MatrixXd& x, double* mu, double* std) 
 }
 
 FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
-  const Evaluation exact = gp.evaluate(x, {.std = true});
-  FastEvaluatorBounds worst{0.0, 0.0};
-  for (Eigen::Index i = 0; i < x.rows(); ++i) {
-    const Eigen::RowVectorXd row = x.row(i);
-    const PointError p = error_at(fast, exact.mu(i), exact.std(i), row.data());
-    worst.mu_absolute = std::max(worst.mu_absolute, p.mu_absolute);
-    worst.std_relative = std::max(worst.std_relative, p.std_relative);
-  }
-  return worst;
+  const PointError worst = point_errors(fast, gp, x).worst;
+  return {worst.mu_absolute, worst.std_relative};
 }
 
 FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluatorOptions& o) {

@@ -6,6 +6,8 @@
 // refined (cells per input ∝ 1/length scale) until the bound is within the tolerances or the
 // memory cap stops it; the bound actually reached is kept either way, so a caller uses the grid
 // only where the bound serves the request.
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <string>
@@ -62,6 +64,10 @@ class FastEvaluator {
   FastEvaluatorBounds bounds_;
   Eigen::VectorXd lo_, inverse_width_;
 };
+
+// log σ is tabulated; σ below this (no noise term, at a training point) cannot be.
+inline constexpr double kSmallestTabulatedStd = 1e-300;
+inline double tabulated_log_std(double std) { return std::log(std::max(std, kSmallestTabulatedStd)); }
 
 // The largest errors of `fast` against the exact `gp` at the points x (SI, one row each): what the
 // bound is measured from, and what a test checks it with.

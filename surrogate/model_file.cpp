@@ -276,7 +276,7 @@ std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, c
   for (long long c = 0; c < checks; ++c) {
     const double mu = values[static_cast<size_t>(2 * which[static_cast<size_t>(c)])];
     const double log_std = values[static_cast<size_t>(2 * which[static_cast<size_t>(c)] + 1)];
-    if (std::abs(mu - e.mu(c)) > kFastNodeTolerance || std::abs(log_std - std::log(std::max(e.std(c), 1e-300))) > kFastNodeTolerance) {
+    if (std::abs(mu - e.mu(c)) > kFastNodeTolerance || std::abs(log_std - tabulated_log_std(e.std(c))) > kFastNodeTolerance) {
       in.fail(group + "/values", "node " + std::to_string(which[static_cast<size_t>(c)]) +
                                      " is not the model's value there (mu " + std::to_string(mu) + " against " +
                                      std::to_string(e.mu(c)) + ")");
