@@ -16,6 +16,7 @@
 #include "common/dataset_generation.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
+#include "common/version.hpp"
 #include "micro/scene/dataset_sample.hpp"
 #include "micro/scene/micro_run.hpp"
 #include "common/csv_table.hpp"
@@ -172,35 +173,81 @@ void run_command(const RunOptions& o) {
 
 struct RefineOptions {
   std::string db, test, candidates_csv, model_out;
+  bool grow = false;
+  double grow_coverage = 1.0;
   long long budget = 0;
   int batch = 8, jobs = 1, threads = 0, restarts = 2;
   long long candidate_count = 4096;
   unsigned long long seed = 1;
 };
 
-// Candidate points: a Sobol' set in the box (shifted per round), plus the rows of a CSV with unit
-// headers such as the server's wide-interval log (points outside the box are dropped: the plan box
-// is what the micro-model is run on).
+// The rows of a CSV with unit headers, such as the server's --log-uncertain file, in the box's
+// input order (SI).
+Eigen::MatrixXd csv_candidates(const std::string& path, const InputSpace& box) {
+  const CsvTable table = read_csv_table(path);
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(table.rows.size()), static_cast<Eigen::Index>(box.size()));
+  for (size_t j = 0; j < box.size(); ++j) {
+    const std::vector<double> column = table.si_column(box[j].name);
+    for (size_t i = 0; i < column.size(); ++i) rows(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = column[i];
+  }
+  return rows;
+}
+
+// Candidate points: a Sobol' set in the box (shifted per round), plus the CSV's rows inside the box
+// (the plan box is what the micro-model is run on; --grow-box moves it toward the others first).
 Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box, int round) {
   Eigen::MatrixXd c = plan_in_box(PlanDesign::sobol, o.candidate_count, box, o.seed + static_cast<unsigned long long>(round));
   if (o.candidates_csv.empty()) return c;
-  const CsvTable table = read_csv_table(o.candidates_csv);
-  std::vector<std::vector<double>> columns;
-  for (const auto& input : box) columns.push_back(table.si_column(input.name));
-  std::vector<Eigen::RowVectorXd> rows;
-  for (size_t i = 0; i < table.rows.size(); ++i) {
-    Eigen::RowVectorXd r(static_cast<Eigen::Index>(box.size()));
-    bool inside = true;
-    for (size_t j = 0; j < box.size(); ++j) {
-      r(static_cast<Eigen::Index>(j)) = columns[j][i];
-      inside = inside && columns[j][i] >= box[j].lo && columns[j][i] <= box[j].hi;
-    }
-    if (inside) rows.push_back(r);
+  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, box);
+  std::vector<Eigen::Index> inside;
+  for (Eigen::Index i = 0; i < logged.rows(); ++i) {
+    bool in = true;
+    for (size_t j = 0; j < box.size(); ++j) in = in && box[j].contains(logged(i, static_cast<Eigen::Index>(j)));
+    if (in) inside.push_back(i);
   }
-  Eigen::MatrixXd all(c.rows() + static_cast<Eigen::Index>(rows.size()), c.cols());
+  Eigen::MatrixXd all(c.rows() + static_cast<Eigen::Index>(inside.size()), c.cols());
   all.topRows(c.rows()) = c;
-  for (size_t i = 0; i < rows.size(); ++i) all.row(c.rows() + static_cast<Eigen::Index>(i)) = rows[i];
+  for (size_t k = 0; k < inside.size(); ++k) all.row(c.rows() + static_cast<Eigen::Index>(k)) = logged.row(inside[k]);
   return all;
+}
+
+std::string box_text(const InputSpace& box) {
+  std::string text;
+  char cell[160];
+  for (const auto& in : box) {
+    std::snprintf(cell, sizeof cell, "%s%s %.6g..%.6g %s", text.empty() ? "" : ", ", in.name.c_str(), in.lo, in.hi, in.unit.c_str());
+    text += cell;
+  }
+  return text;
+}
+
+// --grow-box: the plan's box grows toward the candidates (where the meso code asks), and the change is
+// recorded in the database's /plan/box_history; samples already run stay valid (the old box is inside).
+void grow_plan_box(const RefineOptions& o, Dataset& db) {
+  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, db.inputs);
+  const InputSpace grown = grow_box(db.inputs, logged, o.grow_coverage);
+  long long outside = 0;
+  for (Eigen::Index i = 0; i < logged.rows(); ++i) {
+    bool in = true;
+    for (size_t j = 0; j < db.inputs.size(); ++j) in = in && db.inputs[j].contains(logged(i, static_cast<Eigen::Index>(j)));
+    outside += !in;
+  }
+  bool changed = false;
+  for (size_t j = 0; j < grown.size(); ++j) changed = changed || grown[j].lo != db.inputs[j].lo || grown[j].hi != db.inputs[j].hi;
+  if (!changed) {
+    std::printf("%s: the box already covers the candidates of %s (%lld rows); not grown\n", o.db.c_str(),
+                o.candidates_csv.c_str(), static_cast<long long>(logged.rows()));
+    return;
+  }
+  char head[128];
+  std::snprintf(head, sizeof head, "%s: grown by dataset refine --grow-box (coverage %g) toward %lld of %lld rows of ",
+                utc_timestamp().c_str(), o.grow_coverage, outside, static_cast<long long>(logged.rows()));
+  const std::string record = head + o.candidates_csv + " outside: " + box_text(db.inputs) + " -> " + box_text(grown);
+  db.inputs = grown;
+  db.box_history.push_back(record);
+  write_dataset(o.db, db);
+  std::printf("%s: box %s\n", o.db.c_str(), record.c_str());
+  std::fflush(stdout);
 }
 
 // `test` is the held-out set (null without --test).
@@ -222,6 +269,7 @@ void refine_command(const RefineOptions& o) {
   if (db.plan.rows() == 0 || db.plan_index.size() != static_cast<size_t>(db.size())) {
     throw Error(o.db + ": not a micro-model database (no plan rows); start with mufric dataset plan and run");
   }
+  if (o.grow) grow_plan_box(o, db);
   const scene::Scene sc = run_scene("", {}, db, o.db);
   const SampleEvaluator evaluate = scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads));
   std::optional<TrainingSet> test;
@@ -302,6 +350,7 @@ void status_command(const std::string& path) {
   }
   std::printf("\n");
   print_box(d.inputs);
+  for (const auto& change : d.box_history) std::printf("  box %s\n", change.c_str());
   if (converged > 0) {
     double lo = INFINITY, hi = -INFINITY;
     for (Eigen::Index i = 0; i < d.size(); ++i) {
@@ -384,9 +433,18 @@ void add_dataset_commands(CLI::App& app) {
   refine->add_option("--batch", f->batch, "Runs per round (picked jointly, then run, then the GP is retrained)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   refine->add_option("--test", f->test, "Held-out database: its error is reported after every round")->check(CLI::ExistingFile);
-  refine->add_option("--candidates", f->candidates_csv,
-                     "CSV of extra candidate points with unit headers, e.g. the server's --log-uncertain file")
-      ->check(CLI::ExistingFile);
+  auto* candidates = refine->add_option("--candidates", f->candidates_csv,
+                                        "CSV of extra candidate points with unit headers, e.g. the server's "
+                                        "--log-uncertain file (rows outside the box are left out unless --grow-box)")
+                          ->check(CLI::ExistingFile);
+  refine->add_flag("--grow-box", f->grow,
+                   "First grow the plan's box toward the --candidates rows outside it (where the meso code asks); "
+                   "the new box is recorded in the database (/plan/box_history, shown by dataset status)")
+      ->needs(candidates);
+  refine->add_option("--grow-coverage", f->grow_coverage,
+                     "With --grow-box: cover this quantile of the outside rows per input and side (0.99 ignores the "
+                     "farthest 1 %, e.g. a meso code's spikes)")
+      ->capture_default_str()->check(CLI::Range(1e-3, 1.0));
   refine->add_option("--candidate-count", f->candidate_count, "Sobol' candidates per round")->capture_default_str()
       ->check(CLI::Range(16LL, 100000LL));
   refine->add_option("--model-out", f->model_out, "Write the GP trained after each round here");

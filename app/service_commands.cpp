@@ -58,8 +58,10 @@ void add_service_commands(CLI::App& app) {
   cmd->add_option("--tls-client-ca", o->tls_client_ca, "PEM CA: mutual TLS, clients need a certificate it signed")
       ->check(CLI::ExistingFile);
   cmd->add_option("--log-uncertain", o->uncertain_log_directory,
-                  "Append queries whose 95 % interval is wider than --uncertain-width to DIR/<model>.csv, candidate "
-                  "points for mufric dataset refine --candidates (makes every call compute the std)");
+                  "Append queries whose 95 % interval is wider than --uncertain-width, or that lie outside the model's "
+                  "box, to DIR/<model>.csv: candidate points for mufric dataset refine --candidates [--grow-box]. "
+                  "Counts of outside queries per input and side go to DIR/<model>.outside.json (makes every call "
+                  "compute the std)");
   cmd->add_option("--uncertain-width", o->uncertain_width, "Interval width (in mu) above which a query is logged")
       ->capture_default_str()->check(CLI::Range(1e-9, 1e9));
   cmd->add_option("--uncertain-max-rows", o->uncertain_max_rows, "Most logged queries per model")->capture_default_str()

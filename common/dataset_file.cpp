@@ -83,6 +83,7 @@ Dataset read_hdf5_dataset(const std::string& path) {
   }
   if (in.has_attribute("/plan", "design")) d.plan_design = in.string_attribute("/plan", "design");
   if (in.has_attribute("/plan", "seed")) d.plan_seed = in.int_attribute("/plan", "seed");
+  if (in.has("/plan/box_history")) d.box_history = in.strings("/plan/box_history");
   if (in.has_attribute("/", "source")) d.source = in.string_attribute("/", "source");
   if (in.has_attribute("/", "scene_json")) d.scene_json = in.string_attribute("/", "scene_json");
   if (in.has_attribute("/", "code_version")) d.code_version = in.string_attribute("/", "code_version");
@@ -181,6 +182,7 @@ void write_dataset(const std::string& path, const Dataset& d) {
     out.string_attribute("/plan", "design", d.plan_design);
     out.int_attribute("/plan", "seed", d.plan_seed);
   }
+  if (!d.box_history.empty()) out.strings("/plan/box_history", d.box_history);
   out.commit();
 }
 

@@ -40,6 +40,7 @@ struct Dataset {
   std::vector<long long> plan_index;  // n, row of `plan` each sample answers (−1: none); empty: unknown
   std::string plan_design;          // how the plan was drawn ("sobol", ...), empty if unknown
   long long plan_seed = 0;
+  std::vector<std::string> box_history;  // one line per change of the box (dataset refine --grow-box)
   std::string source;               // how the samples were made (scene hash, law name, ...)
   std::string scene_json;           // scene text when made by the micro-model
   std::string code_version;

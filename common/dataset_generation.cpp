@@ -58,6 +58,7 @@ Dataset empty_database(const Dataset& plan) {
   d.plan = plan.plan;
   d.plan_design = plan.plan_design;
   d.plan_seed = plan.plan_seed;
+  d.box_history = plan.box_history;
   d.source = plan.source;
   d.scene_json = plan.scene_json;
   d.code_version = code_version();

@@ -1,11 +1,15 @@
 #pragma once
 // Where the meso code goes and the surrogate is unsure: query points whose 95 % interval is wider
-// than a threshold, appended per model to DIR/<model>.csv (unit header, SI values), the file
-// `mufric dataset refine --candidates` reads. Opt-in (`serve --log-uncertain DIR`): it makes every
-// call compute the predictive std, which a GP pays n²/2 multiply-adds per point for.
+// than a threshold, or that lie outside the model's box, appended per model to DIR/<model>.csv
+// (unit header, SI values), the file `mufric dataset refine --candidates [--grow-box]` reads; and
+// per input and side, how many queries fell outside the box and how far, in DIR/<model>.outside.json.
+// Opt-in (`serve --log-uncertain DIR`): it makes every call compute the predictive std, which a GP
+// pays n²/2 multiply-adds per point for.
+#include <chrono>
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -13,24 +17,57 @@
 
 namespace mufric::server {
 
+// Queries of one input outside the box: how many on each side, and the farthest seen (SI).
+struct OutsideInputCount {
+  long long below = 0, above = 0;
+  double lowest = 0.0, highest = 0.0;  // meaningful only where below / above > 0
+};
+
+struct OutsideSummary {
+  long long queries = 0;          // every point asked of the model while logging
+  long long outside_queries = 0;  // points with at least one input outside the box
+  std::vector<OutsideInputCount> inputs;  // the model's input order
+};
+
 class UncertainQueryLog {
  public:
   // Throws Error naming --log-uncertain if the directory cannot be created.
   UncertainQueryLog(std::string directory, double width_threshold, long long max_rows_per_model);
+  // Writes every model's outside summary that changed since its last write.
+  ~UncertainQueryLog();
+  UncertainQueryLog(const UncertainQueryLog&) = delete;
+  UncertainQueryLog& operator=(const UncertainQueryLog&) = delete;
 
   // Appends the points (rows of x, SI, the model's input order) whose interval width
-  // 2 · 1.96 · std exceeds the threshold; stops for a model after max_rows_per_model rows.
+  // 2 · 1.96 · std exceeds the threshold or that lie outside `inputs`' box (angles are periodic and
+  // never outside); stops appending for a model after max_rows_per_model rows, while the outside
+  // counts go on.
   void record(const std::string& model, const InputSpace& inputs, const Eigen::Ref<const Eigen::MatrixXd>& x,
               const Eigen::Ref<const Eigen::VectorXd>& std);
   long long rows(const std::string& model) const;
+  OutsideSummary outside(const std::string& model) const;
   std::string path(const std::string& model) const;
+  std::string outside_path(const std::string& model) const;
+  // Writes the summaries now (the destructor does; a summary is otherwise rewritten at most once a
+  // second, so that a crash loses at most a second of counts and a busy server no file writes).
+  void flush();
 
  private:
+  struct ModelLog {
+    long long rows = 0;
+    OutsideSummary outside;
+    InputSpace box;
+    bool summary_dirty = false;
+    std::chrono::steady_clock::time_point summary_written{};
+  };
+  void append_rows(const std::string& model, ModelLog& log, const InputSpace& inputs, const std::string& text, long long added);
+  void write_summary(const std::string& model, ModelLog& log);
+
   std::string directory_;
   double width_threshold_;
   long long max_rows_;
   mutable std::mutex lock_;
-  std::map<std::string, long long> rows_;
+  std::map<std::string, ModelLog> models_;
 };
 
 }  // namespace mufric::server

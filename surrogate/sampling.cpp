@@ -1,6 +1,7 @@
 #include "surrogate/sampling.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <vector>
 
@@ -92,6 +93,32 @@ h5::RowMatrix plan_in_box(PlanDesign design, Eigen::Index n, const InputSpace& i
     x.col(j) = (input.lo + u.col(j).array() * (input.hi - input.lo)).matrix();
   }
   return x;
+}
+
+InputSpace grow_box(const InputSpace& box, const Eigen::Ref<const Eigen::MatrixXd>& points, double coverage) {
+  if (!(coverage > 0.0 && coverage <= 1.0)) throw Error("box growth: coverage must be in (0, 1], not " + std::to_string(coverage));
+  if (points.cols() != static_cast<Eigen::Index>(box.size())) {
+    throw Error("box growth: the points have " + std::to_string(points.cols()) + " columns, the box " +
+                std::to_string(box.size()) + " inputs");
+  }
+  InputSpace grown = box;
+  for (size_t j = 0; j < box.size(); ++j) {
+    if (box[j].kind() == QuantityKind::angle) continue;
+    std::vector<double> values;
+    for (Eigen::Index i = 0; i < points.rows(); ++i) {
+      const double value = points(i, static_cast<Eigen::Index>(j));
+      if (std::isfinite(value)) values.push_back(value);
+    }
+    if (values.empty()) continue;
+    // Nearest-rank quantiles (Hyndman & Fan 1996, definition 1) of all the points, so that growing
+    // twice toward the same points changes nothing the second time.
+    const auto rank = static_cast<std::ptrdiff_t>(std::max(1.0, std::ceil(coverage * static_cast<double>(values.size())))) - 1;
+    std::nth_element(values.begin(), values.begin() + rank, values.end());
+    grown[j].hi = std::max(box[j].hi, values[static_cast<size_t>(rank)]);
+    std::nth_element(values.begin(), values.begin() + rank, values.end(), std::greater<>());
+    grown[j].lo = std::min(box[j].lo, values[static_cast<size_t>(rank)]);
+  }
+  return grown;
 }
 
 }  // namespace mufric

@@ -29,6 +29,13 @@ Eigen::MatrixXd unit_plan(PlanDesign design, Eigen::Index n, Eigen::Index d, std
 // The same plan scaled into the box of `inputs` (SI), one row per point.
 h5::RowMatrix plan_in_box(PlanDesign design, Eigen::Index n, const InputSpace& inputs, std::uint64_t seed);
 
+// The box grown so that, per input and side, it covers the `coverage` quantile of the points
+// (1: every point; 0.99 leaves the farthest 1 % of them out on each side, so that one spike of a
+// meso code does not stretch the campaign). Never shrinks; growing again toward the same points
+// changes nothing. Angles are periodic and keep their box. Points with a non-finite input are
+// ignored. Throws Error if coverage is not in (0, 1] or the columns differ.
+InputSpace grow_box(const InputSpace& box, const Eigen::Ref<const Eigen::MatrixXd>& points, double coverage);
+
 // A Latin hypercube drawn from `rng` (for callers that keep drawing from the same generator).
 Eigen::MatrixXd latin_hypercube(Eigen::Index n, Eigen::Index d, std::mt19937_64& rng);
 

@@ -452,6 +452,32 @@ TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
   EXPECT_EQ(run("describe " + path("gp.h5")).exit_code, 0);
 }
 
+// --grow-box: the plan's box grows toward the logged queries outside it, to the coverage quantile per
+// side (0.75 of {1, 1, 2, 3} GPa is 2 GPa: the 3 GPa spike is left out), the change is recorded and
+// shown, and growing again toward the same rows changes nothing.
+TEST_F(Cli, DatasetRefineGrowsTheBoxTowardTheLoggedQueries) {
+  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 4 --p 700MPa:1300MPa" + kTinyScene).exit_code, 0);
+  ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5")).exit_code, 0);
+  std::ofstream(path("log.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],ci95_width,outside_inputs\n"
+                                     "2000,60,400,0.01,1\n3000,60,400,0.01,1\n1000,6,400,0.01,1\n1000,6,400,0.01,1\n";
+  CommandResult r = run("dataset refine --db " + path("db.h5") + " --budget 1 --batch 1 --restarts 0 --grow-box " +
+                        "--grow-coverage 0.75 --candidates " + path("log.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("grown by dataset refine --grow-box (coverage 0.75) toward 4 of 4 rows"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("-> contact_pressure 7e+08..2e+09 Pa, sliding_velocity 0.1..3.33333 m/s"), std::string::npos)
+      << r.output;
+  const CommandResult status = run("dataset status " + path("db.h5"));
+  EXPECT_NE(status.output.find("  box 20"), std::string::npos) << status.output;  // the record, with its date
+  EXPECT_NE(status.output.find("samples: 5 ("), std::string::npos) << status.output;  // 4 planned + 1 pick
+  // Growing again toward the same rows changes nothing and says so.
+  r = run("dataset refine --db " + path("db.h5") + " --budget 0 --restarts 0 --grow-box --grow-coverage 0.75 --candidates " +
+          path("log.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the box already covers the candidates"), std::string::npos) << r.output;
+  EXPECT_NE(run("dataset refine --db " + path("db.h5") + " --budget 0 --grow-box").exit_code, 0);  // needs --candidates
+}
+
 // kill -9 in the middle of a run loses at most the samples in flight: the database stays readable
 // and a second run completes the plan with every row once.
 TEST_F(Cli, DatasetRunSurvivesKillNine) {

@@ -2,6 +2,9 @@
 // defines the sequence; Latin hypercube strata; reproducibility; scaling into the box.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
 #include <set>
 
 #include "common/error.hpp"
@@ -81,6 +84,46 @@ TEST(Sampling, PlansLieInTheBoxAndNamesParse) {
   }
   EXPECT_THROW(parse_plan_design("halton"), Error);
   EXPECT_THROW(unit_plan(PlanDesign::random, 0, 3, 1), Error);
+}
+
+// grow_box against a sort of every column: coverage 1 reaches the extremes, coverage q the
+// ceil(q n)-th value from each end; an angle keeps its box, the box never shrinks, NaN rows are
+// ignored, and growing twice is growing once.
+TEST(Sampling, GrowBoxCoversTheQuantileOfThePointsPerSide) {
+  const InputSpace box = {{"contact_pressure", "Pa", 300e6, 1300e6}, {"sliding_velocity", "m/s", 0.375, 3.33},
+                          {"fibre_angle", "rad", 0.0, 1.0}};
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> wide(800e6, 900e6), speed(1.5, 2.0), angle(0.5, 3.0);
+  const Eigen::Index n = 200;
+  Eigen::MatrixXd points(n + 1, 3);
+  for (Eigen::Index i = 0; i < n; ++i) points.row(i) << wide(rng), std::abs(speed(rng)) + 0.5, angle(rng);
+  points.row(n) << std::nan(""), 1e9, 0.2;  // a non-finite pressure: its other inputs still count
+  for (const double coverage : {1.0, 0.9}) {
+    const InputSpace grown = grow_box(box, points, coverage);
+    for (Eigen::Index j = 0; j < 2; ++j) {
+      std::vector<double> column;
+      for (Eigen::Index i = 0; i <= n; ++i) {
+        if (std::isfinite(points(i, j))) column.push_back(points(i, j));
+      }
+      std::sort(column.begin(), column.end());
+      const auto k = static_cast<size_t>(std::ceil(coverage * static_cast<double>(column.size()))) - 1;
+      EXPECT_EQ(grown[static_cast<size_t>(j)].hi, std::max(box[static_cast<size_t>(j)].hi, column[k])) << j << " " << coverage;
+      EXPECT_EQ(grown[static_cast<size_t>(j)].lo, std::min(box[static_cast<size_t>(j)].lo, column[column.size() - 1 - k]))
+          << j << " " << coverage;
+    }
+    EXPECT_EQ(grown[2].lo, 0.0);  // periodic
+    EXPECT_EQ(grown[2].hi, 1.0);
+    const InputSpace again = grow_box(grown, points, coverage);
+    for (size_t j = 0; j < 3; ++j) {
+      EXPECT_EQ(again[j].lo, grown[j].lo);
+      EXPECT_EQ(again[j].hi, grown[j].hi);
+    }
+  }
+  EXPECT_EQ(grow_box(box, points, 1.0)[1].hi, 1e9);
+  const Eigen::MatrixXd inside = Eigen::MatrixXd::Constant(4, 3, 0.5).array().rowwise() * Eigen::RowVector3d(1e9, 1.0, 1.0).array();
+  EXPECT_EQ(grow_box(box, inside, 1.0)[0].lo, 300e6);  // never shrinks
+  EXPECT_THROW(grow_box(box, points, 0.0), Error);
+  EXPECT_THROW(grow_box(box, points.leftCols(2), 1.0), Error);
 }
 
 }  // namespace

@@ -6,16 +6,20 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <condition_variable>
 #include <fstream>
 #include <mutex>
+#include <random>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "client/friction_client.hpp"
 #include "client/mufric.h"
@@ -150,6 +154,78 @@ TEST_F(Service, UncertainQueriesAreLoggedForActiveLearning) {
     EXPECT_EQ(t[k], pts.t[expected[k]]);
   }
   EXPECT_EQ(log.rows("gp"), static_cast<long long>(expected.size()));
+}
+
+// Out-of-box queries are logged whatever their width (under the clamp default their std is the
+// box face's, narrow), and counted per input and side with the farthest value seen: the counts
+// against a brute-force count of the same points, and they go on after the row cap.
+TEST_F(Service, OutOfBoxQueriesAreLoggedAndCountedPerInputAndSide) {
+  Points pts = random_points(300);
+  const InputSpace box = default_friction_box();
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double>* columns[] = {&pts.p, &pts.v, &pts.t};
+  for (size_t i = 0; i < pts.p.size(); i += 3) {  // every third point: one input pushed out, side by turn
+    const size_t j = (i / 3) % 3;
+    const double span = box[j].hi - box[j].lo;
+    (*columns[j])[i] = (i / 9) % 2 ? box[j].hi + u(rng) * span : std::max(box[j].lo - u(rng) * span, 0.5 * box[j].lo);
+  }
+  std::array<long long, 3> below{}, above{};
+  std::array<double, 3> lowest{}, highest{};
+  lowest.fill(std::numeric_limits<double>::infinity());
+  highest.fill(-std::numeric_limits<double>::infinity());
+  long long outside = 0;
+  for (size_t i = 0; i < pts.p.size(); ++i) {
+    bool any = false;
+    for (size_t j = 0; j < 3; ++j) {
+      const double value = (*columns[j])[i];
+      if (value < box[j].lo) ++below[j], lowest[j] = std::min(lowest[j], value), any = true;
+      if (value > box[j].hi) ++above[j], highest[j] = std::max(highest[j], value), any = true;
+    }
+    outside += any;
+  }
+  ASSERT_GT(outside, 90);
+  const long long max_rows = 60;
+  const fs::path dir = dir_ / "outside";
+  {
+    server::UncertainQueryLog log(dir.string(), 1e6, max_rows);  // no interval is that wide: only outside points
+    server::ServiceLimits limits;
+    limits.uncertain_log = &log;
+    LoopbackServer server(dir_, 0, limits);
+    const auto remote = client::connect("grpc://" + server.address() + "/gp");
+    const client::Answer a = remote->evaluate(pts.block(), {});  // the clamp default: every point answered
+    for (const double mu : a.mu) EXPECT_TRUE(std::isfinite(mu));
+    const server::OutsideSummary s = log.outside("gp");
+    EXPECT_EQ(s.queries, static_cast<long long>(pts.p.size()));
+    EXPECT_EQ(s.outside_queries, outside);
+    for (size_t j = 0; j < 3; ++j) {
+      EXPECT_EQ(s.inputs[j].below, below[j]) << box[j].name;
+      EXPECT_EQ(s.inputs[j].above, above[j]) << box[j].name;
+      if (below[j] > 0) {
+        EXPECT_EQ(s.inputs[j].lowest, lowest[j]);
+      }
+      if (above[j] > 0) {
+        EXPECT_EQ(s.inputs[j].highest, highest[j]);
+      }
+    }
+    EXPECT_EQ(log.rows("gp"), max_rows);  // the row cap bites, the counts went on
+  }  // the log's destructor writes the summary
+  const CsvTable table = read_csv_table((dir / "gp.csv").string());
+  ASSERT_EQ(table.rows.size(), static_cast<size_t>(max_rows));
+  const auto p = table.si_column("contact_pressure"), flagged = table.si_column("outside_inputs");
+  size_t k = 0;
+  for (size_t i = 0; i < pts.p.size() && k < p.size(); ++i) {
+    const bool out = !box[0].contains(pts.p[i]) || !box[1].contains(pts.v[i]) || !box[2].contains(pts.t[i]);
+    if (!out) continue;
+    EXPECT_EQ(p[k], pts.p[i]);
+    EXPECT_EQ(flagged[k], 1.0);
+    ++k;
+  }
+  const auto json = nlohmann::json::parse(std::ifstream(dir / "gp.outside.json"));
+  EXPECT_EQ(json.at("outside_queries").get<long long>(), outside);
+  EXPECT_EQ(json.at("inputs").at(2).at("name"), "temperature");
+  EXPECT_EQ(json.at("inputs").at(2).at("above").get<long long>(), above[2]);
+  EXPECT_EQ(json.at("inputs").at(1).at("lowest").get<double>(), lowest[1]);
 }
 
 TEST_F(Service, StreamOfIncrementsAnswersLikeUnaryCallsAndSurvivesAnError) {
