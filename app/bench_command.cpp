@@ -125,6 +125,7 @@ void add_bench_command(CLI::App& app) {
     bool with_std = false;
     bool streaming = false;
     bool json = false;
+    bool exact = false;
     std::vector<long long> replay;  // points, increments
   };
   auto o = std::make_shared<Options>();
@@ -138,12 +139,14 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--std", o->with_std, "Also the standard deviation and a 95 % interval");
   cmd->add_flag("--stream", o->streaming, "grpc://: send blocks over one EvaluateStream per client");
   cmd->add_flag("--json", o->json, "One JSON object per batch size instead of a table");
+  cmd->add_flag("--exact", o->exact, "Ask for the exact model only (no certified fast evaluator)");
   cmd->add_option("--replay", o->replay,
                   "Meso-trace replay instead of fixed batches: POINTS,INCREMENTS contact points drifting over "
                   "increments, one call per increment")
       ->delimiter(',')->expected(2);
   cmd->callback([o] {
-    const EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
+    EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
+    if (o->exact) what.mu_tolerance = what.std_relative_tolerance = 0.0;
     client::Options options;
     options.streaming = o->streaming;
     options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
