@@ -189,7 +189,8 @@ void FastEvaluator::evaluate(const double* x, double& mu, double& std) const {
   double out[2];
   grid_.evaluate(u, out);
   mu = out[0];
-  std = std::exp(out[1]);
+  std = out[1];
+  exp_in_place(&std, 1);  // the batch's vector exp: the same σ alone or in a batch, to the bit
 }
 
 void FastEvaluator::evaluate(const Eigen::MatrixXd& x, double* mu, double* std) const {

@@ -4,12 +4,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
+#include "common/blas_threads.hpp"
 #include "common/error.hpp"
 #include "surrogate/cholesky.hpp"
 #include "surrogate/fast_evaluator.hpp"
+#include "surrogate/gp_kernels.hpp"
 #include "surrogate/vector_exp.hpp"
+
+// BLAS dtrmm (OpenBLAS): B ← α op(A) B with A triangular.
+extern "C" void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
+                       const double* alpha, const double* a, const int* lda, double* b, const int* ldb);
 
 namespace mufric {
 namespace {
@@ -22,10 +29,6 @@ constexpr Eigen::Index kParallelThreshold = 2 * kQueryBlock;
 // Up to this many queries with a variance read L⁻¹ row by row once for all of them (memory-bound,
 // split over two cores' L2 caches); larger blocks use a triangular matrix product (compute-bound).
 constexpr Eigen::Index kRowByRowMaxQueries = 16;
-// Partial sums of the mean's dot product (GaussianProcess::mean_from_correlations): four AVX-512 or
-// eight AVX2 registers, enough independent additions to hide their latency (8 lanes cost 10 % of a
-// mean-only batch at n = 900 against Eigen's own reduction; bench/RESULTS.md).
-constexpr Eigen::Index kMeanLanes = 32;
 // An L⁻¹ larger than this (bytes of its lower half) is split over two threads for a single query,
 // so that each half stays in one core's L2 cache.
 constexpr double kSplitRowsAboveBytes = 512.0 * 1024.0;
@@ -126,31 +129,13 @@ GaussianProcess::GaussianProcess(State state) : FrictionModel(state.inputs), sta
 
 void GaussianProcess::correlations_with_training(const Eigen::RowVectorXd& scaled_query,
                                                  Eigen::Ref<Eigen::ArrayXd> correlation) const {
-  correlation = (scaled_train_.col(0).array() - scaled_query(0)).square();
-  for (Eigen::Index k = 1; k < scaled_train_.cols(); ++k) {
-    correlation += (scaled_train_.col(k).array() - scaled_query(k)).square();
-  }
-  rbf_correlation_in_place(correlation);
+  gp_kernels::rbf_exponents(scaled_train_.data(), scaled_train_.rows(), scaled_train_.cols(), scaled_query.data(),
+                            kMinimumExponent, correlation.data());
+  exp_in_place(correlation.data(), correlation.size());
 }
 
 double GaussianProcess::mean_from_correlations(const double* correlation) const {
-  // kMeanLanes interleaved partial sums (one fixed-size array, kept in vector registers), added
-  // pairwise at the end: nothing depends on where the data starts — Eigen's packet reduction of a
-  // dynamic vector peels up to the first aligned element, which moves with the batch.
-  using Lanes = Eigen::Array<double, kMeanLanes, 1>;
-  const double* weights = weights_.data();
-  const auto n = weights_.size();
-  Lanes lane = Lanes::Zero();
-  Eigen::Index i = 0;
-  for (; i + kMeanLanes <= n; i += kMeanLanes) {
-    lane += Eigen::Map<const Lanes>(correlation + i) * Eigen::Map<const Lanes>(weights + i);
-  }
-  for (Eigen::Index l = 0; i < n; ++i, ++l) lane(l) += correlation[i] * weights[i];
-  double* sums = lane.data();
-  for (Eigen::Index width = kMeanLanes / 2; width > 0; width /= 2) {
-    for (Eigen::Index l = 0; l < width; ++l) sums[l] += sums[l + width];
-  }
-  return state_.y_mean + sums[0];
+  return state_.y_mean + gp_kernels::lane_dot(correlation, weights_.data(), weights_.size());
 }
 
 void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count,
@@ -203,7 +188,21 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
     if (count <= kRowByRowMaxQueries) {
       norms2 = squared_norms_row_by_row(k_block, what.max_threads);
     } else {
+#if defined(__AVX2__)
+      // A build for a vector ISA (MUFRIC_NATIVE): Eigen's product, compiled for it, is the faster one
+      // (1.45× OpenBLAS's dtrmm on one AVX-512 core at n = 900; bench/RESULTS.md).
       v_block.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * k_block;
+#else
+      // A portable build: OpenBLAS's dtrmm, whose kernels are chosen for the CPU at load time (2.6×
+      // Eigen's SSE2 product on an AVX-512 core). One BLAS thread: the team is the parallelism.
+      // L⁻¹ is stored row-major: read column-major it is its transpose, upper triangular.
+      v_block = k_block;
+      const char side = 'L', upper = 'U', transpose = 'T', non_unit = 'N';
+      const int rows = static_cast<int>(n), columns = static_cast<int>(count);
+      const double one = 1.0;
+      dtrmm_(&side, &upper, &transpose, &non_unit, &rows, &columns, &one, inverse_factor_.data(), &rows, v_block.data(),
+             &rows);
+#endif
       norms2 = v_block.colwise().squaredNorm();
     }
     const double s2 = state_.hyper.signal_variance;
@@ -237,7 +236,13 @@ Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::Matrix
     Eigen::RowVectorXd sums = Eigen::RowVectorXd::Zero(count);
     if (count == 1) {  // a plain dot product per row: no matrix–vector call overhead
       for (Eigen::Index i = begin; i < end; ++i) {
+#if defined(__AVX2__)
+        // A build for a vector ISA: Eigen's dot, compiled for it (1.2× lane_dot at n = 900).
         const double v = inverse_factor_.row(i).head(i + 1).dot(kernels.col(0).head(i + 1).transpose());
+#else
+        // A portable build: the run-time-dispatched kernel (1.4× Eigen's SSE2 dot on AVX-512).
+        const double v = gp_kernels::lane_dot(inverse_factor_.row(i).data(), kernels.col(0).data(), i + 1);
+#endif
         sums(0) += v * v;
       }
       return sums;
@@ -325,6 +330,11 @@ void GaussianProcess::evaluate_exact(const QueryBatch& x, const EvaluationReques
   if (what.gradient) out.gradient.resize(m, x.cols());
   const Eigen::Index blocks = (m + kQueryBlock - 1) / kQueryBlock;
   const int team = evaluation_team_size(what.max_threads);
+#if !defined(__AVX2__)
+  // Our team (or the caller's) is the parallelism: each block's dtrmm runs on its own thread.
+  std::optional<SingleThreadedBlas> one_blas_thread;
+  if ((what.std || what.ci_level > 0.0) && m > kRowByRowMaxQueries) one_blas_thread.emplace();
+#endif
   if (m < kParallelThreshold || team < 2) {
     Eigen::MatrixXd k_block, v_block;
     for (Eigen::Index block = 0; block < blocks; ++block) {

@@ -279,7 +279,8 @@ std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, c
     if (std::abs(mu - e.mu(c)) > kFastNodeTolerance || std::abs(log_std - tabulated_log_std(e.std(c))) > kFastNodeTolerance) {
       in.fail(group + "/values", "node " + std::to_string(which[static_cast<size_t>(c)]) +
                                      " is not the model's value there (mu " + std::to_string(mu) + " against " +
-                                     std::to_string(e.mu(c)) + ")");
+                                     std::to_string(e.mu(c)) + ", log std " + std::to_string(log_std) + " against " +
+                                     std::to_string(tabulated_log_std(e.std(c))) + ")");
     }
   }
   return fast;

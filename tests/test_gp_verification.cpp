@@ -270,7 +270,9 @@ TEST(GpVerification, BatchedParallelEqualsPointByPoint) {
     EXPECT_EQ(batch.mu(q), one.mu(0));  // one summation order for μ (MuIsTheSameBitsWhateverElseIsAsked)
     // One point reads L⁻¹ row by row, a batch multiplies by it blockwise: same maths, other rounding.
     EXPECT_NEAR(batch.std(q), one.std(0), 1e-10 * one.std(0));
-    EXPECT_NEAR((batch.gradient.row(q) - one.gradient.row(0)).norm(), 0.0, 1e-12 * one.gradient.norm());
+    // The gradient sums α_i ∂k_i/∂x with cancellation: an ulp in a kernel value (a vector exp lane)
+    // moves it by up to 1.2e-12 of |g| (measured); 1e-11 still catches a wrong term.
+    EXPECT_NEAR((batch.gradient.row(q) - one.gradient.row(0)).norm(), 0.0, 1e-11 * one.gradient.norm());
   }
 }
 
