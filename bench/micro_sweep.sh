@@ -3,13 +3,19 @@
 # 300–1300 MPa, 22.5–200 m/min, 25–900 °C): mu, contact, plastic strain, heating, Newton work and
 # wall time per point, as a markdown table. Every run's result.json is kept in the output directory.
 # Usage: bash bench/micro_sweep.sh [build-dir] [out-dir] [extra --set overrides...]
+# Another box: PRESSURES="300MPa 3000MPa" VELOCITIES="1m/min 200m/min" TEMPERATURES="25C 900C"
+# CENTRE="1650MPa 100.5m/min 462.5C" bash bench/micro_sweep.sh ... (CENTRE="" for none).
 set -uo pipefail
+pressures=${PRESSURES:-300MPa 1300MPa}
+velocities=${VELOCITIES:-22.5m/min 200m/min}
+temperatures=${TEMPERATURES:-25C 900C}
+centre=${CENTRE-800MPa 111.25m/min 462.5C}
 build=${1:-build}
 out=${2:-micro-sweep}
 shift 2 2>/dev/null || true
 mufric=$build/app/mufric
 mkdir -p "$out"
-echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; overrides: $*"
+echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; p: $pressures; v: $velocities; T: $temperatures; centre: ${centre:-none}; overrides: $*"
 printf '| p | v | T | mu | contact | max p [MPa] | max plastic strain | max T [C] | Newton | cut-backs | wall [s] |\n|---|---|---|---|---|---|---|---|---|---|---|\n'
 run() {
   local p=$1 v=$2 t=$3
@@ -35,9 +41,10 @@ print(f'| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {mu} | {100*d["contact
       f'{d["newton_iterations"]} | {d["cutbacks"]} | {d["wall_seconds"]:.1f} |')
 PY
 }
-for p in 300MPa 1300MPa; do
-  for v in 22.5m/min 200m/min; do
-    for t in 25C 900C; do run $p $v $t "$@"; done
+for p in $pressures; do
+  for v in $velocities; do
+    for t in $temperatures; do run $p $v $t "$@"; done
   done
 done
-run 800MPa 111.25m/min 462.5C "$@"
+# shellcheck disable=SC2086  # the centre is three words
+[[ -n $centre ]] && run $centre "$@"
