@@ -24,6 +24,14 @@ constexpr double kGrowthMargin = 1.1;
 // The local searches for the worst error: evaluations each (BOBYQA, Powell 2009).
 constexpr int kLocalSearchEvaluations = 60;
 
+// What the grid is built from and measured against: the exact GP, never a grid the GP may already
+// carry (upgrade --rebuild, a GP loaded from a file with one).
+EvaluationRequest exact_with_std() {
+  EvaluationRequest what{.std = true};
+  what.mu_tolerance = what.std_relative_tolerance = 0.0;
+  return what;
+}
+
 std::vector<int> cells_for(const GaussianProcess& gp, double resolution) {
   std::vector<int> cells;
   const Eigen::VectorXd& l = gp.state().hyper.length_scales;
@@ -51,7 +59,7 @@ Eigen::MatrixXd to_si(const Eigen::MatrixXd& u, const InputSpace& box) {
 // The exact μ and log σ at every node of a grid.
 TensorCubicGrid tabulate(const GaussianProcess& gp, const std::vector<int>& cells) {
   const Eigen::MatrixXd x = to_si(TensorCubicGrid::nodes(cells), gp.inputs());
-  const Evaluation e = gp.evaluate(x, {.std = true});
+  const Evaluation e = gp.evaluate(x, exact_with_std());
   Eigen::MatrixXd values(x.rows(), 2);
   values.col(0) = e.mu;
   values.col(1) = e.std.array().max(kSmallestTabulatedStd).log().matrix();
@@ -78,7 +86,7 @@ struct MeasuredErrors {
   PointError worst;
 };
 MeasuredErrors point_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
-  const Evaluation exact = gp.evaluate(x, {.std = true});
+  const Evaluation exact = gp.evaluate(x, exact_with_std());
   MeasuredErrors m;
   m.per_point.resize(static_cast<size_t>(x.rows()));
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
@@ -105,7 +113,7 @@ double search_objective(unsigned d, const double* u, double*, void* data) {
     const auto& in = c->fast->box()[k];
     x(k) = in.lo + std::clamp(u[k], 0.0, 1.0) * (in.hi - in.lo);
   }
-  const Evaluation e = c->gp->evaluate(x, {.std = true});
+  const Evaluation e = c->gp->evaluate(x, exact_with_std());
   const PointError p = error_at(*c->fast, e.mu(0), e.std(0), x.data());
   c->worst.mu_absolute = std::max(c->worst.mu_absolute, p.mu_absolute);
   c->worst.std_relative = std::max(c->worst.std_relative, p.std_relative);

@@ -2,6 +2,8 @@
 // exact GP on points it never saw.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include <cmath>
 #include <random>
 
@@ -74,6 +76,21 @@ TEST(TensorCubicGrid, RefusesShapesThatDoNotFit) {
 }
 
 GaussianProcess small_gp() { return test::fixed_hyper_gp(120, 7, 1.0, {0.4, 0.6, 0.5}, 1e-3); }
+
+// A GP that already carries a grid (a model file being rebuilt) is measured without it: the new
+// grid's bound is the same as when built from the bare GP, not its distance to the old grid.
+TEST(FastEvaluator, ARebuildMeasuresAgainstTheExactModelNotTheOldGrid) {
+  const GaussianProcess bare = small_gp();
+  FastEvaluatorOptions o;
+  o.check_points = 2000;
+  const FastEvaluator first = FastEvaluator::build(bare, o);
+  GaussianProcess carrying = small_gp();
+  carrying.attach_fast_evaluator(std::make_shared<const FastEvaluator>(first));
+  const FastEvaluator rebuilt = FastEvaluator::build(carrying, o);
+  EXPECT_EQ(rebuilt.bounds().mu_absolute, first.bounds().mu_absolute);
+  EXPECT_EQ(rebuilt.bounds().std_relative, first.bounds().std_relative);
+  EXPECT_GT(rebuilt.bounds().mu_absolute, 1e-12);  // a grid, not the exact model
+}
 
 // The stored bound is never exceeded on fresh random points (10⁶ in the optimised build).
 TEST(FastEvaluator, TheMeasuredBoundHoldsOnFreshPoints) {
