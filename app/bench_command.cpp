@@ -126,6 +126,7 @@ void add_bench_command(CLI::App& app) {
     bool streaming = false;
     bool json = false;
     bool exact = false;
+    std::string client_options;
     std::vector<long long> replay;  // points, increments
   };
   auto o = std::make_shared<Options>();
@@ -140,6 +141,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--stream", o->streaming, "grpc://: send blocks over one EvaluateStream per client");
   cmd->add_flag("--json", o->json, "One JSON object per batch size instead of a table");
   cmd->add_flag("--exact", o->exact, "Ask for the exact model only (no certified fast evaluator)");
+  cmd->add_option("--client-options", o->client_options,
+                  "Client options as the C ABI takes them, e.g. \"chunk_points=1024, deadline=5\"");
   cmd->add_option("--replay", o->replay,
                   "Meso-trace replay instead of fixed batches: POINTS,INCREMENTS contact points drifting over "
                   "increments, one call per increment")
@@ -147,8 +150,8 @@ void add_bench_command(CLI::App& app) {
   cmd->callback([o] {
     EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
     if (o->exact) what.mu_tolerance = what.std_relative_tolerance = 0.0;
-    client::Options options;
-    options.streaming = o->streaming;
+    client::Options options = client::parse_options(o->client_options);
+    options.streaming = options.streaming || o->streaming;
     options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
     if (!o->replay.empty()) {
       if (o->replay[0] <= 0 || o->replay[1] <= 0) throw Error("--replay: POINTS and INCREMENTS must be positive");
