@@ -19,7 +19,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mu_protocol import draw_mus, mean_se, run  # noqa: E402  (the same runner, resumable)
+from mu_protocol import draw_mus, mean_se, run, study_arguments  # noqa: E402  (the same runner, resumable)
 
 DEGREES = (2, 3)
 MESHES = ((32, 6), (64, 12), (96, 18))
@@ -45,12 +45,7 @@ def name(degree, mesh, step_nm, tools=TOOLS):
 
 
 def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    mufric, out = sys.argv[1], sys.argv[2]
-    args = sys.argv[3:]
-    extra = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
-    os.makedirs(out, exist_ok=True)
+    mufric, out, _, extra = study_arguments(__doc__)
     print(f"`{' '.join(sys.argv)}` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores\n")
     finest = run(mufric, out, name(*FINEST, FINEST_TOOLS), extra + overrides(*FINEST, FINEST_TOOLS))
     finest_mus = draw_mus(finest)

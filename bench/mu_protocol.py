@@ -197,14 +197,22 @@ STUDIES = {"ramp": study_ramp, "window": study_window, "step": study_step, "heat
            "mesh": study_mesh}
 
 
-def main():
+def study_arguments(usage):
+    """MUFRIC OUT_DIR [words ...] [--set key=value ...] from the command line: the executable, the output
+    directory (created), the words that are not --set pairs, and the --set overrides."""
     if len(sys.argv) < 3:
-        sys.exit(__doc__)
+        sys.exit(usage)
     mufric, out = sys.argv[1], sys.argv[2]
     args = sys.argv[3:]
     extra = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
-    names = [a for i, a in enumerate(args) if a != "--set" and (i == 0 or args[i - 1] != "--set")] or list(STUDIES)
+    words = [a for i, a in enumerate(args) if a != "--set" and (i == 0 or args[i - 1] != "--set")]
     os.makedirs(out, exist_ok=True)
+    return mufric, out, words, extra
+
+
+def main():
+    mufric, out, names, extra = study_arguments(__doc__)
+    names = names or list(STUDIES)
     print(f"`{' '.join(sys.argv)}` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores\n")
     for n in names:
         if n not in STUDIES:
