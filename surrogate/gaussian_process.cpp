@@ -195,15 +195,19 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
 #else
       // A portable build: OpenBLAS's dtrmm, whose kernels are chosen for the CPU at load time (2.6×
       // Eigen's SSE2 product on an AVX-512 core). One BLAS thread: the team is the parallelism.
-      // L⁻¹ is stored row-major: read column-major it is its transpose, upper triangular.
-      v_block = k_block;
+      // L⁻¹ is stored row-major: read column-major it is its transpose, upper triangular. OpenBLAS
+      // rounds a column differently depending on how many columns it is given (its edge tiles), so
+      // every call gets a full block, zero-padded: a query's σ is then the same bits in any batch,
+      // as with Eigen's product (the service's transports agree to the bit; tested).
+      v_block.setZero(n, kQueryBlock);
+      v_block.leftCols(count) = k_block;
       const char side = 'L', upper = 'U', transpose = 'T', non_unit = 'N';
-      const int rows = static_cast<int>(n), columns = static_cast<int>(count);
+      const int rows = static_cast<int>(n), columns = static_cast<int>(kQueryBlock);
       const double one = 1.0;
       dtrmm_(&side, &upper, &transpose, &non_unit, &rows, &columns, &one, inverse_factor_.data(), &rows, v_block.data(),
              &rows);
 #endif
-      norms2 = v_block.colwise().squaredNorm();
+      norms2 = v_block.leftCols(count).colwise().squaredNorm();
     }
     const double s2 = state_.hyper.signal_variance;
     const double scatter = state_.micro_std_error / state_.y_scale;
