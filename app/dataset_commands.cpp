@@ -102,6 +102,7 @@ struct RunOptions {
   int jobs = 1, threads = 0;
   long long limit = -1;
   bool retry_failed = false;
+  double sample_timeout = 0.0;  // s, 0: none
 };
 
 // A progress bar on a terminal, one line per sample otherwise (logs, Slurm output files).
@@ -152,7 +153,7 @@ void run_command(const RunOptions& o) {
   plan.scene_json = sc.effective.dump(2);
 
   const int threads = threads_per_job(o.jobs, o.threads);
-  const SampleEvaluator evaluate = scene::micro_evaluator(sc, plan.inputs, threads);
+  const SampleEvaluator evaluate = scene::micro_evaluator(sc, plan.inputs, threads, o.sample_timeout);
   GenerationOptions options;
   options.shard = parse_shard(o.shard);
   options.jobs = o.jobs;
@@ -175,6 +176,7 @@ struct RefineOptions {
   std::string db, test, candidates_csv, model_out;
   bool grow = false;
   double grow_coverage = 1.0;
+  double sample_timeout = 0.0;  // s, 0: none
   long long budget = 0;
   int batch = 8, jobs = 1, threads = 0, restarts = 2;
   long long candidate_count = 4096;
@@ -271,7 +273,8 @@ void refine_command(const RefineOptions& o) {
   }
   if (o.grow) grow_plan_box(o, db);
   const scene::Scene sc = run_scene("", {}, db, o.db);
-  const SampleEvaluator evaluate = scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads));
+  const SampleEvaluator evaluate =
+      scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads), o.sample_timeout);
   std::optional<TrainingSet> test;
   if (!o.test.empty()) test = training_set(read_dataset_isolated(o.test), o.test);
   GpTrainingOptions training;
@@ -419,6 +422,10 @@ void add_dataset_commands(CLI::App& app) {
   run->add_option("--threads", r->threads, "Threads per sample (default: cores / jobs)")->check(CLI::Range(1, 1024));
   run->add_option("--limit", r->limit, "Run at most this many samples now")->check(CLI::Range(1LL, 10000000LL));
   run->add_flag("--retry-failed", r->retry_failed, "Run failed samples again (their old record is replaced)");
+  run->add_option("--sample-timeout", r->sample_timeout,
+                  "Stop a sample still running after this many seconds and record it as failed, with where it stopped "
+                     "(0: no limit). A corner of the box where the solver crawls then costs a shard this long, not hours")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e7));
   run->footer("The database is rewritten atomically after every sample: a killed run loses only the samples in\n"
               "flight, and running the same command again skips every finished plan row. A sample whose run does\n"
               "not converge is recorded as failed with its reason. Shards write separate databases; combine them\n"
@@ -451,6 +458,9 @@ void add_dataset_commands(CLI::App& app) {
   refine->add_option("--jobs", f->jobs, "Runs at once")->capture_default_str()->check(CLI::Range(1, 1024));
   refine->add_option("--threads", f->threads, "Threads per run (default: cores / jobs)")->check(CLI::Range(1, 1024));
   refine->add_option("--restarts", f->restarts, "GP optimiser restarts per round")->capture_default_str();
+  refine->add_option("--sample-timeout", f->sample_timeout,
+                     "Stop a run still going after this many seconds and record it as failed (0: no limit)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e7));
   refine->add_option("--seed", f->seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
   refine->footer("Each round trains a GP on the converged samples, picks --batch candidates by the largest posterior\n"
                  "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"

@@ -478,6 +478,20 @@ TEST_F(Cli, DatasetRefineGrowsTheBoxTowardTheLoggedQueries) {
   EXPECT_NE(run("dataset refine --db " + path("db.h5") + " --budget 0 --grow-box").exit_code, 0);  // needs --candidates
 }
 
+// --sample-timeout: a sample still running after the limit stops and is recorded as failed, saying
+// where it stopped; --retry-failed without the limit then completes it.
+TEST_F(Cli, DatasetRunStopsASampleThatOutrunsItsTimeLimit) {
+  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 2" + kTinyScene).exit_code, 0);
+  CommandResult r = run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --sample-timeout 0.001");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(0 converged, 2 failed)"), std::string::npos) << r.output;
+  const CommandResult status = run("dataset status " + path("db.h5"));
+  EXPECT_NE(status.output.find("wall-time limit of 0.001 s reached at t = "), std::string::npos) << status.output;
+  r = run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --retry-failed");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(2 converged, 0 failed)"), std::string::npos) << r.output;
+}
+
 // kill -9 in the middle of a run loses at most the samples in flight: the database stays readable
 // and a second run completes the plan with every row once.
 TEST_F(Cli, DatasetRunSurvivesKillNine) {

@@ -9,7 +9,8 @@
 
 namespace mufric::scene {
 
-SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, int threads_per_sample) {
+SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, int threads_per_sample,
+                                double sample_wall_seconds) {
   if (!scene.pressure_controlled) {
     throw Error(scene.source + ": load.vertical_displacement: a dataset varies the contact pressure, so the scene must "
                                "give load.pressure");
@@ -31,7 +32,7 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
   if (pressure < 0 || velocity < 0 || temperature < 0) {
     throw Error("a micro-model dataset needs the inputs contact_pressure, sliding_velocity and temperature");
   }
-  return [scene, pressure, velocity, temperature, threads_per_sample](const Eigen::VectorXd& x) {
+  return [scene, pressure, velocity, temperature, threads_per_sample, sample_wall_seconds](const Eigen::VectorXd& x) {
     omp_set_num_threads(std::max(threads_per_sample, 1));  // this thread's parallel regions
     Scene s = scene;
     s.pressure = x(pressure);
@@ -40,6 +41,7 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     // The sample's draws (tool phases, realisations) share its cores.
     MeasureOptions options;
     options.threads = std::max(threads_per_sample, 1);
+    options.wall_seconds_limit = sample_wall_seconds;
     const MuMeasurement m = measure_mu(s, options);
     SampleOutcome o;
     o.converged = m.completed;

@@ -425,6 +425,12 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     if (step.mu) average.add(position(previous_time), position(view.time), *step.mu);
     previous_time = view.time;
     if (options.on_step) options.on_step(step, scene);
+    if (std::chrono::steady_clock::now() > options.deadline) {
+      char where[160];
+      std::snprintf(where, sizeof where, "wall-time limit of %g s reached at t = %.4g s (sliding distance %.4g um, step %zu)",
+                    options.wall_seconds_limit, view.time, 1e6 * step.sliding_distance, result.history.size());
+      throw Error(where);
+    }
   });
   result.averaged_steps = average.steps();
   const solid::IntegrationReport& report = result.solver;
@@ -560,6 +566,11 @@ MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
     for (size_t i = next++; i < m.draws.size(); i = next++) {
       RunOptions run;
       if (i == 0) run.vtu_directory = options.vtu_directory;
+      if (options.wall_seconds_limit > 0.0) {
+        run.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                   std::chrono::duration<double>(options.wall_seconds_limit));
+        run.wall_seconds_limit = options.wall_seconds_limit;
+      }
       if (options.on_step) {
         run.on_step = [&, i](const MicroStep& step, const Scene& sc) {
           const std::lock_guard<std::mutex> lock(progress_lock);

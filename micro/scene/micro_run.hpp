@@ -4,6 +4,7 @@
 // contact tractions at every step, averaged over a window (scene.protocol: seed 000's time window
 // while the load ramps, or press-slide's sliding-distance window after pressing). measure_mu repeats
 // the run over tool phases and realisations and reports the mean with its standard error.
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -79,6 +80,10 @@ struct MicroResult {
 struct RunOptions {
   std::string vtu_directory;  // empty: no VTU output; else chip.vtu and tool.vtu at the end
   std::function<void(const MicroStep&, const Scene&)> on_step;  // progress
+  // A run still stepping at this time stops with an Error naming the limit and where it stopped
+  // (a dataset's sample that would hold up its shard; checked after every accepted step).
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  double wall_seconds_limit = 0.0;  // what the deadline came from, for the message
 };
 
 // One draw of a press-slide measurement: the tool shifted by `shift_fraction` of the interval (on top
@@ -120,6 +125,7 @@ struct MuMeasurement {
 
 struct MeasureOptions {
   int threads = 0;            // cores to use (draws run in parallel); 0: OpenMP's maximum
+  double wall_seconds_limit = 0.0;  // > 0: the whole measurement stops with an Error after this long
   std::string vtu_directory;  // VTU of the first draw
   // progress: the draw (index into draws) and its step; called from the draws' threads, serialised
   std::function<void(int, const MicroStep&, const Scene&)> on_step;
