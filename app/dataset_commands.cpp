@@ -195,6 +195,13 @@ Eigen::MatrixXd csv_candidates(const std::string& path, const InputSpace& box) {
   return rows;
 }
 
+bool row_inside(const InputSpace& box, const Eigen::MatrixXd& rows, Eigen::Index i) {
+  for (size_t j = 0; j < box.size(); ++j) {
+    if (!box[j].contains(rows(i, static_cast<Eigen::Index>(j)))) return false;
+  }
+  return true;
+}
+
 // Candidate points: a Sobol' set in the box (shifted per round), plus the CSV's rows inside the box
 // (the plan box is what the micro-model is run on; --grow-box moves it toward the others first).
 Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box, int round) {
@@ -203,9 +210,7 @@ Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box,
   const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, box);
   std::vector<Eigen::Index> inside;
   for (Eigen::Index i = 0; i < logged.rows(); ++i) {
-    bool in = true;
-    for (size_t j = 0; j < box.size(); ++j) in = in && box[j].contains(logged(i, static_cast<Eigen::Index>(j)));
-    if (in) inside.push_back(i);
+    if (row_inside(box, logged, i)) inside.push_back(i);
   }
   Eigen::MatrixXd all(c.rows() + static_cast<Eigen::Index>(inside.size()), c.cols());
   all.topRows(c.rows()) = c;
@@ -229,14 +234,8 @@ void grow_plan_box(const RefineOptions& o, Dataset& db) {
   const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, db.inputs);
   const InputSpace grown = grow_box(db.inputs, logged, o.grow_coverage);
   long long outside = 0;
-  for (Eigen::Index i = 0; i < logged.rows(); ++i) {
-    bool in = true;
-    for (size_t j = 0; j < db.inputs.size(); ++j) in = in && db.inputs[j].contains(logged(i, static_cast<Eigen::Index>(j)));
-    outside += !in;
-  }
-  bool changed = false;
-  for (size_t j = 0; j < grown.size(); ++j) changed = changed || grown[j].lo != db.inputs[j].lo || grown[j].hi != db.inputs[j].hi;
-  if (!changed) {
+  for (Eigen::Index i = 0; i < logged.rows(); ++i) outside += !row_inside(db.inputs, logged, i);
+  if (same_input_space(grown, db.inputs)) {
     std::printf("%s: the box already covers the candidates of %s (%lld rows); not grown\n", o.db.c_str(),
                 o.candidates_csv.c_str(), static_cast<long long>(logged.rows()));
     return;

@@ -36,14 +36,6 @@ Shard parse_shard(const std::string& text, const std::string& field) {
 
 namespace {
 
-bool same_inputs(const InputSpace& a, const InputSpace& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t j = 0; j < a.size(); ++j) {
-    if (a[j].name != b[j].name || a[j].unit != b[j].unit || a[j].lo != b[j].lo || a[j].hi != b[j].hi) return false;
-  }
-  return true;
-}
-
 // Equal plans (a shape check first: Eigen compares matrices of equal shape only).
 bool same_plan(const h5::RowMatrix& a, const h5::RowMatrix& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
@@ -71,7 +63,7 @@ Dataset open_database(const std::string& db_path, const Dataset& plan) {
   if (plan.plan.rows() == 0) throw Error("the plan has no points (/plan/inputs is empty)");
   if (!std::filesystem::exists(db_path)) return empty_database(plan);
   Dataset d = read_dataset_isolated(db_path);
-  if (!same_inputs(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
+  if (!same_input_space(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
   if (!same_plan(d.plan, plan.plan)) {
     throw Error(db_path + ": was made from a different plan (" + std::to_string(d.plan.rows()) + " rows, the plan has " +
                 std::to_string(plan.plan.rows()) + " or different points); use another --db");
@@ -244,7 +236,7 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
     files.push_back(read_dataset_isolated(path));
     const Dataset& d = files.back();
     const Dataset& first = files.front();
-    if (!same_inputs(d.inputs, first.inputs)) throw Error("merge: " + path + ": inputs or box differ from " + paths[0]);
+    if (!same_input_space(d.inputs, first.inputs)) throw Error("merge: " + path + ": inputs or box differ from " + paths[0]);
     if (!same_plan(d.plan, first.plan)) throw Error("merge: " + path + ": comes from a different plan than " + paths[0]);
     if (!allow_mixed && d.scene_json != first.scene_json) {
       throw Error("merge: " + path + ": made with a different scene than " + paths[0] + " (--allow-mixed to merge anyway)");

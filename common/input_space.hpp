@@ -19,6 +19,15 @@ struct InputSpec {
 
 using InputSpace = std::vector<InputSpec>;
 
+// The same inputs in the same order, with the same units and boxes.
+inline bool same_input_space(const InputSpace& a, const InputSpace& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t j = 0; j < a.size(); ++j) {
+    if (a[j].name != b[j].name || a[j].unit != b[j].unit || a[j].lo != b[j].lo || a[j].hi != b[j].hi) return false;
+  }
+  return true;
+}
+
 // The default parameter box of seed 000 section 4: p 300–1300 MPa, v 22.5–200 m/min, T 25–900 °C.
 inline InputSpace default_friction_box() {
   return {{"contact_pressure", "Pa", 300e6, 1300e6},
