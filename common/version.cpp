@@ -2,6 +2,8 @@
 
 #include <ctime>
 
+#include "mufric_code_version.hpp"  // generated at build time: MUFRIC_CODE_VERSION
+
 namespace mufric {
 
 const std::string& code_version() {
