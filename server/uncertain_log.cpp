@@ -73,10 +73,14 @@ void UncertainQueryLog::record(const std::string& model, const InputSpace& input
   long long added = 0;
   std::lock_guard<std::mutex> guard(lock_);
   ModelLog& log = models_[model];
-  if (log.outside.inputs.size() != inputs.size()) {  // first call, or the model was reloaded with other inputs
+  // First call, or the model was reloaded with another box: counts against the old box would say
+  // nothing about the new one, so they start again (the summary file is then rewritten).
+  if (log.outside.inputs.size() != inputs.size() || !same_input_space(log.box, inputs)) {
+    const bool summary_on_disk = log.outside.outside_queries > 0;
     log.outside = {.queries = 0, .outside_queries = 0, .inputs = std::vector<OutsideInputCount>(inputs.size())};
+    log.box = inputs;
+    log.summary_dirty = log.summary_dirty || summary_on_disk;
   }
-  log.box = inputs;
   const long long outside_before = log.outside.outside_queries;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
     if (!x.row(i).allFinite()) continue;  // an invalid input, answered with a status, not a place to sample

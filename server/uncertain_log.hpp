@@ -24,8 +24,9 @@ struct OutsideInputCount {
 };
 
 struct OutsideSummary {
-  long long queries = 0;          // every point asked of the model while logging
-  long long outside_queries = 0;  // points with at least one input outside the box
+  long long queries = 0;          // points with finite inputs asked of the model since its box was last set
+                                  // (an invalid point gets a status and is not counted)
+  long long outside_queries = 0;  // of those, points with at least one input outside the box
   std::vector<OutsideInputCount> inputs;  // the model's input order
 };
 

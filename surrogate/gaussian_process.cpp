@@ -270,13 +270,8 @@ Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::Matrix
 }
 
 void GaussianProcess::attach_fast_evaluator(std::shared_ptr<const FastEvaluator> fast) {
-  if (fast) {
-    const InputSpace& box = fast->box();
-    bool same = box.size() == inputs().size();
-    for (size_t k = 0; same && k < box.size(); ++k) {
-      same = box[k].name == inputs()[k].name && box[k].lo == inputs()[k].lo && box[k].hi == inputs()[k].hi;
-    }
-    if (!same) throw Error("fast evaluator: its box is not the model's training box");
+  if (fast && !same_input_space(fast->box(), inputs())) {
+    throw Error("fast evaluator: its box is not the model's training box");
   }
   fast_ = std::move(fast);
 }

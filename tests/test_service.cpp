@@ -228,6 +228,34 @@ TEST_F(Service, OutOfBoxQueriesAreLoggedAndCountedPerInputAndSide) {
   EXPECT_EQ(json.at("inputs").at(1).at("lowest").get<double>(), lowest[1]);
 }
 
+// A model reloaded with a grown box: counts against the old box would mislead, so they restart
+// and the summary on disk is rewritten against the new box.
+TEST_F(Service, OutsideCountsRestartWhenTheModelsBoxChanges) {
+  const InputSpace old_box = default_friction_box();
+  InputSpace grown = old_box;
+  grown[0].hi = 3e9;
+  Eigen::MatrixXd x(2, 3);
+  x << 2e9, 1.0, 400.0,  // above the old box's pressure, inside the grown one
+      4e9, 1.0, 400.0;   // above both
+  const Eigen::VectorXd std = Eigen::VectorXd::Zero(2);
+  const fs::path dir = dir_ / "regrown";
+  server::UncertainQueryLog log(dir.string(), 1e6, 100);
+  log.record("gp", old_box, x, std);
+  EXPECT_EQ(log.outside("gp").outside_queries, 2);
+  EXPECT_EQ(log.outside("gp").inputs[0].above, 2);
+  log.flush();
+  log.record("gp", grown, x, std);
+  const server::OutsideSummary s = log.outside("gp");
+  EXPECT_EQ(s.queries, 2);
+  EXPECT_EQ(s.outside_queries, 1);
+  EXPECT_EQ(s.inputs[0].above, 1);
+  EXPECT_EQ(s.inputs[0].highest, 4e9);
+  log.flush();
+  const auto json = nlohmann::json::parse(std::ifstream(dir / "gp.outside.json"));
+  EXPECT_EQ(json.at("outside_queries").get<long long>(), 1);
+  EXPECT_EQ(json.at("inputs").at(0).at("box_hi").get<double>(), 3e9);
+}
+
 TEST_F(Service, StreamOfIncrementsAnswersLikeUnaryCallsAndSurvivesAnError) {
   LoopbackServer server(dir_);
   client::Options streaming;
