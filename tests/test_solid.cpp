@@ -530,6 +530,38 @@ TEST(TimeIntegration, AFailingStepIsCutBackAndReported) {
   EXPECT_GT(coarse.steps.size(), 1u);
 }
 
+// A wall-time limit reaches into the cut-backs: a step that keeps failing stops the run at the
+// first failed attempt after should_stop says so, not max_cutbacks attempts later.
+TEST(TimeIntegration, AFailingStepStopsWhenAskedBeforeItsCutBacksRunOut) {
+  SolidProblem problem(IgaSpace(unit_square(2, 2)), std::make_shared<J2JohnsonCook>(JohnsonCookParameters{}));
+  problem.fix_side(Side::bottom, 1);
+  problem.fix_side(Side::left, 0);
+  TimeIntegrationOptions options;
+  options.scheme = TimeScheme::quasi_static;
+  options.max_cutbacks = 8;
+  int attempts = 0, asked = 0;
+  options.coupled_step = [&](double, double, std::string& reason) {
+    ++attempts;
+    reason = "never converges";
+    return false;
+  };
+  options.should_stop = [&](std::string& reason) {
+    reason = "wall-time limit";
+    return ++asked == 3;
+  };
+  TimeIntegrator integrator(problem, options);
+  const IntegrationReport report = integrator.run();
+  EXPECT_FALSE(report.completed);
+  EXPECT_EQ(attempts, 3);
+  EXPECT_EQ(report.cutbacks.size(), 3u);
+  EXPECT_NE(report.reason.find("wall-time limit"), std::string::npos) << report.reason;
+  options.should_stop = nullptr;  // without it, the cut-backs run out
+  attempts = 0;
+  TimeIntegrator unlimited(problem, options);
+  EXPECT_FALSE(unlimited.run().completed);
+  EXPECT_EQ(attempts, options.max_cutbacks + 1);
+}
+
 // The step-size control: a linear problem converges in one Newton iteration per step, so each step
 // doubles (the growth limit) until max_dt; without max_dt every step keeps the first step's length.
 TEST(TimeIntegration, EasyStepsGrowToTheLongestAllowedStepAndNoFurther) {

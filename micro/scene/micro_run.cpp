@@ -355,6 +355,19 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     const double pressing_step = scene.max_dt, slide_start = motion.slide_start();
     o.max_dt_at = [=](double t) { return t < slide_start ? pressing_step : sliding_step; };
   }
+  // The wall-time limit also ends a step that keeps failing, after its next failed attempt (accepted
+  // steps are checked in the step callback below, where the sliding distance is known).
+  bool stopped_by_deadline = false;
+  if (options.deadline != std::chrono::steady_clock::time_point::max()) {
+    o.should_stop = [&options, &stopped_by_deadline](std::string& reason) {
+      if (std::chrono::steady_clock::now() <= options.deadline) return false;
+      char limit[80];
+      std::snprintf(limit, sizeof limit, "wall-time limit of %g s reached", options.wall_seconds_limit);
+      reason = limit;
+      stopped_by_deadline = true;
+      return true;
+    };
+  }
   std::unique_ptr<solid::HeatConduction> heat;
   if (scene.heat_conduction) {
     heat = std::make_unique<solid::HeatConduction>(
@@ -432,6 +445,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
       throw Error(where);
     }
   });
+  if (stopped_by_deadline) throw Error(result.solver.reason);  // like the accepted-step check: a failed sample
   result.averaged_steps = average.steps();
   const solid::IntegrationReport& report = result.solver;
   for (size_t k = 0; k < report.steps.size() && k < result.history.size(); ++k) {

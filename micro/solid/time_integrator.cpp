@@ -331,6 +331,11 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
     if (!at.ok) {
       problem_.commit(saved_states);
       report_.cutbacks.push_back({t, this_dt, at.reason});
+      if (std::string stop_reason; options_.should_stop && options_.should_stop(stop_reason)) {
+        record_solver_counts();
+        report_.reason = "stopped after a failed step at t = " + std::to_string(t) + " s: " + stop_reason;
+        return report_;
+      }
       if (++consecutive_cuts > options_.max_cutbacks) {
         record_solver_counts();
         report_.reason = "step at t = " + std::to_string(t) + " s failed after " + std::to_string(options_.max_cutbacks) +

@@ -59,6 +59,10 @@ struct TimeIntegrationOptions {
   // a reason when the coupled step fails (cut back like any failed step); on true, the last trial is
   // accepted.
   std::function<bool(double t0, double dt, std::string& reason)> coupled_step;
+  // When set, asked after every failed attempt, before the step is cut back: true (with a reason)
+  // ends the run as not completed. A wall-time limit, so that a step that keeps failing does not
+  // outlast it by up to max_cutbacks more attempts (accepted steps are the caller's to check).
+  std::function<bool(std::string& reason)> should_stop;
   double end_time = 1e-7;        // s
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
