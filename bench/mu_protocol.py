@@ -20,9 +20,10 @@ import sys
 import time
 
 
-def run(mufric, out, name, overrides):
+def run(mufric, out, name, overrides, scene=None):
+    """One `mufric micro run` of `scene` (a JSON file; None: the default dry scene) with overrides."""
     d = os.path.join(out, name)
-    cmd = [mufric, "micro", "run", "--quiet", "--out", d]
+    cmd = [mufric, "micro", "run"] + ([scene] if scene else []) + ["--quiet", "--out", d]
     for o in overrides:
         cmd += ["--set", o]
     # A run whose result is already there with the same command is read back (a study resumes).

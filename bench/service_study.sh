@@ -10,18 +10,15 @@ build=${1:-build}
 out=${2:-bench/results}
 seconds=${3:-1}
 mufric=$(realpath "$build/app/mufric")
+# shellcheck source=bench/service_common.sh
+source "$(dirname "$0")/service_common.sh"
 mkdir -p "$out"
 work=$(mktemp -d)
 server=
 trap '[[ -n $server ]] && kill $server 2>/dev/null; rm -rf "$work"' EXIT
 mkdir "$work/models"
-"$mufric" law seward --table 4 --out "$work/law.h5" >/dev/null
-"$mufric" dataset from-model --model "$work/law.h5" --samples 900 --noise 0.002 --out "$work/db.h5" >/dev/null
-"$mufric" train --data "$work/db.h5" --out "$work/models/gp.h5" >/dev/null
-"$mufric" serve --models "$work/models" --listen 127.0.0.1:0 --ready-file "$work/address" 2>"$work/server.log" &
-server=$!
-for _ in $(seq 200); do [[ -s $work/address ]] && break; sleep 0.05; done
-address=$(cat "$work/address")
+seward_gp "$mufric" "$work" 900 "$work/models/gp.h5"
+start_server "$work" "$mufric" serve --models "$work/models"
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores;" \
   "load before: $(cut -d' ' -f1-3 /proc/loadavg); $seconds s per point"
 csv=$out/service_study.csv
