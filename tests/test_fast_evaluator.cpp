@@ -67,6 +67,43 @@ TEST(TensorCubicGrid, ErrorFallsAsTheFourthPowerOfTheCellSize) {
   EXPECT_LT(coarse / fine, 22.0) << coarse << " " << fine;
 }
 
+// The 3- and 4-input, 2-output loops (μ and log σ) are specialised. They must give what the generic
+// loop gives to rounding (a file's bound may have been certified on the other path; a native build
+// may fuse multiply-adds differently in the two): here the generic loop answers for a third output,
+// which the specialisations do not take. Both reproduce a cubic in each input exactly.
+TEST(TensorCubicGrid, SpecialisedLoopsAgreeWithTheGenericOne) {
+  constexpr double kRoundingAgreement = 1e-14;  // 256 terms of size ≤ 10: ~50 ulp at most
+  auto cubic = [](const Eigen::RowVectorXd& u, int output) {
+    double f = output + 1.0;
+    for (Eigen::Index k = 0; k < u.size(); ++k) {
+      f *= 0.5 + (static_cast<double>(k) + output + 1.0) * u(k) * u(k) * u(k) - u(k);
+    }
+    return f;
+  };
+  for (const std::vector<int>& cells : {std::vector<int>{5, 3, 7}, std::vector<int>{4, 3, 6, 5}}) {
+    const Eigen::MatrixXd u = TensorCubicGrid::nodes(cells);
+    Eigen::MatrixXd values(u.rows(), 3);
+    for (Eigen::Index i = 0; i < u.rows(); ++i) {
+      for (int o = 0; o < 3; ++o) values(i, o) = cubic(u.row(i), o);
+    }
+    const TensorCubicGrid specialised(cells, values.leftCols(2)), generic(cells, values);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> uniform(-0.1, 1.1);  // past the faces too: clamped
+    for (int i = 0; i < 5000; ++i) {
+      Eigen::RowVectorXd x(static_cast<Eigen::Index>(cells.size()));
+      for (Eigen::Index k = 0; k < x.size(); ++k) x(k) = uniform(rng);
+      double fast[2], slow[3];
+      specialised.evaluate(x.data(), fast);
+      generic.evaluate(x.data(), slow);
+      for (int o = 0; o < 2; ++o) {
+        ASSERT_NEAR(fast[o], slow[o], kRoundingAgreement * (1.0 + std::abs(slow[o]))) << cells.size() << " inputs at " << x;
+      }
+      const Eigen::RowVectorXd inside = x.cwiseMax(0.0).cwiseMin(1.0);
+      for (int o = 0; o < 3; ++o) ASSERT_NEAR((o < 2 ? fast[o] : slow[o]), cubic(inside, o), 1e-11) << x;
+    }
+  }
+}
+
 TEST(TensorCubicGrid, RefusesShapesThatDoNotFit) {
   EXPECT_THROW(TensorCubicGrid({2, 4}, Eigen::MatrixXd::Zero(15, 1)), Error);   // fewer than 3 cells
   EXPECT_THROW(TensorCubicGrid({3, 4}, Eigen::MatrixXd::Zero(19, 1)), Error);   // 20 nodes
