@@ -60,7 +60,7 @@ struct Options {
   double deadline_seconds = 30.0;   // per call
   int retries = 4;                  // on UNAVAILABLE, with exponential backoff
   double first_backoff_seconds = 0.05;
-  long long chunk_points = 65536;   // larger blocks are split into several calls
+  long long chunk_points = 65536;   // larger blocks are split into several calls (at a multiple of 128, from 128 up)
   int max_message_mb = 64;
   // Send blocks over one long-lived EvaluateStream (one block per increment) instead of one unary
   // call each; a broken stream is reopened under the same retry policy. Streams carry no deadline.

@@ -50,6 +50,8 @@ int mufric_open(const char* uri, mufric_client** client);
  * for none); an unknown key or bad value is MUFRIC_INVALID_ARGUMENT naming it. For grpc(s)://:
  *   deadline=S        seconds per call (default 30)       retries=N    on UNAVAILABLE (default 4)
  *   backoff=S         first retry pause (default 0.05)    chunk_points=N, max_message_mb=N
+ *   (chunk_points: most points per call, default 65536; from 128 up cut to a multiple of 128, so
+ *   that a point's std has the same bits as in-process however a block is split)
  *   stream=1          every mufric_evaluate on one long-lived stream of this handle (an explicit
  *                     code's increments: ~5x less overhead per call than unary calls; no deadline)
  *   token=T           bearer token (else $MUFRIC_TOKEN)

@@ -10,6 +10,7 @@
 #include "mufric/v1/friction.grpc.pb.h"
 #include "server/model_registry.hpp"
 #include "server/uncertain_log.hpp"
+#include "surrogate/gaussian_process.hpp"
 
 namespace mufric::server {
 
@@ -28,6 +29,7 @@ struct ServiceLimits {
 
 // Points evaluated between two looks at the caller's deadline and cancellation: a few ms of work.
 inline constexpr long long kPointsBetweenDeadlineChecks = 8192;
+static_assert(kPointsBetweenDeadlineChecks % kGpQueryBlock == 0, "a chunk must end on a GP query block");
 
 // Threads for one evaluation when `in_flight` evaluations (this one included) are running.
 int threads_per_evaluation(int evaluation_threads, int in_flight);

@@ -11,6 +11,11 @@
 
 namespace mufric {
 
+// The GP answers a batch in blocks of this many queries, from its first. σ's last bits depend on
+// how a query falls into them (a short last block takes a row-by-row path), μ's never: whoever
+// splits a batch into calls cuts at multiples of this so that σ keeps its bits.
+inline constexpr long long kGpQueryBlock = 128;
+
 class FastEvaluator;
 
 struct GpHyperParameters {
