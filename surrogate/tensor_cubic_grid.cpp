@@ -85,45 +85,28 @@ TensorCubicGrid::TensorCubicGrid(std::vector<int> cells, const Eigen::MatrixXd& 
 
 namespace {
 
-// Three inputs, any outputs: the loops the compiler can unroll (the common case: p, v, T).
-template <int Outputs>
-void evaluate_three(const std::array<Stencil, kMaximumInputs>& s, const long long* stride, const double* v,
-                    double* out) {
-  double acc[Outputs] = {};
+// The 3- and 4-input loops (p, v, T; and a fibre angle) with their trip counts known, so the
+// compiler unrolls them. Weights multiply input by input and nodes are visited last input fastest,
+// the generic loop's order, so the answers differ from its only by how the compiler fuses
+// multiply-adds (rounding, ~1e-16), far inside any certified bound.
+template <int Input, int Inputs, int Outputs>
+void accumulate(const std::array<Stencil, kMaximumInputs>& s, const long long* stride, const double* node, double w,
+                double* acc) {
   for (int a = 0; a < 4; ++a) {
-    for (int b = 0; b < 4; ++b) {
-      const double wab = s[0].weight[static_cast<size_t>(a)] * s[1].weight[static_cast<size_t>(b)];
-      const double* node = v + a * stride[0] + b * stride[1];
-      for (int c = 0; c < 4; ++c) {
-        const double w = wab * s[2].weight[static_cast<size_t>(c)];
-        for (int o = 0; o < Outputs; ++o) acc[o] += w * node[c * Outputs + o];
-      }
+    const double wa = Input == 0 ? s[0].weight[static_cast<size_t>(a)] : w * s[Input].weight[static_cast<size_t>(a)];
+    if constexpr (Input + 1 == Inputs) {
+      for (int o = 0; o < Outputs; ++o) acc[o] += wa * node[a * Outputs + o];
+    } else {
+      accumulate<Input + 1, Inputs, Outputs>(s, stride, node + a * stride[Input], wa, acc);
     }
   }
-  for (int o = 0; o < Outputs; ++o) out[o] = acc[o];
 }
 
-// Four inputs (p, v, T and a fibre angle). The products and the sums run in the generic loop's order
-// (weights multiplied input by input, nodes visited last input fastest), so the answer differs from
-// the generic path's only by how the compiler fuses multiply-adds (rounding, ~1e-16), far inside any
-// certified bound: files built before this loop existed keep their bound.
-template <int Outputs>
-void evaluate_four(const std::array<Stencil, kMaximumInputs>& s, const long long* stride, const double* v,
-                   double* out) {
+template <int Inputs, int Outputs>
+void evaluate_unrolled(const std::array<Stencil, kMaximumInputs>& s, const long long* stride, const double* v,
+                       double* out) {
   double acc[Outputs] = {};
-  for (int a = 0; a < 4; ++a) {
-    for (int b = 0; b < 4; ++b) {
-      const double wab = s[0].weight[static_cast<size_t>(a)] * s[1].weight[static_cast<size_t>(b)];
-      for (int c = 0; c < 4; ++c) {
-        const double wabc = wab * s[2].weight[static_cast<size_t>(c)];
-        const double* node = v + a * stride[0] + b * stride[1] + c * stride[2];
-        for (int e = 0; e < 4; ++e) {
-          const double w = wabc * s[3].weight[static_cast<size_t>(e)];
-          for (int o = 0; o < Outputs; ++o) acc[o] += w * node[e * Outputs + o];
-        }
-      }
-    }
-  }
+  accumulate<0, Inputs, Outputs>(s, stride, v, 1.0, acc);
   for (int o = 0; o < Outputs; ++o) out[o] = acc[o];
 }
 
@@ -139,11 +122,11 @@ void TensorCubicGrid::evaluate(const double* u, double* out) const {
   }
   const double* v = values_.data() + base;
   if (d == 3 && outputs_ == 2) {
-    evaluate_three<2>(s, stride_.data(), v, out);
+    evaluate_unrolled<3, 2>(s, stride_.data(), v, out);
     return;
   }
   if (d == 4 && outputs_ == 2) {
-    evaluate_four<2>(s, stride_.data(), v, out);
+    evaluate_unrolled<4, 2>(s, stride_.data(), v, out);
     return;
   }
   for (int o = 0; o < outputs_; ++o) out[o] = 0.0;
