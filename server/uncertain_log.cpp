@@ -75,7 +75,7 @@ void UncertainQueryLog::record(const std::string& model, const InputSpace& input
   ModelLog& log = models_[model];
   // First call, or the model was reloaded with another box: counts against the old box would say
   // nothing about the new one, so they start again (the summary file is then rewritten).
-  if (log.outside.inputs.size() != inputs.size() || !same_input_space(log.box, inputs)) {
+  if (!same_input_space(log.box, inputs)) {  // log.box and the counts are set together, here
     const bool summary_on_disk = log.outside.outside_queries > 0;
     log.outside = {.queries = 0, .outside_queries = 0, .inputs = std::vector<OutsideInputCount>(inputs.size())};
     log.box = inputs;

@@ -19,10 +19,10 @@ write "$repo"
 first=$(git -C "$repo" rev-parse --short HEAD)
 grep -q "^#define MUFRIC_CODE_VERSION \"9.8.7+$first\"$" "$header" || fail "first commit $first not recorded"
 
-inode_time=$(stat -c %y "$header")
+written_at=$(stat -c %y "$header")
 sleep 1.1
 write "$repo"
-[[ "$(stat -c %y "$header")" == "$inode_time" ]] || fail "header rewritten although the version did not change"
+[[ "$(stat -c %y "$header")" == "$written_at" ]] || fail "header rewritten although the version did not change"
 
 git -C "$repo" -c user.name=t -c user.email=t@t commit -q --allow-empty -m second
 write "$repo"

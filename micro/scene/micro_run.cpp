@@ -357,13 +357,14 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   }
   // The wall-time limit also ends a step that keeps failing, after its next failed attempt (accepted
   // steps are checked in the step callback below, where the sliding distance is known).
+  const auto past_deadline = [&options] { return std::chrono::steady_clock::now() > options.deadline; };
+  char limit_reached[80];
+  std::snprintf(limit_reached, sizeof limit_reached, "wall-time limit of %g s reached", options.wall_seconds_limit);
   bool stopped_by_deadline = false;
   if (options.deadline != std::chrono::steady_clock::time_point::max()) {
-    o.should_stop = [&options, &stopped_by_deadline](std::string& reason) {
-      if (std::chrono::steady_clock::now() <= options.deadline) return false;
-      char limit[80];
-      std::snprintf(limit, sizeof limit, "wall-time limit of %g s reached", options.wall_seconds_limit);
-      reason = limit;
+    o.should_stop = [&](std::string& reason) {
+      if (!past_deadline()) return false;
+      reason = limit_reached;
       stopped_by_deadline = true;
       return true;
     };
@@ -438,11 +439,11 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     if (step.mu) average.add(position(previous_time), position(view.time), *step.mu);
     previous_time = view.time;
     if (options.on_step) options.on_step(step, scene);
-    if (std::chrono::steady_clock::now() > options.deadline) {
-      char where[160];
-      std::snprintf(where, sizeof where, "wall-time limit of %g s reached at t = %.4g s (sliding distance %.4g um, step %zu)",
-                    options.wall_seconds_limit, view.time, 1e6 * step.sliding_distance, result.history.size());
-      throw Error(where);
+    if (past_deadline()) {
+      char where[120];
+      std::snprintf(where, sizeof where, " at t = %.4g s (sliding distance %.4g um, step %zu)", view.time,
+                    1e6 * step.sliding_distance, result.history.size());
+      throw Error(limit_reached + std::string(where));
     }
   });
   if (stopped_by_deadline) throw Error(result.solver.reason);  // like the accepted-step check: a failed sample
