@@ -99,34 +99,60 @@ void apply_box_options(FrictionModel& model, const BoxOptions& o) {
 // --fast-* options of train and upgrade.
 struct FastOptions {
   FastEvaluatorOptions build;
+  double max_seconds = 0.0;  // 0: the GP fit's own time (see fast_evaluator_budget)
   bool skip = false;
 };
+
+// The fast evaluator's default time budget: the GP fit's own wall time, so that `train` takes at most
+// about twice the fit (a grid pays off in proportion to the exact model's cost, which grows with the
+// fit's), but at least this much: a fit of 900 points takes well under a second here, and the grid
+// that holds μ to 1e-6 at n = 900 takes 1-2 s (bench/RESULTS.md, "Fast evaluator: budget").
+constexpr double kLeastFastEvaluatorSeconds = 2.0;
+double fast_evaluator_budget(const FastOptions& o, double fit_seconds) {
+  return o.max_seconds > 0.0 ? o.max_seconds : std::max(kLeastFastEvaluatorSeconds, fit_seconds);
+}
 
 void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
   cmd->add_option("--fast-mu-tolerance", o.build.mu_tolerance,
                   "Fast evaluator: refine until its measured bound on mu is within this (absolute)")
       ->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--fast-std-tolerance", o.build.std_relative_tolerance,
-                  "Fast evaluator: ... and its bound on std within this (relative)")
+                  "Fast evaluator: ... and its bound on std within this fraction of max(std, F), where\n"
+                  "F = mu tolerance / std tolerance: the interval's bounds mu +- z std are then accurate to\n"
+                  "this fraction of the half-width, or to the mu tolerance where std is smaller than F")
       ->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--fast-max-mb", o.build.max_megabytes, "Fast evaluator: largest grid, MB")
       ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--fast-max-seconds", o.max_seconds,
+                  "Fast evaluator: time budget; a finer grid whose predicted cost would not fit is not built\n"
+                  "(default: the GP fit's wall time, at least 2 s)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
 }
 
-// Builds, reports and attaches a fast evaluator (a model whose grid cannot reach the tolerances keeps
-// it with the bound it reached: requests with tighter tolerances get the exact model).
-void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o) {
+// Builds, reports and attaches a fast evaluator. A grid that cannot reach the tolerances within the
+// budgets is not stored: no default request could use it, and it would only weigh on the file (issue
+// 30: 57.7 MB for a 2-point model). The message says what stopped it and how to build it later.
+void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o, double fit_seconds) {
+  gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
   if (o.skip) return;
   FastEvaluatorOptions build = o.build;
+  build.max_seconds = fast_evaluator_budget(o, fit_seconds);
   build.progress = [](const std::string& line) { std::printf("  fast evaluator: %s\n", line.c_str()); };
+  std::printf("fast evaluator: building within %.1f s and %.0f MB (--fast-max-seconds, --fast-max-mb)\n",
+              build.max_seconds, build.max_megabytes);
   const auto start = std::chrono::steady_clock::now();
   auto fast = std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, build));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("fast evaluator: %.1f MB, built in %.1f s; %s\n", static_cast<double>(fast->grid().bytes()) / 1e6, seconds,
-              fast->meets(o.build.mu_tolerance, o.build.std_relative_tolerance)
-                  ? "meets the tolerances: it answers default requests inside the box"
-                  : "does NOT meet the tolerances within the memory cap: default requests get the exact model");
+  if (!fast->meets(o.build.mu_tolerance, o.build.std_relative_tolerance)) {
+    std::printf("fast evaluator: not stored, built in %.1f s: %s before the tolerances were met; the exact model answers "
+                "every request (a larger --fast-max-seconds / --fast-max-mb, or looser --fast-*-tolerance, with "
+                "`mufric upgrade --rebuild`)\n",
+                seconds, fast->stop_reason().c_str());
+    return;
+  }
+  std::printf("fast evaluator: %.1f MB, built in %.1f s; meets the tolerances: it answers default requests inside the box\n",
+              static_cast<double>(fast->grid().bytes()) / 1e6, seconds);
   gp.attach_fast_evaluator(std::move(fast));
 }
 
@@ -180,7 +206,7 @@ void add_train(CLI::App& app) {
     GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
     print_training_report(gp, report);
     apply_box_options(gp, o->box);  // before the grid: it tabulates μ as served (clipped to the range)
-    attach_fast_evaluator(gp, o->fast);
+    attach_fast_evaluator(gp, o->fast, report.seconds);
     save_model(o->out, gp);
     std::printf("wrote %s (gp, %lld training points) in %.2f s\n", o->out.c_str(),
                 static_cast<long long>(data.x.rows()), report.seconds);
@@ -386,7 +412,7 @@ void add_upgrade(CLI::App& app) {
     apply_box_options(*model, o->box);
     if (auto* gp = dynamic_cast<GaussianProcess*>(model.get())) {
       if (gp->fast_evaluator() == nullptr || o->rebuild || range_changed) {
-        attach_fast_evaluator(*gp, o->fast);
+        attach_fast_evaluator(*gp, o->fast, gp->state().summary.seconds);
       } else {
         std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
       }

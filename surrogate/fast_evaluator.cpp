@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <cstdio>
 #include <numeric>
 #include <random>
@@ -23,6 +24,12 @@ constexpr double kMostGrowth = 3.0;
 constexpr double kGrowthMargin = 1.1;
 // The local searches for the worst error: evaluations each (BOBYQA, Powell 2009).
 constexpr int kLocalSearchEvaluations = 60;
+// Random points per refinement round: enough to steer the next grid's size; the certification of
+// the final grid uses the options' full check set and the local searches.
+constexpr long long kRefinementCheckPoints = 2000;
+// A search evaluates one point per call, several times dearer than a point of a batch (measured
+// ~4× at n = 900); the time prediction counts each as this many batch points.
+constexpr double kSearchEvaluationCost = 4.0;
 
 // What the grid is built from and measured against: the exact GP, never a grid the GP may already
 // carry (upgrade --rebuild, a GP loaded from a file with one).
@@ -66,6 +73,9 @@ TensorCubicGrid tabulate(const GaussianProcess& gp, const std::vector<int>& cell
   return TensorCubicGrid(cells, values);
 }
 
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
 // Errors of one point, each over its tolerance: the larger one is what the searches maximise.
 struct PointError {
   double mu_absolute = 0.0, std_relative = 0.0;
@@ -74,10 +84,12 @@ struct PointError {
   }
 };
 
+// σ's error against max(σ, the bounds' floor): see "What σ's tolerance means" in the header.
 PointError error_at(const FastEvaluator& fast, double mu, double std, const double* x) {
   double mu_fast = 0.0, std_fast = 0.0;
   fast.evaluate(x, mu_fast, std_fast);
-  return {std::abs(mu_fast - mu), std::abs(std_fast - std) / std::max(std, kSmallestTabulatedStd)};
+  const double std_scale = std::max({std, fast.bounds().std_floor, kSmallestTabulatedStd});
+  return {std::abs(mu_fast - mu), std::abs(std_fast - std) / std_scale};
 }
 
 // Every point's error against the exact model at the points x (SI, one row each), and the largest.
@@ -126,7 +138,8 @@ FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianPro
   const auto d = static_cast<Eigen::Index>(gp.inputs().size());
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  Eigen::MatrixXd u(o.check_points, d);
+  const long long checks = search ? o.check_points : std::min(o.check_points, kRefinementCheckPoints);
+  Eigen::MatrixXd u(checks, d);
   for (Eigen::Index i = 0; i < u.rows(); ++i) {
     for (Eigen::Index k = 0; k < d; ++k) u(i, k) = uniform(rng);
   }
@@ -159,7 +172,17 @@ FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianPro
     }
     worst = context.worst;
   }
-  return {FastEvaluator::kBoundSafetyFactor * worst.mu_absolute, FastEvaluator::kBoundSafetyFactor * worst.std_relative};
+  return {FastEvaluator::kBoundSafetyFactor * worst.mu_absolute, FastEvaluator::kBoundSafetyFactor * worst.std_relative,
+          fast.bounds().std_floor};
+}
+
+std::string shape_text(const std::vector<int>& cells) {
+  std::string shape;
+  for (const int c : cells) {
+    if (!shape.empty()) shape += 'x';
+    shape += std::to_string(c);
+  }
+  return shape;
 }
 
 }  // namespace
@@ -171,8 +194,9 @@ FastEvaluator::FastEvaluator(InputSpace box, TensorCubicGrid grid, FastEvaluator
                 std::to_string(grid_.outputs()) + " outputs for a box of " + std::to_string(box_.size()) +
                 " inputs (expected 2 outputs: mu, log std)");
   }
-  if (!(bounds_.mu_absolute >= 0.0) || !(bounds_.std_relative >= 0.0)) {
-    throw Error("fast evaluator: error bounds must be >= 0");
+  if (!(bounds_.mu_absolute >= 0.0) || !(bounds_.std_relative >= 0.0) || !(bounds_.std_floor >= 0.0) ||
+      !std::isfinite(bounds_.std_floor)) {
+    throw Error("fast evaluator: error bounds and the std floor must be >= 0");
   }
   const auto d = static_cast<Eigen::Index>(box_.size());
   lo_.resize(d);
@@ -216,7 +240,7 @@ void FastEvaluator::evaluate(const Eigen::MatrixXd& x, double* mu, double* std) 
 
 FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
   const PointError worst = point_errors(fast, gp, x).worst;
-  return {worst.mu_absolute, worst.std_relative};
+  return {worst.mu_absolute, worst.std_relative, fast.bounds().std_floor};
 }
 
 FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluatorOptions& o) {
@@ -224,39 +248,64 @@ FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluato
     throw Error("fast evaluator: tolerances must be > 0");
   }
   if (o.check_points < 1) throw Error("fast evaluator: check_points must be >= 1");
+  if (!(o.max_seconds > 0.0)) throw Error("fast evaluator: the time budget must be > 0 s");
   auto say = [&](const std::string& line) {
     if (o.progress) o.progress(line);
   };
+  const Clock::time_point start = Clock::now();
+  const FastEvaluatorBounds unmeasured{.std_floor = std_floor_for(o.mu_tolerance, o.std_relative_tolerance)};
   double resolution = kFirstResolution;
   std::vector<int> cells = cells_for(gp, resolution);
   if (grid_megabytes(cells) > o.max_megabytes) {
     throw Error("fast evaluator: the coarsest grid needs " + std::to_string(grid_megabytes(cells)) +
                 " MB, more than the cap of " + std::to_string(o.max_megabytes) + " MB");
   }
+  char line[320];
   for (unsigned round = 0;; ++round) {
-    FastEvaluator fast(gp.inputs(), tabulate(gp, cells), {});
+    const Clock::time_point round_start = Clock::now();
+    FastEvaluator fast(gp.inputs(), tabulate(gp, cells), unmeasured);
     const FastEvaluatorBounds sampled = measured_bounds(fast, gp, o, o.seed + round, false);
+    // The cost of one exact evaluation in a batch, as this round measured it: what the next round's
+    // and the certification's times are predicted from.
+    const double per_point = seconds_since(round_start) /
+                             static_cast<double>(TensorCubicGrid::node_count(cells) + std::min(o.check_points, kRefinementCheckPoints));
     const double score = std::max(sampled.mu_absolute / o.mu_tolerance, sampled.std_relative / o.std_relative_tolerance);
-    std::string shape;
-    for (const int c : cells) {
-      if (!shape.empty()) shape += 'x';
-      shape += std::to_string(c);
-    }
-    char line[256];
-    std::snprintf(line, sizeof line, "grid %s cells (%.1f MB): mu within %.2e, std within %.2e relative (sampled)",
-                  shape.c_str(), grid_megabytes(cells), sampled.mu_absolute, sampled.std_relative);
+    std::snprintf(line, sizeof line,
+                  "grid %s cells (%.1f MB): mu within %.2e, std within %.2e of max(std, %.0e) (sampled); %.1f s so far",
+                  shape_text(cells).c_str(), grid_megabytes(cells), sampled.mu_absolute, sampled.std_relative,
+                  unmeasured.std_floor, seconds_since(start));
     say(line);
     const double growth = std::clamp(std::pow(score, 0.25) * kGrowthMargin, kLeastGrowth, kMostGrowth);
     const std::vector<int> finer = cells_for(gp, resolution * growth);
-    const bool capped = grid_megabytes(finer) > o.max_megabytes || finer == cells;
-    if (score <= 1.0 || capped) {
-      // Certify this grid: a fresh check set and local searches from its worst points.
+    const double certification_seconds =
+        per_point * (static_cast<double>(o.check_points) + o.local_searches * kLocalSearchEvaluations * kSearchEvaluationCost);
+    const double next_round_seconds =
+        per_point * static_cast<double>(TensorCubicGrid::node_count(finer) + std::min(o.check_points, kRefinementCheckPoints));
+    std::string limit;
+    if (finer == cells) {
+      limit = "the finest grid (" + std::to_string(kMaximumCellsPerInput) + " cells per input) is reached";
+    } else if (grid_megabytes(finer) > o.max_megabytes) {
+      std::snprintf(line, sizeof line, "the next grid (%s cells, %.1f MB) exceeds the memory cap of %.1f MB",
+                    shape_text(finer).c_str(), grid_megabytes(finer), o.max_megabytes);
+      limit = line;
+    } else if (seconds_since(start) + next_round_seconds + certification_seconds > o.max_seconds) {
+      std::snprintf(line, sizeof line, "the next grid (%s cells) would take about %.1f s more, past the time budget of %.1f s",
+                    shape_text(finer).c_str(), next_round_seconds + certification_seconds, o.max_seconds);
+      limit = line;
+    }
+    if (score <= 1.0 || !limit.empty()) {
+      // Certify this grid: the full check set and local searches from its worst points.
       fast.bounds_ = measured_bounds(fast, gp, o, o.seed + 1000 + round, true);
       const bool meets = fast.meets(o.mu_tolerance, o.std_relative_tolerance);
-      std::snprintf(line, sizeof line, "certified: mu within %.2e, std within %.2e relative (%s)", fast.bounds_.mu_absolute,
-                    fast.bounds_.std_relative, meets ? "meets the tolerances" : capped ? "memory cap reached" : "refining");
+      std::snprintf(line, sizeof line, "certified: mu within %.2e, std within %.2e of max(std, %.0e) (%s); %.1f s",
+                    fast.bounds_.mu_absolute, fast.bounds_.std_relative, unmeasured.std_floor,
+                    meets ? "meets the tolerances" : limit.empty() ? "refining" : "stopped", seconds_since(start));
       say(line);
-      if (meets || capped) return fast;
+      if (meets) return fast;
+      if (!limit.empty()) {
+        fast.stop_reason_ = limit;
+        return fast;
+      }
     }
     resolution *= growth;
     cells = finer;

@@ -391,8 +391,9 @@ std::string GaussianProcess::summary() const {
     s << "\n  fast evaluator: grid ";
     for (size_t k = 0; k < fast_->grid().cells().size(); ++k) s << (k ? "x" : "") << fast_->grid().cells()[k];
     s << " cells (" << static_cast<double>(fast_->grid().bytes()) / 1e6 << " MB); measured bound: mu "
-      << fast_->bounds().mu_absolute << " absolute, std " << fast_->bounds().std_relative
-      << " relative; it answers requests whose tolerances are at least these, inside the box";
+      << fast_->bounds().mu_absolute << " absolute, std " << fast_->bounds().std_relative << " of "
+      << (fast_->bounds().std_floor > 0.0 ? "max(std, " + std::to_string(fast_->bounds().std_floor) + ")" : std::string("std"))
+      << "; it answers requests whose tolerances are at least these, inside the box";
   } else {
     s << "\n  fast evaluator: none (the exact model answers; `mufric upgrade` adds one)";
   }

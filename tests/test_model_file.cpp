@@ -335,6 +335,23 @@ TEST(ModelFile, ATamperedOrForeignFastEvaluatorIsRefused) {
   std::filesystem::remove(path);
 }
 
+// A model `train` would write for noise-free data (σ at the noise floor, where two evaluation paths
+// round σ differently far beyond 1e-9) loads with its fast evaluator: the load-time check holds a node
+// to the file's certified bound, not to a tolerance the quantity cannot meet (issue 30).
+TEST(ModelFile, ANoiseFreeModelLoadsWithItsFastEvaluator) {
+  const std::string path = temp_path("noise_floor.h5");
+  GaussianProcess gp = test::fixed_hyper_gp(400, 13, 50.0, {1.5, 2.0, 3.0}, 1e-6);
+  gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, FastEvaluatorOptions{})));
+  save_model(path, gp);
+  const auto loaded = load_model(path);
+  const auto* back = dynamic_cast<const GaussianProcess*>(loaded.get());
+  ASSERT_NE(back, nullptr);
+  ASSERT_NE(back->fast_evaluator(), nullptr);
+  EXPECT_EQ(back->fast_evaluator()->bounds().std_floor, gp.fast_evaluator()->bounds().std_floor);
+  EXPECT_EQ(back->evaluate(test::smooth_training_set(20, 8).x, {.std = true}).fast_points, 20);
+  std::filesystem::remove(path);
+}
+
 // A schema-2 file (before fast evaluators) still loads, with none: the exact model answers.
 TEST(ModelFile, AnOlderSchemaLoadsWithoutAFastEvaluator) {
   const std::string path = temp_path("schema2.h5");
