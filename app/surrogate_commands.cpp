@@ -138,7 +138,10 @@ void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o, double fit
   if (o.skip) return;
   FastEvaluatorOptions build = o.build;
   build.max_seconds = fast_evaluator_budget(o, fit_seconds);
-  build.progress = [](const std::string& line) { std::printf("  fast evaluator: %s\n", line.c_str()); };
+  build.progress = [](const std::string& line) {
+    std::printf("  fast evaluator: %s\n", line.c_str());
+    std::fflush(stdout);
+  };
   std::printf("fast evaluator: building within %.1f s and %.0f MB (--fast-max-seconds, --fast-max-mb)\n",
               build.max_seconds, build.max_megabytes);
   const auto start = std::chrono::steady_clock::now();
@@ -203,6 +206,10 @@ void add_train(CLI::App& app) {
     }
     if (!dataset.note.empty()) std::printf("note: %s\n", dataset.note.c_str());
     GpTrainingReport report;
+    o->gp.progress = [](const std::string& line) {
+      std::printf("  fit: %s\n", line.c_str());
+      std::fflush(stdout);
+    };
     GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
     print_training_report(gp, report);
     apply_box_options(gp, o->box);  // before the grid: it tabulates μ as served (clipped to the range)

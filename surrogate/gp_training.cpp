@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
+#include <mutex>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -28,16 +30,52 @@ constexpr double kRelativeErrorFloor = 1e-12;
 // A hyper-parameter closer than this (in log units) to a bound is reported as "at the bound".
 constexpr double kAtBoundLog = 1e-2;
 constexpr double kZ95 = 1.959963984540054;
+// Above this many points a full-data likelihood evaluation takes seconds: the fit says so up front.
+constexpr Eigen::Index kSlowFitPoints = 3000;
 
 // The best point is tracked here rather than trusted from NLopt's return: with jitter the LML is
 // slightly discontinuous and L-BFGS may end in NLOPT_FAILURE after having found a good point.
+// Progress lines from starts running in parallel: one at a time, each start at most every
+// options.progress_seconds.
+class TrainingProgress {
+ public:
+  explicit TrainingProgress(const std::function<void(const std::string&)>& sink) : sink_(sink) {}
+  void say(const std::string& line) {
+    if (!sink_) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    sink_(line);
+  }
+  bool enabled() const { return static_cast<bool>(sink_); }
+
+ private:
+  const std::function<void(const std::string&)>& sink_;
+  std::mutex mutex_;
+};
+
 struct StartContext {
   LogMarginalLikelihood* lml;
   int evaluations = 0;
   std::string last_failure;
   double best_lml = kFailedLml;
   Eigen::VectorXd best_theta;
+  // Set for a full-data climb that reports its progress.
+  TrainingProgress* progress = nullptr;
+  double progress_seconds = 0.0;
+  std::string label;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now(), last_report = started;
 };
+
+void report_progress(StartContext& ctx) {
+  if (ctx.progress == nullptr) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - ctx.last_report).count() < ctx.progress_seconds) return;
+  ctx.last_report = now;
+  const double elapsed = std::chrono::duration<double>(now - ctx.started).count();
+  std::ostringstream line;
+  line << ctx.label << ": " << ctx.evaluations << " LML evaluations in " << std::fixed << std::setprecision(1) << elapsed
+       << " s (" << elapsed / ctx.evaluations << " s each), best LML " << std::setprecision(3) << ctx.best_lml;
+  ctx.progress->say(line.str());
+}
 
 double nlopt_objective(unsigned p, const double* x, double* grad, void* data) {
   auto* ctx = static_cast<StartContext*>(data);
@@ -54,6 +92,7 @@ double nlopt_objective(unsigned p, const double* x, double* grad, void* data) {
     ctx->best_lml = value.lml;
     ctx->best_theta = theta;
   }
+  report_progress(*ctx);
   return value.lml;
 }
 
@@ -104,8 +143,11 @@ struct LocalOptimum {
 
 // One bounded L-BFGS run (NLopt's NLOPT_LD_LBFGS, Liu & Nocedal 1989) from `start`.
 LocalOptimum maximise(LogMarginalLikelihood& lml, const Eigen::VectorXd& start, const GpTrainingOptions& options,
-                      const LogBounds& bounds) {
+                      const LogBounds& bounds, TrainingProgress* progress = nullptr, std::string label = {}) {
   StartContext ctx{&lml, 0, {}, kFailedLml, start};
+  ctx.progress = progress;
+  ctx.progress_seconds = options.progress_seconds;
+  ctx.label = std::move(label);
   LocalOptimum result;
   result.theta = start;
   const auto p = static_cast<unsigned>(start.size());
@@ -311,7 +353,10 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   std::vector<double> subset_lml(starts.size(), kFailedLml);
   const bool use_subset =
       options.optimise && options.subset_size > 0 && n > 2 * static_cast<Eigen::Index>(options.subset_size);
+  TrainingProgress progress(options.progress);
   if (use_subset) {
+    progress.say(std::to_string(starts.size()) + " start(s) on a subset of " + std::to_string(options.subset_size) +
+                 " of the " + std::to_string(n) + " points");
     std::vector<Eigen::Index> order(static_cast<size_t>(n));
     std::iota(order.begin(), order.end(), Eigen::Index{0});
     std::shuffle(order.begin(), order.end(), std::mt19937_64(options.seed ^ 0x5eed5eedULL));
@@ -356,6 +401,12 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     }
     if (leader[s] == s) leaders.push_back(s);
   }
+  if (options.optimise) {
+    progress.say(std::to_string(leaders.size()) + " start(s) on all " + std::to_string(n) + " points" +
+                 (n > kSlowFitPoints ? " (a likelihood evaluation costs O(n^3): progress every " +
+                                           std::to_string(static_cast<int>(options.progress_seconds)) + " s)"
+                                     : std::string()));
+  }
   for_each_parallel(leaders.size(), threads, [&](size_t i) {
     const size_t s = leaders[i];
     const auto t_start = std::chrono::steady_clock::now();
@@ -378,7 +429,8 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
         r.outcome = why.str();
       }
     } else {
-      const LocalOptimum optimum = maximise(lml, polish_from[s], options, bounds);
+      const LocalOptimum optimum =
+          maximise(lml, polish_from[s], options, bounds, progress.enabled() ? &progress : nullptr, "start " + std::to_string(s));
       r.final_log = optimum.theta;
       r.log_marginal_likelihood = optimum.lml;
       r.evaluations = optimum.evaluations;

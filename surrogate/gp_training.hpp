@@ -2,6 +2,7 @@
 // Hyper-parameter fitting by maximising the log marginal likelihood (R&W eq. 2.30, gradient
 // eq. 5.9) with NLopt's bounded L-BFGS from several deterministic starts.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,7 +42,14 @@ struct GpTrainingOptions {
   // (common random numbers: every plan row uses the same phases and seeds) has errors correlated
   // across samples, which the diagonal would wrongly smooth away. Needs every sample's μ_std.
   bool sample_noise = false;
+  // Progress lines for long fits (thread-safe calls): when each stage starts, and during a start's
+  // full-data climb at most every kTrainingProgressSeconds. May be empty.
+  std::function<void(const std::string&)> progress;
+  double progress_seconds = 10.0;  // between two lines of one start's climb (see below)
 };
+
+// progress_seconds: a fit of 10 000 points spends tens of seconds per LML evaluation, and printed
+// nothing for minutes (issue 30); a line every 10 s says it is alive and what an evaluation costs.
 
 struct GpStartReport {
   Eigen::VectorXd initial_log;

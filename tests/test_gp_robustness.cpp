@@ -3,6 +3,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
@@ -111,6 +113,27 @@ TEST(GpRobustness, FiveThousandPointsFitAndReproduceTheData) {
   const Evaluation e = gp.evaluate(data.x.topRows(500), {.std = true});
   expect_all_finite(e);
   EXPECT_LT((e.mu - data.mu.head(500)).cwiseAbs().maxCoeff(), 1e-3);
+}
+
+// A long fit says what it is doing: each stage, then (here every evaluation) its starts' climbs.
+TEST(GpRobustness, TrainingReportsItsProgress) {
+  GpTrainingOptions options;
+  options.restarts = 1;
+  options.threads = 2;
+  options.progress_seconds = 0.0;
+  std::vector<std::string> lines;
+  options.progress = [&](const std::string& line) { lines.push_back(line); };  // serialised by the trainer
+  GpTrainingReport report;
+  train_gaussian_process(test::smooth_training_set(600, 3), options, &report);
+  ASSERT_GE(lines.size(), 3u);
+  EXPECT_NE(lines[0].find("on a subset of 256 of the 600 points"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[1].find("on all 600 points"), std::string::npos) << lines[1];
+  int climbs = 0;
+  for (const auto& start : report.starts) climbs += start.outcome.find("same basin") == std::string::npos &&
+                                                    start.outcome.find("not refined") == std::string::npos
+                                                    ? start.evaluations : 0;
+  EXPECT_EQ(static_cast<int>(lines.size()) - 2, climbs);
+  EXPECT_NE(lines[2].find("LML evaluations in"), std::string::npos) << lines[2];
 }
 
 TEST(GpRobustness, NonFiniteTrainingDataIsRefusedWithAMessage) {
