@@ -59,8 +59,10 @@ int mufric_open(const char* uri, mufric_client** client);
  *   mu_tolerance=E, std_tolerance=R   a model's certified fast evaluator answers (inside its box)
  *                     only if its measured bound is within these (defaults 1e-6 absolute on mu,
  *                     1e-3 relative on std); 0: the exact model for every point
- *   extrapolation=P   points outside the model's training box: raw (the model itself), clamp (the
- *                     model at the nearest point of the box) or refuse (OUT_OF_BOX, NaN); default:
+ *   extrapolation=P   points outside the model's training box: raw (the model itself), clamp (mu of
+ *                     the model at the nearest point of the box, with an interval that grows with the
+ *                     distance from the box: the model's RMS error of that mu at the real point) or
+ *                     refuse (OUT_OF_BOX, NaN); default:
  *                     the model file's policy (clamp unless it says otherwise)
  * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
 int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);

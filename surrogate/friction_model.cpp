@@ -74,6 +74,38 @@ double normal_quantile_two_sided(double level) {
   return boost::math::quantile(boost::math::normal(), 0.5 * (1.0 + level));
 }
 
+// Under the clamp policy μ is the box face's, but nothing is known beyond the face: σ is the model's
+// own root-mean-square error of that answer at the real point, E[(f(x) − μ_face)²] = σ²(x) + (μ(x) −
+// μ_face)² under the model's posterior at x (the raw model: a GP reverts to its prior there). It
+// equals the face's σ at the face and grows with the distance from the box; it is never below the
+// raw model's σ (issue 30: clamping it gave 0.023 at 10 GPa, the value at the 1.3 GPa face).
+void FrictionModel::widen_clamped_intervals(const QueryBatch& x, const std::vector<Eigen::Index>& valid,
+                                            const EvaluationRequest& what, Evaluation& clamped) const {
+  std::vector<Eigen::Index> outside;  // positions in `valid`
+  for (size_t k = 0; k < valid.size(); ++k) {
+    for (size_t j = 0; j < inputs_.size(); ++j) {
+      if (clamped_input(inputs_[j]) && !inputs_[j].contains(x(valid[k], static_cast<Eigen::Index>(j)))) {
+        outside.push_back(static_cast<Eigen::Index>(k));
+        break;
+      }
+    }
+  }
+  if (outside.empty()) return;
+  QueryBatch real(static_cast<Eigen::Index>(outside.size()), x.cols());
+  for (size_t r = 0; r < outside.size(); ++r) real.row(static_cast<Eigen::Index>(r)) = x.row(valid[static_cast<size_t>(outside[r])]);
+  EvaluationRequest raw_what{.std = true, .max_threads = what.max_threads};
+  raw_what.mu_tolerance = what.mu_tolerance;
+  raw_what.std_relative_tolerance = what.std_relative_tolerance;
+  Evaluation raw;
+  evaluate_valid(real, raw_what, raw);
+  for (size_t r = 0; r < outside.size(); ++r) {
+    const Eigen::Index k = outside[r];
+    const auto i = static_cast<Eigen::Index>(r);
+    clamped.std(k) = std::hypot(raw.std(i), clamped.mu(k) - raw.mu(i));
+  }
+  clamped.clamped_variances += raw.clamped_variances;
+}
+
 Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest& what) const {
   const auto d = static_cast<Eigen::Index>(inputs_.size());
   if (x.cols() != d) {
@@ -119,6 +151,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
       }
     }
     evaluate_valid(compact, what, inner);
+    if (clamp && need_std && has_uncertainty()) widen_clamped_intervals(x, valid, what, inner);
     if (clamp && what.gradient) {
       // μ is constant along a clamped input beyond the box.
       for (Eigen::Index k = 0; k < n_valid; ++k) {

@@ -21,8 +21,10 @@ std::string_view to_string(PointStatus status);
 
 // What a model does with a point outside its training box.
 //   raw     the model itself, far from its data (a GP reverts to its prior mean, with a wide band)
-//   clamp   the model at the nearest point of the box (each input clamped to its range; the gradient
-//           along a clamped input is zero), still flagged EXTRAPOLATED — seed 001's way
+//   clamp   μ of the model at the nearest point of the box (each input clamped to its range; the
+//           gradient along a clamped input is zero), still flagged EXTRAPOLATED — seed 001's way; σ is
+//           the model's root-mean-square error of that μ at the real point, √(σ²(x) + (μ(x) − μ_face)²),
+//           so the interval grows with the distance from the box
 //   refuse  no answer: status OUT_OF_BOX, NaN outputs
 enum class Extrapolation : std::uint8_t { model_default = 0, raw = 1, clamp = 2, refuse = 3 };
 std::string_view to_string(Extrapolation policy);
@@ -96,6 +98,10 @@ class FrictionModel {
   virtual void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const = 0;
 
  private:
+  // σ of the clamped answers (rows of `clamped`, evaluated at the box face) of points outside the box.
+  void widen_clamped_intervals(const QueryBatch& x, const std::vector<Eigen::Index>& valid, const EvaluationRequest& what,
+                               Evaluation& clamped) const;
+
   InputSpace inputs_;
   Extrapolation default_extrapolation_ = kDefaultExtrapolation;
   double mu_min_ = kDefaultMuMin, mu_max_ = kDefaultMuMax;

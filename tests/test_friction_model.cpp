@@ -6,7 +6,9 @@
 #include <numbers>
 
 #include "common/error.hpp"
+#include "gp_test_data.hpp"
 #include "surrogate/empirical_laws.hpp"
+#include "surrogate/fast_evaluator.hpp"
 
 namespace mufric {
 namespace {
@@ -94,6 +96,48 @@ TEST(FrictionModel, NormalQuantileMatchesTables) {
   EXPECT_NEAR(normal_quantile_two_sided(0.95), 1.959963984540054, 1e-12);
   EXPECT_NEAR(normal_quantile_two_sided(0.99), 2.5758293035489004, 1e-12);
   EXPECT_NEAR(normal_quantile_two_sided(0.6826894921370859), 1.0, 1e-10);
+}
+
+
+// Clamped, a GP keeps the face's μ but its σ is the posterior RMS error of that μ at the real point,
+// √(σ_raw² + (μ_raw − μ_face)²), computed here from two separate evaluations: the raw model at the
+// point and the model at the face. It grows with the distance and meets the face's σ at the face —
+// with and without a fast evaluator (which answers inside the box only).
+TEST(FrictionModel, AClampedIntervalGrowsWithTheDistanceFromTheBox) {
+  GaussianProcess gp = test::fixed_hyper_gp(120, 7, 1.0, {0.4, 0.6, 0.5}, 1e-3);
+  for (const bool fast : {false, true}) {
+    if (fast) {
+      FastEvaluatorOptions o;
+      o.check_points = 1000;
+      gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, o)));
+    }
+    const double face = 1300e6;
+    QueryBatch x(4, 3), at_face(4, 3);
+    const double pressures[] = {face * (1 + 1e-12), 1500e6, 3000e6, 10000e6};
+    for (Eigen::Index i = 0; i < 4; ++i) {
+      x.row(i) << pressures[i], 1.5, 700.0;
+      at_face.row(i) << face, 1.5, 700.0;
+    }
+    EvaluationRequest clamp{.std = true, .ci_level = 0.95};
+    clamp.extrapolation = Extrapolation::clamp;
+    EvaluationRequest raw = clamp;
+    raw.extrapolation = Extrapolation::raw;
+    raw.mu_tolerance = 0.0;  // the exact model: the formula's terms without grid error
+    const Evaluation c = gp.evaluate(x, clamp), r = gp.evaluate(x, raw), f = gp.evaluate(at_face, clamp);
+    const double z = normal_quantile_two_sided(0.95);
+    for (Eigen::Index i = 0; i < 4; ++i) {
+      EXPECT_EQ(c.status[static_cast<size_t>(i)], PointStatus::extrapolated);
+      EXPECT_EQ(c.mu(i), f.mu(i)) << i;  // the face's μ, to the bit
+      EXPECT_NEAR(c.std(i), std::hypot(r.std(i), r.mu(i) - f.mu(i)), 1e-9) << i;
+      EXPECT_GE(c.std(i), r.std(i) * (1 - 1e-12)) << i;
+      EXPECT_NEAR(c.hi(i), std::min(c.mu(i) + z * c.std(i), gp.mu_max()), 1e-12) << i;  // the interval uses it
+      EXPECT_NEAR(c.lo(i), std::max(c.mu(i) - z * c.std(i), gp.mu_min()), 1e-12) << i;
+    }
+    EXPECT_NEAR(c.std(0), f.std(0), 1e-6 * f.std(0) + 1e-9);  // continuous at the face
+    EXPECT_LT(c.std(1), c.std(2));
+    EXPECT_LT(c.std(2), c.std(3));
+    EXPECT_GT(c.std(3), 10 * f.std(3));  // far out: the prior's width, not the face's
+  }
 }
 
 }  // namespace
