@@ -4,9 +4,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <string>
 
 #include "app/commands.hpp"
 #include "common/error.hpp"
@@ -30,6 +32,26 @@ void bound_openmp_spinning(char** argv) {
   ::execv("/proc/self/exe", argv);
 }
 
+// The exit code of every error, whether the command line or the work failed (README).
+constexpr int kErrorExitCode = 2;
+
+// The subcommands the parser reached ("mufric dataset plan"), for the usage hint of a parse error.
+std::string command_line_of(const CLI::App& app) {
+  std::string line = "mufric";
+  for (const CLI::App* level = &app; !level->get_subcommands().empty();) {
+    level = level->get_subcommands().back();
+    line += " " + level->get_name();
+  }
+  return line;
+}
+
+// An error message on one line (a few of CLI11's span several).
+std::string one_line(std::string message) {
+  std::replace(message.begin(), message.end(), '\n', ' ');
+  while (!message.empty() && message.back() == ' ') message.pop_back();
+  return message;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -49,16 +71,22 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version are "errors" with CLI11's success code: their normal output, exit 0.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    // Every other parse error is an error like any other (README: one line, exit code 2), not
+    // CLI11's two lines and its own exit codes (105, 106, 114, …).
+    std::fprintf(stderr, "mufric: error: %s (run `%s --help` for usage)\n", one_line(e.what()).c_str(),
+                 command_line_of(app).c_str());
+    return kErrorExitCode;
   } catch (const mufric::Error& e) {
     std::fprintf(stderr, "mufric: error: %s\n", e.what());
-    return 2;
+    return kErrorExitCode;
   } catch (const H5::Exception& e) {
     std::fprintf(stderr, "mufric: error: HDF5: %s\n", e.getDetailMsg().c_str());
-    return 2;
+    return kErrorExitCode;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mufric: error: %s\n", e.what());
-    return 2;
+    return kErrorExitCode;
   }
   return 0;
 }

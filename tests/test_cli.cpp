@@ -15,6 +15,7 @@
 #include <string>
 #include <algorithm>
 #include <sstream>
+#include <vector>
 
 #include "corrupt_files.hpp"
 
@@ -35,6 +36,8 @@ CommandResult run(const std::string& arguments) {
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
+
+size_t line_count(const std::string& text) { return static_cast<size_t>(std::count(text.begin(), text.end(), '\n')); }
 
 class Cli : public ::testing::Test {
  protected:
@@ -91,6 +94,27 @@ TEST_F(Cli, HelpExplainsTheSubcommands) {
     EXPECT_NE(r.output.find(word), std::string::npos) << word;
   }
   EXPECT_EQ(run("train --help").exit_code, 0);
+}
+
+// Regression (issue 30): a command line CLI11 refused ended with CLI11's own exit code (105, 106,
+// 114, …) and two lines without mufric's prefix; the README promises one line and exit code 2 for
+// every error. --help and --version keep exit code 0 and their output.
+TEST_F(Cli, CommandLineErrorsAreOneLineWithExitCode2) {
+  for (const std::string& command : std::vector<std::string>{
+           "micro run /nonexistent.json", "law coulomb --mu -1 --out " + path("c.h5"),
+           "dataset plan --samples 0 --out " + path("p.h5"), "law coulomb --no-such-flag", "no-such-command"}) {
+    const CommandResult r = run(command);
+    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.output;
+    EXPECT_EQ(r.output.rfind("mufric: error: ", 0), 0u) << command << ": " << r.output;
+    EXPECT_EQ(line_count(r.output), 1u) << command << ": " << r.output;
+  }
+  EXPECT_NE(run("micro run /nonexistent.json").output.find("/nonexistent.json"), std::string::npos);
+  EXPECT_NE(run("dataset plan --samples 0").output.find("mufric dataset plan --help"), std::string::npos);
+  for (const std::string command : {"--help", "--version", "dataset plan --help"}) {
+    const CommandResult r = run(command);
+    EXPECT_EQ(r.exit_code, 0) << command << ": " << r.output;
+    EXPECT_EQ(r.output.find("error"), std::string::npos) << command << ": " << r.output;
+  }
 }
 
 // Regression: `mufric describe` on a model file with a flipped global-heap string length died of
