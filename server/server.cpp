@@ -3,9 +3,15 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <netdb.h>
 #include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -28,6 +34,79 @@ constexpr int kReplyFlushMs = 200;
 void log_line(const std::string& level, const std::string& message) {
   std::fprintf(stderr, "%s level=%s msg=\"%s\"\n", utc_timestamp().c_str(), level.c_str(), message.c_str());
   std::fflush(stderr);
+}
+
+constexpr long kLargestPort = 65535;
+
+struct ListenAddress {
+  std::string host;  // an IPv6 address without its brackets
+  std::string port;  // decimal, 0 to kLargestPort; 0: any free port
+};
+
+Error listen_error(const std::string& listen, const std::string& why) { return Error("--listen " + listen + ": " + why); }
+
+// "host:port" or "[IPv6]:port", checked here: gRPC takes "nonsense" or port 99999 apart only in a raw
+// log line of its own, after it has started.
+ListenAddress parse_listen_address(const std::string& listen) {
+  const std::string expected = " (expected host:port, e.g. 127.0.0.1:50051; port 0: any free port)";
+  const size_t colon = listen.rfind(':');
+  if (colon == std::string::npos) throw listen_error(listen, "no port" + expected);
+  ListenAddress address{listen.substr(0, colon), listen.substr(colon + 1)};
+  if (address.host.size() >= 2 && address.host.front() == '[' && address.host.back() == ']') {
+    address.host = address.host.substr(1, address.host.size() - 2);
+  } else if (address.host.find(':') != std::string::npos) {
+    throw listen_error(listen, "an IPv6 address goes in brackets, e.g. [::1]:50051");
+  }
+  if (address.host.empty()) throw listen_error(listen, "no host" + expected);
+  const bool digits_only = !address.port.empty() && std::all_of(address.port.begin(), address.port.end(),
+                                                                 [](unsigned char c) { return std::isdigit(c) != 0; });
+  // More than 6 digits cannot be a port and would overflow stol.
+  if (!digits_only || address.port.size() > 6 || std::stol(address.port) > kLargestPort) {
+    throw listen_error(listen, "the port must be a number from 0 to " + std::to_string(kLargestPort) + expected);
+  }
+  return address;
+}
+
+// Binds a socket to every address the host resolves to, as gRPC will, and closes it again, so that a
+// port in use or a host that is not this machine's is an error naming --listen, not gRPC's raw log
+// lines. SO_REUSEADDR as gRPC sets it (connections in TIME_WAIT are no objection), no SO_REUSEPORT:
+// a server listening there is.
+void check_listen_address(const std::string& listen, const ListenAddress& address) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  if (const int rc = getaddrinfo(address.host.c_str(), address.port.c_str(), &hints, &found); rc != 0) {
+    throw listen_error(listen, "cannot resolve '" + address.host + "': " + gai_strerror(rc));
+  }
+  const std::unique_ptr<addrinfo, decltype(&freeaddrinfo)> addresses(found, &freeaddrinfo);
+  int first_error = 0;
+  bool any_bound = false;
+  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+    const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) {  // a family this machine lacks (no IPv6): gRPC passes it over too
+      if (first_error == 0) first_error = errno;
+      continue;
+    }
+    const int on = 1;
+    ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+    const bool bound = ::bind(fd, a->ai_addr, a->ai_addrlen) == 0;
+    const int error = errno;
+    ::close(fd);
+    if (bound) {
+      any_bound = true;
+    } else if (error == EADDRINUSE) {
+      throw listen_error(listen, "the port is in use (another server listens there?)");
+    } else if (first_error == 0) {
+      first_error = error;
+    }
+  }
+  // gRPC serves on the addresses it can bind ("localhost" on a machine without IPv6: 127.0.0.1 only).
+  if (any_bound) return;
+  if (first_error == EADDRNOTAVAIL) throw listen_error(listen, "'" + address.host + "' is not an address of this machine");
+  if (first_error == EACCES) throw listen_error(listen, "permission denied (ports below 1024 need privileges)");
+  throw listen_error(listen, std::string("cannot listen there: ") + std::strerror(first_error));
 }
 
 }  // namespace
@@ -55,6 +134,7 @@ std::shared_ptr<grpc::ServerCredentials> server_credentials(const ServerOptions&
 }
 
 void run_server(const ServerOptions& options) {
+  check_listen_address(options.listen, parse_listen_address(options.listen));
   if (!std::filesystem::is_directory(options.models_directory)) {
     throw Error("--models: '" + options.models_directory + "' is not a directory");
   }
@@ -88,13 +168,17 @@ void run_server(const ServerOptions& options) {
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
+  // gRPC sets SO_REUSEPORT by default: a second server on a port in use then started anyway, and the
+  // kernel handed each connection to one of the two at random.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   int bound_port = 0;
   builder.AddListeningPort(options.listen, server_credentials(options), &bound_port);
   builder.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
   builder.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
-  if (!server || bound_port == 0) throw Error("--listen: cannot listen on '" + options.listen + "'");
+  // check_listen_address found the port free: taken since, or refused for a reason gRPC logged above.
+  if (!server || bound_port == 0) throw listen_error(options.listen, "cannot listen there");
   const std::string host = options.listen.substr(0, options.listen.rfind(':'));
   const std::string address = host + ":" + std::to_string(bound_port);
   const std::string security = options.tls_cert.empty()           ? "plaintext"

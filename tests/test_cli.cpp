@@ -26,8 +26,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr
 };
 
-CommandResult run(const std::string& arguments) {
-  const std::string command = std::string(MUFRIC_EXE) + " " + arguments + " 2>&1";
+// `launcher` goes before the executable: "timeout 20", "taskset -c 0 env OMP_NUM_THREADS=1", ….
+CommandResult run(const std::string& arguments, const std::string& launcher = "") {
+  const std::string command = launcher + " " + std::string(MUFRIC_EXE) + " " + arguments + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   std::string output;
   std::array<char, 4096> buffer{};
@@ -232,6 +233,31 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   std::string text, line;
   while (std::getline(log, line)) text += line + "\n";
   EXPECT_NE(text.find("SIGTERM: draining"), std::string::npos) << text;
+}
+
+// Regression (issue 30): gRPC sets SO_REUSEPORT, so a second server on a port where one already
+// listened started too, and the kernel handed each connection to one of the two at random. Now the
+// second is refused naming the port; so is an address that is no host:port, before gRPC logs a line.
+TEST_F(Cli, ServeRefusesAPortInUseAndAnAddressThatIsNoHostAndPort) {
+  std::filesystem::create_directories(path("models"));
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("models/law.h5")).exit_code, 0);
+  ServeProcess first(path("models"), path("serve.log"), path("address"));
+  ASSERT_FALSE(first.address().empty()) << "server did not start";
+  // Without the fix the second server serves until killed: `timeout` makes that a failure, not a hang.
+  const std::string serve = "serve --models " + path("models") + " --listen ";
+  CommandResult r = run(serve + first.address(), "timeout 20");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(r.output, "mufric: error: --listen " + first.address() + ": the port is in use (another server listens there?)\n");
+  for (const std::string listen : {"127.0.0.1:99999", "127.0.0.1:65536", "nonsense", "127.0.0.1:", "127.0.0.1:x"}) {
+    r = run(serve + listen, "timeout 20");
+    EXPECT_EQ(r.exit_code, 2) << listen << ": " << r.output;
+    EXPECT_EQ(r.output.rfind("mufric: error: --listen " + listen + ": ", 0), 0u) << r.output;  // nothing from gRPC first
+    EXPECT_EQ(line_count(r.output), 1u) << r.output;
+  }
+  // The first server still answers.
+  r = run("predict --model grpc://" + first.address() + "/law --p 80MPa --v 10m/min --T 20C");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(first.stop(), 0);
 }
 
 TEST_F(Cli, MicroProfileReportsRoughnessAndFitError) {
