@@ -35,6 +35,10 @@ std::pair<double, double> parse_range(const std::string& text, QuantityKind kind
   if (colon == std::string::npos) throw Error(flag + " '" + text + "': give lo:hi with units, e.g. 300MPa:1300MPa");
   const double lo = parse_quantity(text.substr(0, colon), kind, flag);
   const double hi = parse_quantity(text.substr(colon + 1), kind, flag);
+  for (const double end : {lo, hi}) {
+    const std::string why = physical_range_violation(end, kind);
+    if (!why.empty()) throw Error(flag + " '" + text + "': " + why);
+  }
   if (!(lo < hi)) throw Error(flag + " '" + text + "': the lower end must lie below the upper end");
   return {lo, hi};
 }

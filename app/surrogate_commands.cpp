@@ -91,6 +91,24 @@ void add_box_options(CLI::App* cmd, BoxOptions& o) {
       ->expected(2);
 }
 
+// Training data must lie inside the μ range the model will declare: a row outside it (μ = 5 in a
+// file of friction coefficients) is a mistake, and a range that excludes the data pins every
+// answer to its edge (issue 30). Refused before the fit, naming the file and row.
+void check_mu_within_range(const TrainingSet& data, const BoxOptions& o, const std::string& path) {
+  const double lo = o.mu_range.empty() ? FrictionModel::kDefaultMuMin : o.mu_range[0];
+  const double hi = o.mu_range.empty() ? FrictionModel::kDefaultMuMax : o.mu_range[1];
+  for (Eigen::Index i = 0; i < data.mu.size(); ++i) {
+    if (data.mu(i) < lo || data.mu(i) > hi) {
+      char what[256];
+      std::snprintf(what, sizeof what, "%s: converged sample %lld, column mu: %g is outside the "
+                                       "model's mu range [%g, %g]%s",
+                    path.c_str(), static_cast<long long>(i + 1), data.mu(i), lo, hi,
+                    o.mu_range.empty() ? " (--mu-range LO HI declares another)" : " given by --mu-range");
+      throw Error(what);
+    }
+  }
+}
+
 void apply_box_options(FrictionModel& model, const BoxOptions& o) {
   if (!o.extrapolation.empty()) model.set_default_extrapolation(extrapolation_from_string(o.extrapolation));
   if (!o.mu_range.empty()) model.set_mu_range(o.mu_range[0], o.mu_range[1]);
@@ -206,6 +224,10 @@ void add_train(CLI::App& app) {
                   data.outside_model);
     }
     if (!dataset.note.empty()) std::printf("note: %s\n", dataset.note.c_str());
+    if (!o->box.mu_range.empty() && !(o->box.mu_range[0] < o->box.mu_range[1])) {
+      throw Error("--mu-range: the lower end must lie below the upper end");
+    }
+    check_mu_within_range(data, o->box, o->data);
     GpTrainingReport report;
     o->gp.progress = [](const std::string& line) {
       std::printf("  fit: %s\n", line.c_str());

@@ -1,5 +1,7 @@
 #include "common/dataset_file.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -98,10 +100,26 @@ Dataset read_csv_dataset(const std::string& path) {
   Dataset d;
   d.source = "csv:" + std::filesystem::path(path).filename().string();
   std::vector<std::vector<double>> columns;
+  const std::vector<std::string>& known = known_input_names();
   for (const auto& c : table.columns) {
     if (c.name == "mu" || c.name == "mu_std") continue;
+    // A column that is not a known input is a mistake, not a new input: an id column became a fourth
+    // input, and 'pressure[MPa]' an input "pressure" in unit "1" (issue 30).
+    if (std::find(known.begin(), known.end(), c.name) == known.end()) {
+      std::string names;
+      for (const auto& k : known) names += (names.empty() ? "" : ", ") + k;
+      throw Error(path + ": column '" + c.name + "' is not a model input (inputs: " + names +
+                  "; outputs: mu, mu_std); rename it, or remove it from the file");
+    }
     columns.push_back(table.si_column(c.name));
-    d.inputs.push_back({c.name, std::string(si_unit(kind_of_input(c.name))), 0.0, 0.0});
+    const QuantityKind kind = kind_of_input(c.name);
+    for (size_t i = 0; i < columns.back().size(); ++i) {
+      const std::string why = physical_range_violation(columns.back()[i], kind);
+      if (!why.empty()) {
+        throw Error(path + ": line " + std::to_string(table.line_of_row[i]) + ", column '" + c.name + "': " + why);
+      }
+    }
+    d.inputs.push_back({c.name, std::string(si_unit(kind)), 0.0, 0.0});
   }
   if (d.inputs.empty()) throw Error(path + ": no input columns besides 'mu'");
   const auto n = static_cast<Eigen::Index>(table.rows.size());
@@ -121,7 +139,8 @@ Dataset read_csv_dataset(const std::string& path) {
     const auto std_error = table.si_column("mu_std");
     for (Eigen::Index i = 0; i < n; ++i) {
       if (!(std_error[static_cast<size_t>(i)] >= 0.0)) {
-        throw Error(path + ": row " + std::to_string(i + 2) + ", column mu_std: a standard error must be a number >= 0");
+        throw Error(path + ": line " + std::to_string(table.line_of_row[static_cast<size_t>(i)]) +
+                    ", column 'mu_std': a standard error must be a number >= 0");
       }
       d.mu_std(i) = std_error[static_cast<size_t>(i)];
     }

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "common/error.hpp"
@@ -161,6 +162,36 @@ std::string format_human(double value_si, QuantityKind kind, int precision) {
   char text[64];
   std::snprintf(text, sizeof text, "%.*g", precision, si_to_human(value_si, kind));
   return std::string(text) + std::string(human_unit(kind));
+}
+
+const std::vector<std::string>& known_input_names() {
+  static const std::vector<std::string> names{"contact_pressure", "sliding_velocity", "temperature", "fibre_angle"};
+  return names;
+}
+
+PhysicalRange physical_range(QuantityKind kind) {
+  constexpr double kHighestPressure = 100e9;  // Pa
+  constexpr double kHighestSpeed = 1000.0;     // m/s
+  constexpr double kHighestTemperature = 1e4;  // K
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  switch (kind) {
+    case QuantityKind::pressure: return {0.0, kHighestPressure};
+    case QuantityKind::velocity: return {0.0, kHighestSpeed};  // a speed: a direction is given apart
+    case QuantityKind::temperature: return {0.0, kHighestTemperature};
+    default: return {-inf, inf};
+  }
+}
+
+std::string physical_range_violation(double value_si, QuantityKind kind) {
+  if (!std::isfinite(value_si)) return "not a finite number";
+  const PhysicalRange range = physical_range(kind);
+  if (value_si >= range.lo && value_si <= range.hi) return "";
+  const std::string value = format_human(value_si, kind);
+  if (value_si < range.lo) {
+    if (kind == QuantityKind::temperature) return value + " is below absolute zero (" + format_human(0.0, kind, 6) + ")";
+    return value + " is below " + format_human(range.lo, kind) + ", the least a " + std::string(to_string(kind)) + " can be";
+  }
+  return value + " is above " + format_human(range.hi, kind) + ", beyond any physical " + std::string(to_string(kind));
 }
 
 QuantityKind kind_of_input(std::string_view input_name) {

@@ -3,6 +3,7 @@
 // SI everywhere inside: Pa, m/s, K, rad, m, s.
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace mufric {
 
@@ -37,5 +38,20 @@ double si_to_human(double value_si, QuantityKind kind);
 
 // The kind of a named model input (contact_pressure → pressure, ...); dimensionless if unknown.
 QuantityKind kind_of_input(std::string_view input_name);
+// The model inputs mufric knows, in their usual order: contact_pressure, sliding_velocity,
+// temperature, fibre_angle.
+const std::vector<std::string>& known_input_names();
+
+// Where a quantity of a kind can physically lie (SI), the one table every command checks against
+// (dataset plan, scene files, training data, queries): pressure 0–100 GPa (no contact pressure
+// reaches the theoretical strength of a metal, ~E/10), sliding speed 0–1000 m/s (ballistic),
+// temperature from absolute zero to 10 000 K (above every melting point). Other kinds: unbounded.
+struct PhysicalRange {
+  double lo, hi;
+};
+PhysicalRange physical_range(QuantityKind kind);
+// "" when `value_si` is finite and within the kind's physical range; else why not, in human units,
+// e.g. "-293.8 °C is below absolute zero (-273.15 °C)".
+std::string physical_range_violation(double value_si, QuantityKind kind);
 
 }  // namespace mufric

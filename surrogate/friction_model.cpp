@@ -10,15 +10,10 @@
 namespace mufric {
 namespace {
 
-// Pressure, speed and absolute temperature are non-negative by nature; angles and unnamed inputs are free.
+// The one physical-range table of common/units.hpp: a negative pressure, speed or absolute
+// temperature, or one beyond any physical value, is not a point of any model.
 bool physically_valid(const InputSpec& input, double value) {
-  if (!std::isfinite(value)) return false;
-  switch (input.kind()) {
-    case QuantityKind::pressure:
-    case QuantityKind::velocity:
-    case QuantityKind::temperature: return value >= 0.0;
-    default: return true;
-  }
+  return physical_range_violation(value, input.kind()).empty();
 }
 
 // An angle is periodic (a ply at θ and θ + 180° is the same ply): the laws wrap it, so the clamp

@@ -139,6 +139,26 @@ TEST(DatasetFile, CsvErrorsNameLineAndColumn) {
   std::filesystem::remove(path);
 }
 
+// A column that is not a model input (an id, a misspelt name) and a value outside the physical range
+// are refused naming the column, and the line for a value (issue 30).
+TEST(DatasetFile, CsvRefusesUnknownColumnsAndImpossibleValues) {
+  const std::string path = temp_path("unknown.csv");
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],run_id,mu\n800,120,500,7,0.3\n";
+  std::string m = error_of([&] { read_dataset(path); });
+  EXPECT_NE(m.find("column 'run_id' is not a model input"), std::string::npos) << m;
+  std::ofstream(path) << "pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n800,120,500,0.3\n";
+  m = error_of([&] { read_dataset(path); });
+  EXPECT_NE(m.find("column 'pressure' is not a model input"), std::string::npos) << m;
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n# a comment\n800,120,500,0.3\n"
+                         "-500,120,500,0.3\n";
+  m = error_of([&] { read_dataset(path); });
+  EXPECT_NE(m.find("line 4, column 'contact_pressure': -500MPa is below 0MPa"), std::string::npos) << m;
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n800,120,-400,0.3\n";
+  m = error_of([&] { read_dataset(path); });
+  EXPECT_NE(m.find("line 2, column 'temperature': -400°C is below absolute zero"), std::string::npos) << m;
+  std::filesystem::remove(path);
+}
+
 TEST(DatasetFile, NonFiniteConvergedSampleIsNamedByRow) {
   Dataset d;
   d.inputs = default_friction_box();

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "common/error.hpp"
 #include "common/units.hpp"
 
@@ -42,6 +44,21 @@ TEST(Units, FormatsInHumanUnits) {
   EXPECT_EQ(format_human(800e6, QuantityKind::pressure), "800MPa");
   EXPECT_EQ(format_human(2.0, QuantityKind::velocity), "120m/min");
   EXPECT_EQ(format_human(773.15, QuantityKind::temperature), "500°C");
+}
+
+// One table of physical ranges for every command: the edges are inside, just beyond them is not, and
+// the message names the value in human units.
+TEST(Units, PhysicalRangesRefuseImpossibleValuesWithAReason) {
+  EXPECT_EQ(physical_range_violation(800e6, QuantityKind::pressure), "");
+  EXPECT_EQ(physical_range_violation(0.0, QuantityKind::pressure), "");
+  EXPECT_EQ(physical_range_violation(0.0, QuantityKind::temperature), "");
+  EXPECT_EQ(physical_range_violation(-3.0, QuantityKind::angle), "");  // angles are periodic, unbounded
+  EXPECT_NE(physical_range_violation(-1e-9, QuantityKind::pressure), "");
+  EXPECT_NE(physical_range_violation(-0.1, QuantityKind::velocity), "");
+  EXPECT_NE(physical_range_violation(101e9, QuantityKind::pressure), "");
+  EXPECT_NE(physical_range_violation(std::nan(""), QuantityKind::angle), "");
+  EXPECT_EQ(physical_range_violation(-400.0 + 273.15, QuantityKind::temperature), "-400°C is below absolute zero (-273.15°C)");
+  EXPECT_EQ(physical_range_violation(-500e6, QuantityKind::pressure), "-500MPa is below 0MPa, the least a pressure can be");
 }
 
 }  // namespace

@@ -218,10 +218,14 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
       l.fail("", "give exactly one of pressure or vertical_displacement");
     }
     s.pressure_controlled = l.has("pressure");
-    s.pressure = l.quantity("pressure", QuantityKind::pressure, s.pressure, 0.0, 1e11);
+    // Physical ranges from the one table every command checks (common/units.hpp).
+    const PhysicalRange pressures = physical_range(QuantityKind::pressure);
+    const PhysicalRange speeds = physical_range(QuantityKind::velocity);
+    const PhysicalRange temperatures = physical_range(QuantityKind::temperature);
+    s.pressure = l.quantity("pressure", QuantityKind::pressure, s.pressure, pressures.lo, pressures.hi);
     s.vertical_displacement = l.quantity("vertical_displacement", QuantityKind::length, 0.0, -1e-3, 1e-3);
-    s.velocity = l.quantity("velocity", QuantityKind::velocity, s.velocity, -1e3, 1e3);
-    s.temperature = l.quantity("temperature", QuantityKind::temperature, s.temperature, 0.0, 1e4);
+    s.velocity = l.quantity("velocity", QuantityKind::velocity, s.velocity, -speeds.hi, speeds.hi);  // signed: direction
+    s.temperature = l.quantity("temperature", QuantityKind::temperature, s.temperature, temperatures.lo, temperatures.hi);
     s.ramp = l.quantity("ramp", QuantityKind::time, s.ramp, 0.0, 1.0);
     l.finish();
   }
