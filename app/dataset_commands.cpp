@@ -9,11 +9,11 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/commands.hpp"
 #include "common/dataset_generation.hpp"
+#include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
@@ -146,8 +146,7 @@ scene::Scene run_scene(const std::string& scene_path, const std::vector<std::str
 }
 
 int threads_per_job(int jobs, int threads) {
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  return threads > 0 ? threads : std::max(1, cores / jobs);
+  return threads > 0 ? threads : std::max(1, usable_cores() / jobs);
 }
 
 void run_command(const RunOptions& o) {

@@ -46,8 +46,8 @@ void add_service_commands(CLI::App& app) {
   cmd->add_option("--max-points", o->max_points, "Most points in one request")->capture_default_str()
       ->check(CLI::Range(1LL, 100'000'000LL));
   cmd->add_option("--threads", o->threads,
-                  "Cores evaluation may use (0: all). A batch running alone uses them all; k concurrent batches "
-                  "share them, max(1, threads/k) each")
+                  "Cores evaluation may use (0: all the CPU affinity allows, at most OMP_NUM_THREADS). A batch "
+                  "running alone uses them all; k concurrent batches share them, max(1, threads/k) each")
       ->capture_default_str()->check(CLI::Range(0, 4096));
   cmd->add_option("--drain", o->drain_seconds, "Seconds requests in flight get on SIGTERM")->capture_default_str();
   cmd->add_option("--ready-file", o->ready_file, "Write the bound address here once serving (for scripts)");

@@ -20,6 +20,7 @@
 #include <mutex>
 #include <thread>
 
+#include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/version.hpp"
@@ -154,7 +155,7 @@ void run_server(const ServerOptions& options) {
     token.erase(token.find_last_not_of(" \t\r\n") + 1);
     if (token.empty()) throw Error("--token-file: '" + options.token_file + "' is empty");
   }
-  const int threads = options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0 ? options.threads : usable_cores();
   std::unique_ptr<UncertainQueryLog> uncertain_log;
   if (!options.uncertain_log_directory.empty()) {
     uncertain_log = std::make_unique<UncertainQueryLog>(options.uncertain_log_directory, options.uncertain_width,

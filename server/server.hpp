@@ -15,7 +15,7 @@ struct ServerOptions {
   int max_message_mb = 64;            // receive limit; 10⁵ points × 4 doubles needs ~3.2 MB
   long long max_points = 1'000'000;   // per request
   double drain_seconds = 5.0;         // requests in flight get this long on shutdown
-  int threads = 0;                    // cores for evaluation; 0: all the machine has
+  int threads = 0;                    // cores for evaluation; 0: all this process may use (usable_cores())
   std::string ready_file;             // written with the bound address once serving (for scripts)
   std::string token_file;             // bearer token required of every client (file, not argv)
   std::string tls_cert, tls_key;      // PEM server certificate chain and key: TLS instead of plaintext

@@ -17,6 +17,8 @@
 #include <sstream>
 #include <vector>
 
+#include <sched.h>
+
 #include "corrupt_files.hpp"
 
 namespace {
@@ -40,6 +42,25 @@ CommandResult run(const std::string& arguments, const std::string& launcher = ""
 
 size_t line_count(const std::string& text) { return static_cast<size_t>(std::count(text.begin(), text.end(), '\n')); }
 
+// The first CPU this process may run on (`taskset -c 0` would fail where CPU 0 is not among them).
+int first_allowed_cpu() {
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  if (sched_getaffinity(0, sizeof mask, &mask) == 0) {
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+      if (CPU_ISSET(cpu, &mask)) return cpu;
+    }
+  }
+  return 0;
+}
+
+std::string read_text(const std::string& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -51,17 +72,23 @@ class Cli : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
-// `mufric serve --models DIR` in a child process on a free loopback port, its stderr in LOG.
+// `mufric serve --models DIR` in a child process on a free loopback port, its stderr in LOG;
+// `launcher` goes before the executable ({"taskset", "-c", "0"}).
 class ServeProcess {
  public:
-  ServeProcess(const std::string& models, const std::string& log, const std::string& ready_file) {
+  ServeProcess(const std::string& models, const std::string& log, const std::string& ready_file,
+               const std::vector<std::string>& launcher = {}) {
     pid_ = fork();
     if (pid_ == 0) {
       freopen(log.c_str(), "w", stderr);
       unsetenv("GOMP_SPINCOUNT");  // as a user who chose no wait policy
       unsetenv("OMP_WAIT_POLICY");
-      execl(MUFRIC_EXE, MUFRIC_EXE, "serve", "--models", models.c_str(), "--listen", "127.0.0.1:0", "--ready-file",
-            ready_file.c_str(), static_cast<char*>(nullptr));
+      std::vector<std::string> words = launcher;
+      words.insert(words.end(), {MUFRIC_EXE, "serve", "--models", models, "--listen", "127.0.0.1:0", "--ready-file", ready_file});
+      std::vector<char*> argv;
+      for (std::string& word : words) argv.push_back(word.data());
+      argv.push_back(nullptr);
+      execvp(argv[0], argv.data());
       _exit(127);
     }
     for (int i = 0; i < 100 && address_.empty() && pid_ > 0; ++i) {
@@ -576,6 +603,33 @@ TEST_F(Cli, DatasetRunSurvivesKillNine) {
   r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
   EXPECT_NE(r.output.find("0 duplicates removed -> 6 samples"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("0 of 6 plan rows not yet run"), std::string::npos) << r.output;
+}
+
+// Regression (issue 30): default thread counts came from std::thread::hardware_concurrency(), the
+// machine's CPUs: under `taskset -c 0` with OMP_NUM_THREADS=1 on 2 cores `dataset run` said "1 job(s)
+// x 2 thread(s)" and `serve` "2 evaluation threads". Both now follow the CPU affinity mask, and
+// OMP_NUM_THREADS when that is smaller.
+TEST_F(Cli, DefaultThreadCountsFollowTheCpuAffinityAndOmpNumThreads) {
+  const std::string cpu = std::to_string(first_allowed_cpu());
+  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 1" + kTinyScene).exit_code, 0);
+  std::filesystem::create_directories(path("models"));
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("models/law.h5")).exit_code, 0);
+  const std::vector<std::vector<std::string>> launchers = {{"taskset", "-c", cpu, "env", "-u", "OMP_NUM_THREADS"},
+                                                           {"taskset", "-c", cpu, "env", "OMP_NUM_THREADS=1"},
+                                                           {"env", "OMP_NUM_THREADS=1"}};
+  for (size_t i = 0; i < launchers.size(); ++i) {
+    std::string launcher;
+    for (const std::string& word : launchers[i]) launcher += word + " ";
+    // Shard 1/2 of a one-row plan is empty: the run says its thread counts and ends.
+    const CommandResult r = run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --shard 1/2", launcher);
+    EXPECT_EQ(r.exit_code, 0) << launcher << ": " << r.output;
+    EXPECT_NE(r.output.find("1 job(s) x 1 thread(s)"), std::string::npos) << launcher << ": " << r.output;
+    const std::string log = path("serve" + std::to_string(i) + ".log");
+    ServeProcess server(path("models"), log, path("address" + std::to_string(i)), launchers[i]);
+    ASSERT_FALSE(server.address().empty()) << launcher << ": server did not start: " << read_text(log);
+    EXPECT_EQ(server.stop(), 0);
+    EXPECT_NE(read_text(log).find(", 1 evaluation threads)"), std::string::npos) << launcher << ": " << read_text(log);
+  }
 }
 
 }  // namespace

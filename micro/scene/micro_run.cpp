@@ -11,6 +11,7 @@
 
 #include <omp.h>
 
+#include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
@@ -567,7 +568,7 @@ MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   MuMeasurement m;
   m.draws = protocol_draws(scene);
-  const int cores = std::max(options.threads > 0 ? options.threads : omp_get_max_threads(), 1);
+  const int cores = std::max(options.threads > 0 ? options.threads : usable_cores(), 1);
   const int workers = std::min(cores, static_cast<int>(m.draws.size()));
   m.threads = workers;
   // Draws are independent runs: one per worker, each worker's OpenMP share of the cores for its

@@ -124,7 +124,7 @@ struct MuMeasurement {
 };
 
 struct MeasureOptions {
-  int threads = 0;            // cores to use (draws run in parallel); 0: OpenMP's maximum
+  int threads = 0;            // cores to use (draws run in parallel); 0: usable_cores()
   double wall_seconds_limit = 0.0;  // > 0: the whole measurement stops with an Error after this long
   std::string vtu_directory;  // VTU of the first draw
   // progress: the draw (index into draws) and its step; called from the draws' threads, serialised
