@@ -57,9 +57,10 @@ bool CsvTable::has_column(const std::string& name) const {
   return false;
 }
 
-std::vector<double> CsvTable::si_column(const std::string& name) const {
+std::vector<double> CsvTable::si_column(const std::string& name) const { return si_column(name, kind_of_input(name)); }
+
+std::vector<double> CsvTable::si_column(const std::string& name, QuantityKind kind) const {
   const size_t j = column(name);
-  const QuantityKind kind = kind_of_input(name);
   const std::string& unit = columns[j].unit;
   if (unit.empty() && kind != QuantityKind::dimensionless) {
     throw Error(path + ": column '" + name + "' has no unit in the header; write e.g. '" + name + "[" +

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "common/units.hpp"
+
 namespace mufric {
 
 struct CsvColumn {
@@ -22,6 +24,9 @@ struct CsvTable {
   bool has_column(const std::string& name) const;
   // Column values converted to SI using the header unit; throws if the unit is missing or unknown.
   std::vector<double> si_column(const std::string& name) const;
+  // The same for a column that must carry a unit of `kind` (a profile's x and height: lengths),
+  // whatever its name says.
+  std::vector<double> si_column(const std::string& name, QuantityKind kind) const;
 };
 
 // Parses `path`; every cell must be a finite number. Throws Error naming line and column.

@@ -273,6 +273,22 @@ TEST(RoughProfile, CsvWithUnitsIsReadAndBadRowsAreNamed) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:9"), std::string::npos) << e.what();
   }
+  // A length column must carry a length unit: another kind's (height[MPa] reported Ra 3e13 um) or
+  // none (read as metres) is refused, naming the column (issue 30).
+  for (const std::string header : {"x[um],height[MPa]", "x[um],height", "x,height[um]"}) {
+    {
+      std::ofstream out(dir / "units.csv");
+      out << header << "\n";
+      for (int k = 0; k < 12; ++k) out << k << "," << k % 3 << "\n";
+    }
+    try {
+      read_profile_csv((dir / "units.csv").string());
+      ADD_FAILURE() << header << " accepted";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_TRUE(m.find("has no unit") != std::string::npos || m.find("expected a length") != std::string::npos) << m;
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

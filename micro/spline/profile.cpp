@@ -28,8 +28,9 @@ std::vector<double> centred(const std::vector<double>& h) {
 Profile read_profile_csv(const std::string& path, double period_m) {
   const CsvTable table = read_csv_table(path);
   Profile p;
-  p.x = table.si_column("x");
-  p.height = table.si_column("height");
+  // Both are lengths: a header without a unit, or with another kind's (height[MPa]), is refused.
+  p.x = table.si_column("x", QuantityKind::length);
+  p.height = table.si_column("height", QuantityKind::length);
   p.source = path;
   if (p.x.size() < kMinimumProfileSamples) {
     throw Error(path + ": a profile needs at least " + std::to_string(kMinimumProfileSamples) + " rows, found " +
