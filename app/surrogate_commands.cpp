@@ -194,7 +194,7 @@ void add_train(CLI::App& app) {
   cmd->add_option("--restarts", o->gp.restarts, "Optimiser starts after the first (log-uniform in the bounds)")
       ->capture_default_str()->check(CLI::Range(0, 1000));
   cmd->add_option("--seed", o->gp.seed, "Seed of the restart points")->capture_default_str();
-  cmd->add_option("--threads", o->gp.threads, "Starts run in parallel on this many threads (0: all cores)")
+  cmd->add_option("--threads", o->gp.threads, "Starts run in parallel on this many threads (0: the cores this process may use, at most OMP_NUM_THREADS)")
       ->capture_default_str();
   cmd->add_option("--max-evaluations", o->gp.max_evaluations, "LML evaluations per start")->capture_default_str();
   cmd->add_option("--subset", o->gp.subset_size,

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/blas_threads.hpp"
+#include "common/environment.hpp"
 #include "common/error.hpp"
 #include "surrogate/cholesky.hpp"
 #include "surrogate/fast_evaluator.hpp"
@@ -229,7 +230,10 @@ int evaluation_team_size(int max_threads) {
   // A region of one thread is not active (OpenMP's own rule): the other cores are idle and a team
   // may use them (1.9× faster at n = 900 in examples/c/meso_loop.c; bench/RESULTS.md).
   if (omp_in_parallel()) return 1;
-  const int available = omp_get_max_threads();
+  // OpenMP's limit follows the affinity mask but not an OMP_NUM_THREADS above it; usable_cores()
+  // honours both. Read once: this is on every call's path, and the mask of a running code is fixed.
+  static const int cores = usable_cores();
+  const int available = std::min(omp_get_max_threads(), cores);
   return max_threads > 0 ? std::min(max_threads, available) : available;
 }
 

@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 
+#include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/version.hpp"
 #include "surrogate/cholesky.hpp"
@@ -340,7 +341,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     }
   }
 
-  const int threads = options.threads > 0 ? options.threads : omp_get_num_procs();
+  const int threads = options.threads > 0 ? options.threads : usable_cores();  // affinity and OMP_NUM_THREADS
   report.starts.resize(starts.size());
   for (size_t s = 0; s < starts.size(); ++s) {
     report.starts[s].initial_log = starts[s];
