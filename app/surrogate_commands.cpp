@@ -10,6 +10,7 @@
 
 #include "app/commands.hpp"
 #include "client/friction_client.hpp"
+#include "common/csv_table.hpp"
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
@@ -275,77 +276,172 @@ const std::map<std::string, std::string> kInputFlags{{"contact_pressure", "--p"}
                                                      {"temperature", "--T"},
                                                      {"fibre_angle", "--angle"}};
 
+// The points to ask: one from the flags, or every row of --csv (columns named like the model's
+// inputs, with units).
+struct PredictPoints {
+  std::vector<std::vector<double>> columns;  // SI, per model input: what the block points into
+  std::vector<int> lines;                    // CSV line of each point (empty for flags)
+};
+
+PredictPoints points_from_csv(const std::string& path, const InputSpace& inputs) {
+  const CsvTable table = read_csv_table(path);
+  for (const auto& c : table.columns) {
+    const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == c.name; });
+    if (!used) throw Error(path + ": column '" + c.name + "' is not an input of the model");
+  }
+  PredictPoints p;
+  for (const auto& input : inputs) {
+    if (!table.has_column(input.name)) {
+      throw Error(path + ": no column '" + input.name + "' (the model's input; e.g. " + input.name + "[" +
+                  std::string(human_unit(input.kind())) + "])");
+    }
+    p.columns.push_back(table.si_column(input.name));
+  }
+  p.lines = table.line_of_row;
+  return p;
+}
+
+// dμ/dx in per-human-unit (per MPa, per m/min, per °C), as the inputs are given.
+double gradient_per_human_unit(double per_si, QuantityKind kind) {
+  return per_si * unit_to_si(human_unit(kind)).scale;
+}
+
 void add_predict(CLI::App& app) {
   struct Options {
-    std::string model;
+    std::string model, csv, out;
     std::map<std::string, std::string> values;  // flag → text
     double level = 0.95;
     bool gradient = false;
     std::string extrapolation;
   };
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("predict", "One friction coefficient with its confidence interval, human units");
+  auto* cmd = app.add_subcommand("predict", "Friction coefficients with their confidence intervals, human units");
   cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), or grpc://host:port/model")->required();
   for (const auto& [input, flag] : kInputFlags) {
     cmd->add_option(flag, o->values[flag],
                     "The " + input + " with its unit, e.g. " + std::string(example_quantity(kind_of_input(input))));
   }
+  cmd->add_option("--csv", o->csv,
+                  "Many points: a CSV whose columns are the model's inputs with units, e.g.\n"
+                  "contact_pressure[MPa],sliding_velocity[m/min],temperature[C]; writes a CSV of mu, std, lo, hi,\n"
+                  "status and the reason of a point that is not OK")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", o->out, "With --csv: write the answers here (default: standard output)");
   cmd->add_option("--level", o->level, "Confidence level of the interval")->capture_default_str()
       ->check(CLI::Range(0.5, 0.9999));
-  cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput");
+  cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput, per the input's human unit (per MPa, m/min, C)");
   cmd->add_option("--extrapolation", o->extrapolation,
                   "Outside the training box: raw, clamp or refuse (default: the model file's policy)")
       ->check(CLI::IsMember({"raw", "clamp", "refuse"}));
+  cmd->footer("Exit status 2 when a point gets no answer (INVALID_INPUT: impossible values; OUT_OF_BOX: outside the\n"
+              "box under --extrapolation refuse), with the reason; EXTRAPOLATED points are answered and say why.");
   cmd->callback([o] {
     client::Options options;
     options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
     const auto client = client::connect(o->model, options);
     const client::ModelInfo info = client->describe();
     const InputSpace& inputs = info.inputs;
-    std::vector<double> values(inputs.size());
-    client::Block block{.points = 1};
-    for (size_t j = 0; j < inputs.size(); ++j) {
-      const auto flag_it = kInputFlags.find(inputs[j].name);
-      if (flag_it == kInputFlags.end()) throw Error("model input '" + inputs[j].name + "' has no command-line flag");
-      const std::string& text = o->values[flag_it->second];
-      if (text.empty()) throw Error(flag_it->second + " is required: the model's input " + inputs[j].name + " (e.g. " +
-                                    flag_it->second + " " + std::string(example_quantity(inputs[j].kind())) + ")");
-      values[j] = parse_quantity(text, inputs[j].kind(), flag_it->second);
-      if (const auto field = client::Block::field_for(inputs[j].name)) block.*field = &values[j];
+    const bool from_csv = !o->csv.empty();
+    PredictPoints points;
+    if (from_csv) {
+      for (const auto& [input, flag] : kInputFlags) {
+        if (!o->values[flag].empty()) throw Error(flag + " and --csv exclude each other");
+      }
+      points = points_from_csv(o->csv, inputs);
+    } else {
+      if (!o->out.empty()) throw Error("--out goes with --csv");
+      for (const auto& input : inputs) {
+        const auto flag_it = kInputFlags.find(input.name);
+        if (flag_it == kInputFlags.end()) throw Error("model input '" + input.name + "' has no command-line flag");
+        const std::string& text = o->values[flag_it->second];
+        if (text.empty()) throw Error(flag_it->second + " is required: the model's input " + input.name + " (e.g. " +
+                                      flag_it->second + " " + std::string(example_quantity(input.kind())) + ")");
+        points.columns.push_back({parse_quantity(text, input.kind(), flag_it->second)});
+      }
+      for (const auto& [input, flag] : kInputFlags) {
+        const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });
+        if (!used && !o->values[flag].empty()) throw Error(flag + " was given but the model has no input " + input);
+      }
     }
-    for (const auto& [input, flag] : kInputFlags) {
-      const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });
-      if (!used && !o->values[flag].empty()) throw Error(flag + " was given but the model has no input " + input);
+    const size_t n = points.columns.empty() ? 0 : points.columns.front().size();
+    client::Block block{.points = n};
+    for (size_t j = 0; j < inputs.size(); ++j) {
+      if (const auto field = client::Block::field_for(inputs[j].name)) block.*field = points.columns[j].data();
     }
     EvaluationRequest what{.std = true, .ci_level = o->level, .gradient = o->gradient};
     if (!o->extrapolation.empty()) what.extrapolation = extrapolation_from_string(o->extrapolation);
     const client::Answer a = client->evaluate(block, what);
-    for (size_t j = 0; j < inputs.size(); ++j) {
-      std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(values[j], inputs[j].kind()).c_str());
-    }
-    std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s  (%s)\n", a.mu[0], a.std[0],
-                100 * o->level, a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str(),
-                a.fast_points > 0 ? "fast evaluator" : "exact model");
-    if (o->gradient) {
-      for (size_t j = 0; j < inputs.size(); ++j) {
-        std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(), a.gradient[j],
-                    std::string(si_unit(inputs[j].kind())).c_str());
+    std::vector<double> x(inputs.size());
+    auto reason_of = [&](size_t i) {
+      for (size_t j = 0; j < inputs.size(); ++j) x[j] = points.columns[j][i];
+      return point_reason(inputs, x.data());
+    };
+    long long unanswered = 0;
+    std::string first_unanswered;
+    for (size_t i = 0; i < n; ++i) {
+      if (a.status[i] == PointStatus::invalid_input || a.status[i] == PointStatus::out_of_box) {
+        if (unanswered++ == 0) {
+          first_unanswered = (from_csv ? o->csv + ": line " + std::to_string(points.lines[i]) + ": " : std::string()) +
+                             std::string(to_string(a.status[i])) + ": " + reason_of(i);
+        }
       }
+    }
+    if (from_csv) {
+      std::FILE* out = o->out.empty() ? stdout : std::fopen(o->out.c_str(), "w");
+      if (out == nullptr) throw Error(o->out + ": cannot write");
+      for (const auto& input : inputs) std::fprintf(out, "%s[%s],", input.name.c_str(), std::string(human_unit(input.kind())).c_str());
+      std::fprintf(out, "mu,std,lo,hi,status,reason\n");
+      for (size_t i = 0; i < n; ++i) {
+        for (size_t j = 0; j < inputs.size(); ++j) std::fprintf(out, "%.10g,", si_to_human(points.columns[j][i], inputs[j].kind()));
+        const std::string reason = a.status[i] == PointStatus::ok ? std::string() : reason_of(i);
+        std::fprintf(out, "%.10g,%.6g,%.10g,%.10g,%s,\"%s\"\n", a.mu[i], a.std[i], a.lo[i], a.hi[i],
+                     std::string(to_string(a.status[i])).c_str(), reason.c_str());
+      }
+      if (out != stdout && std::fclose(out) != 0) throw Error(o->out + ": write failed");
+      std::fprintf(stderr, "%zu points (%lld answered by the fast evaluator)\n", n, a.fast_points);
+    } else {
+      for (size_t j = 0; j < inputs.size(); ++j) {
+        std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(points.columns[j][0], inputs[j].kind()).c_str());
+      }
+      std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s  (%s)\n", a.mu[0], a.std[0],
+                  100 * o->level, a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str(),
+                  a.fast_points > 0 ? "fast evaluator" : "exact model");
+      if (a.status[0] == PointStatus::extrapolated) std::printf("  outside the training box: %s\n", reason_of(0).c_str());
+      if (o->gradient && a.status[0] != PointStatus::invalid_input && a.status[0] != PointStatus::out_of_box) {
+        for (size_t j = 0; j < inputs.size(); ++j) {
+          std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(),
+                      gradient_per_human_unit(a.gradient[j], inputs[j].kind()), std::string(human_unit(inputs[j].kind())).c_str());
+        }
+      }
+    }
+    if (unanswered > 0) {
+      throw Error(first_unanswered + (unanswered > 1 ? " (and " + std::to_string(unanswered - 1) + " more points without an answer)" : ""));
     }
   });
 }
 
 void add_describe(CLI::App& app) {
   auto model_uri = std::make_shared<std::string>();
-  auto* cmd = app.add_subcommand("describe", "Inputs, units, training box and accuracy figures of a model file");
-  cmd->add_option("model", *model_uri, "Model file or file:// URI")->required();
+  auto* cmd = app.add_subcommand("describe", "Inputs, units, training box and accuracy figures of a model");
+  cmd->add_option("model", *model_uri, "Model file or file:// URI, or a served model: grpc://host:port/model")->required();
   cmd->callback([model_uri] {
+    auto print_inputs = [](const InputSpace& inputs) {
+      for (const auto& input : inputs) {
+        std::printf("  %-18s [%s, %s]  stored in %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
+                    format_human(input.hi, input.kind()).c_str(), input.unit.c_str());
+      }
+    };
+    if (model_uri->rfind("grpc://", 0) == 0 || model_uri->rfind("grpcs://", 0) == 0) {
+      const client::ModelInfo info = client::connect(*model_uri)->describe();
+      std::printf("%s: model %s, version %s, kind %s\ninputs (training box):\n", model_uri->c_str(), info.name.c_str(),
+                  info.version.c_str(), info.kind.c_str());
+      print_inputs(info.inputs);
+      std::printf("%s\n", info.summary.c_str());
+      return;
+    }
     const auto model = load_model_isolated(model_path_from_uri(*model_uri));
     std::printf("%s: kind %s\ninputs (training box):\n", model_uri->c_str(), std::string(model->kind()).c_str());
-    for (const auto& input : model->inputs()) {
-      std::printf("  %-18s [%s, %s]  stored in %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
-                  format_human(input.hi, input.kind()).c_str(), input.unit.c_str());
-    }
+    print_inputs(model->inputs());
     std::printf("outside the box: %s (a request may choose raw, clamp or refuse); mu kept in [%g, %g]\n",
                 std::string(to_string(model->default_extrapolation())).c_str(), model->mu_min(), model->mu_max());
     std::printf("%s\n", model->summary().c_str());

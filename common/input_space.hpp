@@ -1,5 +1,6 @@
 #pragma once
 // Named, ordered model inputs with SI units and the box they were sampled from.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -14,7 +15,15 @@ struct InputSpec {
   double hi = 0.0;
 
   QuantityKind kind() const { return kind_of_input(name); }
-  bool contains(double value) const { return value >= lo && value <= hi; }
+  // An angle repeats every 180° (a ply at θ and θ + 180° is the same ply): 270° lies in a box of
+  // 0°–90°. Other inputs: the closed interval [lo, hi].
+  bool contains(double value) const {
+    if (value >= lo && value <= hi) return true;
+    if (kind() != QuantityKind::angle || !std::isfinite(value)) return false;
+    constexpr double kHalfTurn = 3.14159265358979323846;
+    const double wrapped = lo + (value - lo) - kHalfTurn * std::floor((value - lo) / kHalfTurn);
+    return wrapped >= lo && wrapped <= hi;
+  }
 };
 
 using InputSpace = std::vector<InputSpec>;

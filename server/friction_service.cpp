@@ -210,6 +210,11 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   response.set_fast_points(fast);
   response.set_out_of_box_points(out_of_box);
   response.set_range_clipped_points(clipped);
+  if (invalid + out_of_box > 0) {
+    std::vector<PointStatus> all(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) all[static_cast<size_t>(i)] = static_cast<PointStatus>(response.status(i));
+    response.set_message(unanswered_points_message(model.inputs(), batch, all));
+  }
   counters_.fast_points += static_cast<long long>(fast);
   for (auto& name : ignored) response.add_ignored_inputs(std::move(name));
   counters_.points += n;

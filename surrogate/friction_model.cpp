@@ -197,4 +197,32 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
   return out;
 }
 
+std::string point_reason(const InputSpace& inputs, const double* x) {
+  for (size_t j = 0; j < inputs.size(); ++j) {
+    const std::string why = physical_range_violation(x[j], inputs[j].kind());
+    if (!why.empty()) return inputs[j].name + ": " + why;
+  }
+  for (size_t j = 0; j < inputs.size(); ++j) {
+    if (inputs[j].contains(x[j])) continue;
+    const QuantityKind kind = inputs[j].kind();
+    return inputs[j].name + ": " + format_human(x[j], kind) + " is " + (x[j] < inputs[j].lo ? "below" : "above") +
+           " the box (" + format_human(inputs[j].lo, kind) + " to " + format_human(inputs[j].hi, kind) + ")";
+  }
+  return "";
+}
+
+std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status) {
+  long long unanswered = 0;
+  std::string first;
+  for (size_t i = 0; i < status.size(); ++i) {
+    if (status[i] != PointStatus::invalid_input && status[i] != PointStatus::out_of_box) continue;
+    if (unanswered++ == 0) {
+      const Eigen::RowVectorXd row = x.row(static_cast<Eigen::Index>(i));
+      first = "point " + std::to_string(i) + " " + std::string(to_string(status[i])) + ": " + point_reason(inputs, row.data());
+    }
+  }
+  if (unanswered > 1) first += " (and " + std::to_string(unanswered - 1) + " more points without an answer)";
+  return first;
+}
+
 }  // namespace mufric

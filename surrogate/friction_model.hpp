@@ -107,6 +107,14 @@ class FrictionModel {
   double mu_min_ = kDefaultMuMin, mu_max_ = kDefaultMuMax;
 };
 
+// Why a point (SI, one value per input) is INVALID_INPUT, OUT_OF_BOX or EXTRAPOLATED, naming the
+// input and the side, in human units: "contact_pressure: -5MPa is below 0MPa, the least a pressure
+// can be", "contact_pressure: 10000MPa is above the box (300MPa to 1300MPa)"; "" for a point inside.
+std::string point_reason(const InputSpace& inputs, const double* x);
+// One line for a response: the first point that got no answer (INVALID_INPUT, OUT_OF_BOX) and why,
+// with how many more there are; "" when every point was answered. x: the batch, one row per point.
+std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status);
+
 // Two-sided normal quantile z such that P(|Z| ≤ z) = level (Boost.Math).
 double normal_quantile_two_sided(double level);
 

@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
+#include <cmath>
 #include <string>
 #include <algorithm>
 #include <sstream>
@@ -199,6 +201,90 @@ TEST_F(Cli, UpgradeAddsAFastEvaluator) {
   EXPECT_NE(run("upgrade " + path("nope.h5")).exit_code, 0);
 }
 
+// Regression (issue 30): a model `train` wrote for noise-free data (the learned noise at its lower
+// bound, σ a cancelling difference) was refused by `describe`, and its fast evaluator refined for
+// minutes. It must load, with its grid built within the default budget.
+TEST_F(Cli, AModelTrainedOnNoiseFreeDataLoadsInEveryCommand) {
+  {
+    std::ofstream csv(path("smooth.csv"));
+    csv << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n";
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    csv.precision(17);
+    for (int i = 0; i < 400; ++i) {
+      const double a = u(rng), b = u(rng), c = u(rng);
+      csv << 300 + 1000 * a << "," << 22.5 + 177.5 * b << "," << 25 + 875 * c << ","
+          << 0.2 + 0.03 * std::sin(2 * a) * std::cos(1.5 * b) - 0.04 * c * c << "\n";
+    }
+  }
+  CommandResult r = run("train --data " + path("smooth.csv") + " --out " + path("gp.h5") + " --restarts 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("noise variance is at its lower bound"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meets the tolerances"), std::string::npos) << r.output;
+  r = run("describe " + path("gp.h5"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("measured bound: mu"), std::string::npos) << r.output;
+  r = run("predict --model " + path("gp.h5") + " --p 800MPa --v 100m/min --T 500C");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(fast evaluator)"), std::string::npos) << r.output;
+}
+
+// Data that cannot be a model's are refused before anything runs, naming the file, line or column
+// (issue 30): an extra column, a misspelt input, a μ outside the μ range, a range excluding the
+// data, a plan below absolute zero.
+TEST_F(Cli, DataThatCannotBeAModelsDataIsRefusedByName) {
+  std::ofstream(path("extra.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],run_id,mu\n"
+                                      "800,100,500,1,0.2\n900,120,400,2,0.25\n";
+  CommandResult r = run("train --data " + path("extra.csv") + " --out " + path("m.h5"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("column 'run_id' is not a model input"), std::string::npos) << r.output;
+  std::ofstream(path("big.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n"
+                                    "800,100,500,0.2\n900,120,400,5.0\n";
+  r = run("train --data " + path("big.csv") + " --out " + path("m.h5"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("big.csv: converged sample 2, column mu: 5 is outside the model's mu range [0, 1]"),
+            std::string::npos) << r.output;
+  std::ofstream(path("ok.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu\n"
+                                   "800,100,500,0.2\n900,120,400,0.25\n";
+  r = run("train --data " + path("ok.csv") + " --out " + path("m.h5") + " --mu-range 0.3 0.4");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("given by --mu-range"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(path("m.h5")));
+  r = run("dataset plan --out " + path("p.h5") + " --samples 4 --T -400C:25C");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--T '-400C:25C': -400°C is below absolute zero"), std::string::npos) << r.output;
+  r = run("dataset plan --out " + path("p.h5") + " --samples 4 --p -500MPa:-100MPa");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("-500MPa is below 0MPa"), std::string::npos) << r.output;
+}
+
+// A point without an answer says which input and why, and predict exits 2; --csv answers many points
+// as a CSV with a status and reason per row (issue 30 items 4 and the small ones).
+TEST_F(Cli, PredictSaysWhyAPointHasNoAnswerAndAnswersACsv) {
+  ASSERT_EQ(run("law seward --table 4 --out " + path("law.h5")).exit_code, 0);
+  CommandResult r = run("predict --model " + path("law.h5") + " --p 10000MPa --v 10m/min --angle 90deg --extrapolation refuse");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("mufric: error: OUT_OF_BOX: contact_pressure: 1e+04MPa is above the box"), std::string::npos)
+      << r.output;
+  r = run("predict --model " + path("law.h5") + " --p -5MPa --v 10m/min --angle 90deg");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("INVALID_INPUT: contact_pressure: -5MPa is below 0MPa"), std::string::npos) << r.output;
+  r = run("predict --model " + path("law.h5") + " --p 10000MPa --v 10m/min --angle 270deg");
+  EXPECT_EQ(r.exit_code, 0) << r.output;  // clamped: answered, and says why it is EXTRAPOLATED
+  EXPECT_NE(r.output.find("outside the training box: contact_pressure"), std::string::npos) << r.output;
+  r = run("predict --model " + path("law.h5") + " --p 80MPa --v 10m/min --angle 270deg");
+  EXPECT_NE(r.output.find("status OK"), std::string::npos) << r.output;  // 270° is 90°: inside
+  std::ofstream(path("points.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],fibre_angle[deg]\n"
+                                       "80,10,90\n-5,10,90\n";
+  r = run("predict --model " + path("law.h5") + " --csv " + path("points.csv") + " --out " + path("answers.csv"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("points.csv: line 3: INVALID_INPUT"), std::string::npos) << r.output;
+  const std::string answers = read_text(path("answers.csv"));
+  EXPECT_NE(answers.find("mu,std,lo,hi,status,reason"), std::string::npos) << answers;
+  EXPECT_NE(answers.find("80,10,90,0.221001"), std::string::npos) << answers;  // Table 4 at 90°, as above
+  EXPECT_NE(answers.find("INVALID_INPUT,\"contact_pressure: -5MPa"), std::string::npos) << answers;
+}
+
 TEST_F(Cli, NumberWithoutUnitNamesTheFlag) {
   ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("c.h5")).exit_code, 0);
   const CommandResult r = run("predict --model " + path("c.h5") + " --p 800 --v 100m/min --T 500C");
@@ -252,6 +338,10 @@ TEST_F(Cli, ServeAnswersPredictOverGrpcAndDrainsOnSigterm) {
   const CommandResult r = run("predict --model grpc://" + address + "/law --p 80MPa --v 10m/min --angle 90deg");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mu = 0.221001"), std::string::npos) << r.output;
+  const CommandResult described = run("describe grpc://" + address + "/law");
+  EXPECT_EQ(described.exit_code, 0) << described.output;
+  EXPECT_NE(described.output.find("kind mlr"), std::string::npos) << described.output;
+  EXPECT_NE(described.output.find("contact_pressure"), std::string::npos) << described.output;
   const CommandResult missing = run("predict --model grpc://" + address + "/other --p 80MPa --v 10m/min --angle 90deg");
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_NE(missing.output.find("NOT_FOUND"), std::string::npos) << missing.output;

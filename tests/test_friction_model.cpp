@@ -140,5 +140,41 @@ TEST(FrictionModel, AClampedIntervalGrowsWithTheDistanceFromTheBox) {
   }
 }
 
+
+// A fibre angle repeats every 180°: 270° and −90° lie in a 0°–90° box, 100° does not (issue 30).
+TEST(FrictionModel, AnAngleIsInsideItsBoxModulo180Degrees) {
+  const double deg = std::numbers::pi / 180.0;
+  const InputSpec angle{"fibre_angle", "rad", 0.0, 90.0 * deg};
+  EXPECT_TRUE(angle.contains(270.0 * deg));
+  EXPECT_TRUE(angle.contains(-90.0 * deg));
+  EXPECT_TRUE(angle.contains(180.0 * deg));
+  EXPECT_FALSE(angle.contains(100.0 * deg));
+  EXPECT_FALSE(angle.contains(-10.0 * deg));
+  EXPECT_FALSE(angle.contains(std::nan("")));
+  const InputSpec pressure{"contact_pressure", "Pa", 0.0, 90.0 * deg};  // not periodic
+  EXPECT_FALSE(pressure.contains(270.0 * deg));
+}
+
+// Why a point is not OK names the input, the side and the value in human units; a response's message
+// names the first unanswered point and counts the others.
+TEST(FrictionModel, PointReasonsNameTheInputAndTheSide) {
+  const InputSpace box = default_friction_box();
+  const double inside[] = {800e6, 1.0, 700.0}, above[] = {10000e6, 1.0, 700.0}, below[] = {800e6, 0.1, 700.0},
+               negative[] = {-5e6, 1.0, 700.0};
+  EXPECT_EQ(point_reason(box, inside), "");
+  EXPECT_EQ(point_reason(box, above), "contact_pressure: 1e+04MPa is above the box (300MPa to 1300MPa)");
+  EXPECT_EQ(point_reason(box, below), "sliding_velocity: 6m/min is below the box (22.5m/min to 200m/min)");
+  EXPECT_EQ(point_reason(box, negative), "contact_pressure: -5MPa is below 0MPa, the least a pressure can be");
+  QueryBatch x(3, 3);
+  x.row(0) = Eigen::Map<const Eigen::RowVector3d>(inside);
+  x.row(1) = Eigen::Map<const Eigen::RowVector3d>(negative);
+  x.row(2) = Eigen::Map<const Eigen::RowVector3d>(above);
+  const std::vector<PointStatus> status{PointStatus::ok, PointStatus::invalid_input, PointStatus::out_of_box};
+  EXPECT_EQ(unanswered_points_message(box, x, status),
+            "point 1 INVALID_INPUT: contact_pressure: -5MPa is below 0MPa, the least a pressure can be (and 1 more "
+            "points without an answer)");
+  EXPECT_EQ(unanswered_points_message(box, x, {PointStatus::ok, PointStatus::ok, PointStatus::extrapolated}), "");
+}
+
 }  // namespace
 }  // namespace mufric
