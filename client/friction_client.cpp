@@ -8,6 +8,7 @@
 #include <atomic>
 #include <mutex>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <chrono>
 #include <thread>
@@ -26,10 +27,27 @@ const double* input_pointer(const Block& block, const std::string& name) {
   return field ? block.*field : nullptr;
 }
 
+// Options::fill: every output of a point without an answer gets the caller's value instead of NaN.
+// Chosen by the status, not by testing the value: isnan is quiet, but the caller may run with
+// FE_INVALID trapping, and nothing here should even look at a NaN in a way that could raise it.
+void fill_unanswered(Answer& answer, double value) {
+  const size_t points = answer.status.size();
+  const size_t gradient_width = points > 0 ? answer.gradient.size() / points : 0;
+  for (size_t i = 0; i < points; ++i) {
+    if (answer.status[i] != PointStatus::invalid_input && answer.status[i] != PointStatus::out_of_box) continue;
+    for (auto* output : {&answer.mu, &answer.std, &answer.lo, &answer.hi}) {
+      if (i < output->size()) (*output)[i] = value;
+    }
+    std::fill_n(answer.gradient.begin() + static_cast<std::ptrdiff_t>(i * gradient_width), gradient_width, value);
+  }
+}
+
 class InProcessClient final : public FrictionClient {
  public:
-  InProcessClient(const std::string& path, bool isolate)
-      : path_(path), model_(isolate ? load_model_isolated(path) : load_model(path)) {}
+  InProcessClient(const std::string& path, const Options& options)
+      : path_(path),
+        model_(options.isolate_file_parsing ? load_model_isolated(path) : load_model(path)),
+        fill_(options.fill) {}
 
   Answer evaluate(const Block& block, const EvaluationRequest& request) override {
     // Several threads of the caller at once (std::thread, MPI + threads: an OpenMP caller is caught
@@ -60,6 +78,9 @@ class InProcessClient final : public FrictionClient {
     }
     a.status = e.status;
     a.fast_points = e.fast_points;
+    a.range_clipped = e.range_clipped;
+    a.message = unanswered_points_message(inputs, x, a.status);  // the server's words for the same block
+    if (fill_) fill_unanswered(a, *fill_);
     return a;
   }
 
@@ -83,6 +104,7 @@ class InProcessClient final : public FrictionClient {
 
   std::string path_;
   std::unique_ptr<FrictionModel> model_;  // evaluation is const and keeps no state: safe from many threads
+  std::optional<double> fill_;
   std::atomic<int> in_flight_{0};
 };
 
@@ -167,9 +189,11 @@ class GrpcClient final : public FrictionClient {
       } else {
         call("Evaluate", [&](grpc::ClientContext* context) { return stub_->Evaluate(context, request, &response); });
       }
-      append(response, answer);
+      append(response, first, answer);
       if (block.points == 0) break;
     }
+    if (!answer.message.empty() && chunk < block.points) answer.message = block_message(answer);
+    if (options_.fill) fill_unanswered(answer, *options_.fill);
     return answer;
   }
 
@@ -250,7 +274,14 @@ class GrpcClient final : public FrictionClient {
     return request;
   }
 
-  static void append(const mufric::v1::EvaluateResponse& response, Answer& answer) {
+  // The server numbers points within its call: for a block split into calls, the first message is
+  // renumbered as the block's point and its count of further points made the block's, so the
+  // caller reads what an in-process evaluation of the whole block says. The first call with a
+  // message comes first (calls go in order), so its first point is the block's first.
+  static void append(const mufric::v1::EvaluateResponse& response, size_t first, Answer& answer) {
+    if (answer.message.empty() && !response.message().empty()) {
+      answer.message = renumbered(response.message(), first);
+    }
     answer.model = response.model();
     answer.version = response.version();
     answer.mu.insert(answer.mu.end(), response.mu().begin(), response.mu().end());
@@ -261,6 +292,32 @@ class GrpcClient final : public FrictionClient {
     answer.gradient_inputs.assign(response.gradient_inputs().begin(), response.gradient_inputs().end());
     for (const int s : response.status()) answer.status.push_back(static_cast<PointStatus>(s));
     answer.fast_points += static_cast<long long>(response.fast_points());
+    answer.range_clipped += static_cast<long long>(response.range_clipped_points());
+  }
+
+  // "point 3 OUT_OF_BOX: ..." of a call that started at block point `first`: "point 3+first ...".
+  // Anything not in that form (another server's words) is passed on as it is.
+  static std::string renumbered(const std::string& message, size_t first) {
+    constexpr std::string_view prefix = "point ";
+    if (first == 0 || message.rfind(prefix, 0) != 0) return message;
+    size_t index = 0;
+    const char* digits = message.data() + prefix.size();
+    const auto [end, ec] = std::from_chars(digits, message.data() + message.size(), index);
+    if (ec != std::errc() || end == digits) return message;
+    return std::string(prefix) + std::to_string(index + first) + std::string(end, message.data() + message.size());
+  }
+
+  // The whole block's count of further unanswered points in place of the first call's.
+  static std::string block_message(const Answer& answer) {
+    constexpr std::string_view more = " more points without an answer)";
+    std::string message = answer.message;
+    const auto tail = message.rfind(" (and ");
+    if (tail != std::string::npos && message.ends_with(more)) message.erase(tail);
+    const auto unanswered = std::count_if(answer.status.begin(), answer.status.end(), [](PointStatus s) {
+      return s == PointStatus::invalid_input || s == PointStatus::out_of_box;
+    });
+    if (unanswered > 1) message += " (and " + std::to_string(unanswered - 1) + std::string(more);
+    return message;
   }
 
   // One request, one response on the open stream; the stream is (re)opened as needed, and a stream
@@ -405,10 +462,13 @@ Options parse_options(std::string_view text, Options base) {
       o.mu_tolerance = number_option(key, value, 0.0, 1.0);
     } else if (key == "std_tolerance") {
       o.std_tolerance = number_option(key, value, 0.0, 1.0);
+    } else if (key == "fill") {
+      constexpr double largest = std::numeric_limits<double>::max();
+      o.fill = number_option(key, value, -largest, largest);  // finite: NaN or inf would defeat its purpose
     } else {
       throw InvalidArgument("option '" + key +
                             "' is unknown (known: deadline, retries, backoff, chunk_points, max_message_mb, stream, "
-                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation)");
+                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation, fill)");
     }
   }
   return o;
@@ -421,7 +481,7 @@ std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& o
     }
     return std::make_unique<GrpcClient>(server->target, server->model, server->tls, options);
   }
-  return std::make_unique<InProcessClient>(model_path_from_uri(uri), options.isolate_file_parsing);
+  return std::make_unique<InProcessClient>(model_path_from_uri(uri), options);
 }
 
 }  // namespace mufric::client

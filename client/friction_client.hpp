@@ -5,6 +5,7 @@
 //   grpcs://host:port/model  the same over TLS (mutual TLS with a client certificate)
 //   file:///path/model.h5    the same model evaluated in-process, no server (or a plain path)
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -47,6 +48,10 @@ struct Answer {
   std::vector<std::string> gradient_inputs;
   std::vector<PointStatus> status;
   long long fast_points = 0;  // answered by the model's fast evaluator; the rest by the exact model
+  long long range_clipped = 0;  // points whose μ or interval was clipped to the model's physical μ range
+  // "" when every point was answered; else the first point without an answer (INVALID_INPUT or
+  // OUT_OF_BOX, numbered in this block), which input and why, and how many more there are.
+  std::string message;
 };
 
 struct ModelInfo {
@@ -80,13 +85,18 @@ struct Options {
   double mu_tolerance = EvaluationRequest{}.mu_tolerance;
   double std_tolerance = EvaluationRequest{}.std_relative_tolerance;
   Extrapolation extrapolation = Extrapolation::model_default;  // raw, clamp or refuse outside the box
+  // Points without an answer (INVALID_INPUT, OUT_OF_BOX) get this finite value in every output (μ,
+  // σ, lo, hi, gradient) instead of NaN: a code that traps FE_INVALID must never be handed a NaN,
+  // and its status array still says which points these are. Applied to the Answer by both transports.
+  std::optional<double> fill;
 };
 
 // Options from text, for the C ABI and Fortran (and configuration files): "key=value" pairs separated
 // by commas, semicolons or blanks, e.g. "deadline=2, retries=1, stream=1, token=abc".
 // Keys: deadline (s), retries, backoff (s, the first), chunk_points, max_message_mb, stream (0/1),
 // token, tls_ca, tls_cert, tls_key (PEM file paths), mu_tolerance, std_tolerance (0: exact model),
-// extrapolation (raw, clamp or refuse; default: the model's own). Starts from `base`; throws InvalidArgument
+// extrapolation (raw, clamp or refuse; default: the model's own), fill (a finite number for the outputs
+// of points without an answer; default: NaN). Starts from `base`; throws InvalidArgument
 // naming the key or value it cannot use.
 Options parse_options(std::string_view text, Options base = {});
 

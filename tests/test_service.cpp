@@ -6,6 +6,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -116,6 +117,64 @@ TEST_F(Service, GrpcAnswersEqualInProcessAnswersAcrossChunks) {
   EXPECT_EQ(a.model, "gp");
   EXPECT_EQ(a.version.size(), 16u);
   EXPECT_EQ(remote->describe().inputs.size(), 3u);
+}
+
+// The points without an answer are told about in the same words by both transports: the first one
+// and why, numbered in the caller's block even when the client split it into several calls, and the
+// count of the others; range-clipped points are counted alike; fill=V replaces NaN in every output.
+TEST_F(Service, GrpcAndInProcessTellTheSameMessageAndCounts) {
+  LoopbackServer server(dir_);
+  client::Options options = client::parse_options("chunk_points=256, fill=-1");  // 1000 points → 4 calls
+  const auto remote = client::connect("grpc://" + server.address() + "/gp", options);
+  const auto local = client::connect("file://" + (dir_ / "gp.h5").string(), options);
+  Points pts = random_points(1000);
+  pts.p[300] = 5000e6;  // above the box, in the block's second call
+  pts.t[700] = -10.0;   // invalid, in the third
+  pts.v[999] = 1e-4;    // below the box, in the last
+  EvaluationRequest refuse{.std = true, .ci_level = 0.95, .gradient = true};
+  refuse.extrapolation = Extrapolation::refuse;
+  const client::Answer a = remote->evaluate(pts.block(), refuse), b = local->evaluate(pts.block(), refuse);
+  EXPECT_EQ(a.message, b.message);
+  EXPECT_EQ(a.message.rfind("point 300 OUT_OF_BOX: contact_pressure: 5000MPa is above the box", 0), 0u) << a.message;
+  EXPECT_NE(a.message.find("(and 2 more points without an answer)"), std::string::npos) << a.message;
+  EXPECT_EQ(a.status, b.status);
+  EXPECT_EQ(a.status[700], PointStatus::invalid_input);
+  for (const client::Answer* answer : {&a, &b}) {
+    for (const size_t i : {300u, 700u, 999u}) {
+      EXPECT_EQ(answer->mu[i], -1.0);
+      EXPECT_EQ(answer->std[i], -1.0);
+      EXPECT_EQ(answer->lo[i], -1.0);
+      EXPECT_EQ(answer->hi[i], -1.0);
+      EXPECT_EQ(answer->gradient[3 * i], -1.0);
+    }
+  }
+  EXPECT_EQ(a.mu, b.mu);
+  EXPECT_EQ(a.gradient, b.gradient);
+
+  // Alone in a call of its own, the same point is point 0; a block of answered points says nothing.
+  Points one = random_points(1);
+  one.p[0] = 5000e6;
+  EXPECT_EQ(remote->evaluate(one.block(), refuse).message, local->evaluate(one.block(), refuse).message);
+  EXPECT_EQ(remote->evaluate(one.block(), refuse).message.rfind("point 0 OUT_OF_BOX", 0), 0u);
+  EXPECT_EQ(remote->evaluate(random_points(10).block(), refuse).message, "");
+  EXPECT_EQ(local->evaluate(random_points(10).block(), refuse).message, "");
+
+  // The same GP declaring μ ≤ its median over these points: about half of them are clipped.
+  const Points inside = random_points(600);
+  std::vector<double> mu = local->evaluate(inside.block(), {}).mu;
+  std::nth_element(mu.begin(), mu.begin() + 300, mu.end());
+  {
+    auto narrow = std::unique_ptr<FrictionModel>(load_model((dir_ / "gp.h5").string()));
+    narrow->set_mu_range(0.0, mu[300]);
+    save_model((dir_ / "narrow.h5").string(), *narrow);
+  }
+  server.registry().refresh();
+  const EvaluationRequest interval{.ci_level = 0.95};
+  const long long clipped_remote =
+      client::connect("grpc://" + server.address() + "/narrow", options)->evaluate(inside.block(), interval).range_clipped;
+  EXPECT_EQ(clipped_remote,
+            client::connect("file://" + (dir_ / "narrow.h5").string())->evaluate(inside.block(), interval).range_clipped);
+  EXPECT_GE(clipped_remote, 300);
 }
 
 // --log-uncertain: exactly the queried points whose 95 % interval is wider than the threshold land
@@ -607,6 +666,10 @@ TEST(ClientOptions, ParsedFromTextNamingWhatIsWrong) {
   EXPECT_NE(refusal("retries=1.5").find("not a whole number"), std::string::npos);
   EXPECT_NE(refusal("stream=maybe").find("stream: 'maybe'"), std::string::npos);
   EXPECT_NE(refusal("stream").find("expected key=value"), std::string::npos);
+  EXPECT_EQ(client::parse_options("fill=-1").fill, -1.0);
+  EXPECT_FALSE(client::parse_options("").fill.has_value());
+  EXPECT_NE(refusal("fill=nan").find("fill: 'nan' is not a number"), std::string::npos) << refusal("fill=nan");
+  EXPECT_NE(refusal("fill=-inf").find("fill: '-inf' is not a number"), std::string::npos);
 }
 
 // A served model with a fast evaluator: the response and the status count the points it answered;
