@@ -7,10 +7,15 @@ module mufric
   use, intrinsic :: iso_c_binding
   implicit none
   private
-  public :: mufric_connect, mufric_error, c_mufric_evaluate, c_mufric_close
+  public :: mufric_connect, mufric_error, c_mufric_evaluate, c_mufric_close, c_mufric_evaluate_ex, c_mufric_box
   integer(c_int), parameter, public :: MUFRIC_OK = 0, MUFRIC_INVALID_ARGUMENT = 1, MUFRIC_FAILED = 2
   integer(c_int), parameter, public :: MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, &
                                        MUFRIC_POINT_INVALID_INPUT = 2, MUFRIC_POINT_OUT_OF_BOX = 3
+
+  ! One c_mufric_evaluate_ex call's counts over its points (mufric.h's mufric_counts).
+  type, bind(C), public :: mufric_counts
+    integer(c_size_t) :: extrapolated = 0, invalid = 0, out_of_box = 0, range_clipped = 0, fast_points = 0
+  end type
 
   interface
     function c_mufric_open(uri, client) bind(C, name="mufric_open") result(status)
@@ -38,6 +43,29 @@ module mufric
       type(c_ptr), value :: contact_pressure, sliding_velocity, temperature, fibre_angle
       real(c_double), value :: ci_level
       type(c_ptr), value :: mu, std, lo, hi, status
+      integer(c_int) :: code
+    end function
+    ! c_mufric_evaluate and two more outputs (c_null_ptr if not wanted): outside, c_loc of an
+    ! integer(c_int) array of length n, bit 2k (below) and 2k+1 (above the box) for input k = 0..3 in
+    ! argument order; counts, c_loc of a type(mufric_counts). Unanswered points' message: mufric_error().
+    function c_mufric_evaluate_ex(client, n, contact_pressure, sliding_velocity, temperature, fibre_angle, &
+                                  ci_level, mu, std, lo, hi, status, outside, counts) &
+        bind(C, name="mufric_evaluate_ex") result(code)
+      import :: c_ptr, c_size_t, c_double, c_int
+      type(c_ptr), value :: client
+      integer(c_size_t), value :: n
+      type(c_ptr), value :: contact_pressure, sliding_velocity, temperature, fibre_angle
+      real(c_double), value :: ci_level
+      type(c_ptr), value :: mu, std, lo, hi, status, outside, counts
+      integer(c_int) :: code
+    end function
+    ! The model's training box in argument order (pressure, velocity, temperature, fibre angle), SI;
+    ! used(k) = 1 for an input the model takes.
+    function c_mufric_box(client, used, lo, hi) bind(C, name="mufric_box") result(code)
+      import :: c_ptr, c_double, c_int
+      type(c_ptr), value :: client
+      integer(c_int), intent(out) :: used(4)
+      real(c_double), intent(out) :: lo(4), hi(4)
       integer(c_int) :: code
     end function
     function c_mufric_last_error() bind(C, name="mufric_last_error") result(message)

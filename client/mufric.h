@@ -35,7 +35,8 @@ enum mufric_status_code {
 };
 
 /* EXTRAPOLATED: outside the model's training box, answered (raw or clamp policy); OUT_OF_BOX: outside
- * it under the refuse policy, NaN outputs. */
+ * it under the refuse policy, NaN outputs (or the fill=V value). INVALID_INPUT: not a finite number or
+ * physically impossible (a negative pressure, speed or temperature), NaN outputs (or V). */
 enum mufric_point_status {
   MUFRIC_POINT_OK = 0,
   MUFRIC_POINT_EXTRAPOLATED = 1,
@@ -53,7 +54,10 @@ int mufric_open(const char* uri, mufric_client** client);
  *   (chunk_points: most points per call, default 65536; from 128 up cut to a multiple of 128, so
  *   that a point's std has the same bits as in-process however a block is split)
  *   stream=1          every mufric_evaluate on one long-lived stream of this handle (an explicit
- *                     code's increments: ~5x less overhead per call than unary calls; no deadline)
+ *                     code's increments; no deadline). Measured (bench/RESULTS.md, a 2-core AMD
+ *                     EPYC node, client and server on it): 1.6x less time per call than unary
+ *                     calls for ~11-point blocks (46 against 75 us), 49 against 73 us for one
+ *                     point; no gain for blocks of thousands of points, where evaluation dominates
  *   token=T           bearer token (else $MUFRIC_TOKEN)
  *   tls_ca=F, tls_cert=F, tls_key=F   PEM files for grpcs:// (else $MUFRIC_TLS_CA, ...)
  *   mu_tolerance=E, std_tolerance=R   a model's certified fast evaluator answers (inside its box)
@@ -64,18 +68,61 @@ int mufric_open(const char* uri, mufric_client** client);
  *                     distance from the box: the model's RMS error of that mu at the real point) or
  *                     refuse (OUT_OF_BOX, NaN); default:
  *                     the model file's policy (clamp unless it says otherwise)
+ *   fill=V            points without an answer (INVALID_INPUT, OUT_OF_BOX) get the finite value V
+ *                     in mu, std, lo and hi instead of NaN (e.g. fill=-1: no physical mu is
+ *                     negative); their status still says which they are. For codes that trap
+ *                     floating-point exceptions (see "Floating-point traps" below)
  * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
 int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);
 void mufric_close(mufric_client* client);
 
 /* n points. Inputs: NULL for inputs not sent (the model's own inputs are required). Outputs: NULL
  * for outputs not wanted; lo/hi need ci_level in (0, 1), else pass 0. status: one
- * mufric_point_status per point, or NULL. Invalid points get NaN outputs; the others are answered. */
+ * mufric_point_status per point, or NULL. Points without an answer (INVALID_INPUT, OUT_OF_BOX) get
+ * NaN outputs, or the fill=V value; the others are answered, and the call returns MUFRIC_OK. Its
+ * message (the first such point, the input and why) is then readable through mufric_last_error().
+ *
+ * Floating-point traps: a code that enables feenableexcept(FE_INVALID | FE_OVERFLOW | ...) must open
+ * its handle with fill=V, or be handed NaN (which it will trap on at its first comparison). With V,
+ * mufric's own code on the calling thread raises no FE_INVALID for such points either: they are told
+ * apart by their status and the box flags below by quiet comparisons (isless/isgreater), never by
+ * an ordered comparison with a NaN. Tested in-process and over gRPC with FE_INVALID, FE_OVERFLOW and
+ * FE_DIVBYZERO trapping (tests/clients/fp_traps.c). */
 int mufric_evaluate(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                     const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
                     double* lo, double* hi, int* status);
 
-/* The message of the last failure on this thread ("" if none). Valid until the next call. */
+/* What one mufric_evaluate_ex call met, counted over its n points. */
+typedef struct mufric_counts {
+  size_t extrapolated;  /* MUFRIC_POINT_EXTRAPOLATED: outside the box, answered (raw or clamp) */
+  size_t invalid;       /* MUFRIC_POINT_INVALID_INPUT */
+  size_t out_of_box;    /* MUFRIC_POINT_OUT_OF_BOX (extrapolation=refuse) */
+  size_t range_clipped; /* mu or its interval clipped to the model's physical range of mu */
+  size_t fast_points;   /* answered by the model's certified fast evaluator; the rest by the exact model */
+} mufric_counts;
+
+/* mufric_evaluate with two more outputs, each NULL if not wanted:
+ *   outside  n values; for input k in argument order (0 contact_pressure, 1 sliding_velocity,
+ *            2 temperature, 3 fibre_angle) bit 2k is set when the point's input lies below the model's
+ *            training box (mufric_box), bit 2k+1 when above; 0 for a point inside and for inputs the
+ *            model does not take. Outside as the model sees it: a fibre angle a half turn (180
+ *            degrees) away from a point of the box is inside. Set whatever the point's status (a
+ *            negative pressure is below the box too); a NaN input sets no bit.
+ *   counts   one struct, this call's counts.
+ * As for mufric_evaluate, a call with points without an answer returns MUFRIC_OK and leaves its
+ * message in mufric_last_error() ("" when every point was answered). */
+int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
+                       const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
+                       double* lo, double* hi, int* status, unsigned* outside, mufric_counts* counts);
+
+/* The model's training box, in the argument order of mufric_evaluate (contact_pressure,
+ * sliding_velocity, temperature, fibre_angle), SI: used[k] = 1 and lo[k] <= hi[k] for an input the
+ * model takes, used[k] = 0 and lo[k] = hi[k] = 0 for one it does not. Any of the three may be NULL.
+ * Read when the handle was opened (no call to the server). */
+int mufric_box(mufric_client* client, int used[4], double lo[4], double hi[4]);
+
+/* The message of the last failure on this thread, or of the last evaluation's points without an
+ * answer ("" if none). Valid until the next call. */
 const char* mufric_last_error(void);
 
 /* F77-style entry points (trailing underscore, every argument by reference, hidden string length

@@ -1,8 +1,10 @@
 // The C ABI over the C++ client: every exception stops here and becomes a status code.
+#include <array>
 #include <cmath>
 #include <exception>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "client/friction_client.hpp"
 #include "client/mufric.h"
@@ -11,6 +13,12 @@ struct mufric_client {
   std::unique_ptr<mufric::client::FrictionClient> impl;
   double mu_tolerance = 0.0, std_tolerance = 0.0;  // from the options (a fast evaluator's admission)
   mufric::Extrapolation extrapolation = mufric::Extrapolation::model_default;
+  // The model's training box in mufric_evaluate's argument order, read once at open (mufric_box,
+  // the outside flags); an input the model does not take is not used, with a box of [0, 0].
+  static constexpr std::array<std::string_view, 4> input_names{"contact_pressure", "sliding_velocity", "temperature",
+                                                               "fibre_angle"};
+  std::array<bool, 4> used{};
+  std::array<mufric::InputSpec, 4> box{};
 };
 
 namespace {
@@ -50,7 +58,14 @@ int mufric_open_with_options(const char* uri, const char* options, mufric_client
     handle->mu_tolerance = parsed.mu_tolerance;
     handle->std_tolerance = parsed.std_tolerance;
     handle->extrapolation = parsed.extrapolation;
-    handle->impl->describe();  // fail now, not at the first evaluation, if the model is not there
+    // Fails now, not at the first evaluation, if the model is not there.
+    for (const auto& input : handle->impl->describe().inputs) {
+      for (size_t k = 0; k < mufric_client::input_names.size(); ++k) {
+        if (input.name != mufric_client::input_names[k]) continue;
+        handle->used[k] = true;
+        handle->box[k] = input;
+      }
+    }
     *client = handle.release();
     last_error.clear();
     return MUFRIC_OK;
@@ -64,6 +79,13 @@ void mufric_close(mufric_client* client) { delete client; }
 int mufric_evaluate(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                     const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
                     double* lo, double* hi, int* status) {
+  return mufric_evaluate_ex(client, n, contact_pressure, sliding_velocity, temperature, fibre_angle, ci_level, mu, std,
+                            lo, hi, status, nullptr, nullptr);
+}
+
+int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
+                       const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
+                       double* lo, double* hi, int* status, unsigned* outside, mufric_counts* counts) {
   if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: client is NULL");
   if (mu == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: mu must not be NULL");
   const bool want_interval = lo != nullptr || hi != nullptr;
@@ -77,6 +99,8 @@ int mufric_evaluate(mufric_client* client, size_t n, const double* contact_press
     what.std_relative_tolerance = client->std_tolerance;
     what.extrapolation = client->extrapolation;
     const auto answer = client->impl->evaluate(block, what);
+    // Copies only: the outputs of points without an answer are NaN or the fill value, and nothing
+    // here compares them (a caller trapping FE_INVALID would die on an ordered comparison with NaN).
     for (size_t i = 0; i < n; ++i) {
       mu[i] = answer.mu[i];
       if (std) std[i] = answer.std[i];
@@ -84,13 +108,53 @@ int mufric_evaluate(mufric_client* client, size_t n, const double* contact_press
       if (hi) hi[i] = answer.hi[i];
       if (status) status[i] = static_cast<int>(answer.status[i]);
     }
-    last_error.clear();
+    if (outside) {
+      const std::array<const double*, 4> inputs{contact_pressure, sliding_velocity, temperature, fibre_angle};
+      for (size_t i = 0; i < n; ++i) {
+        unsigned bits = 0;
+        for (unsigned k = 0; k < 4; ++k) {
+          if (!client->used[k] || inputs[k] == nullptr) continue;
+          const double x = inputs[k][i];
+          const mufric::InputSpec& input = client->box[k];
+          // Outside as the model sees it (an angle a half turn away from the box is inside). A NaN
+          // sets no bit and is never compared: isnan, isless and isgreater are quiet, where an
+          // ordered comparison would raise FE_INVALID in a caller that traps it.
+          if (std::isnan(x) || input.contains(x)) continue;
+          if (std::isless(x, input.lo)) bits |= 1u << (2 * k);
+          if (std::isgreater(x, input.hi)) bits |= 1u << (2 * k + 1);
+        }
+        outside[i] = bits;
+      }
+    }
+    if (counts) {
+      *counts = mufric_counts{};
+      for (const auto s : answer.status) {
+        counts->extrapolated += s == mufric::PointStatus::extrapolated;
+        counts->invalid += s == mufric::PointStatus::invalid_input;
+        counts->out_of_box += s == mufric::PointStatus::out_of_box;
+      }
+      counts->range_clipped = static_cast<size_t>(answer.range_clipped);
+      counts->fast_points = static_cast<size_t>(answer.fast_points);
+    }
+    // A call with points without an answer succeeds; their message is what mufric_last_error says.
+    last_error = answer.message;
     return MUFRIC_OK;
   } catch (const mufric::client::InvalidArgument& e) {
     return fail(MUFRIC_INVALID_ARGUMENT, std::string("mufric_evaluate: ") + e.what());
   } catch (const std::exception& e) {
     return fail(MUFRIC_FAILED, std::string("mufric_evaluate: ") + e.what());
   }
+}
+
+int mufric_box(mufric_client* client, int used[4], double lo[4], double hi[4]) {
+  if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_box: client is NULL");
+  for (size_t k = 0; k < 4; ++k) {
+    if (used) used[k] = client->used[k] ? 1 : 0;
+    if (lo) lo[k] = client->box[k].lo;
+    if (hi) hi[k] = client->box[k].hi;
+  }
+  last_error.clear();
+  return MUFRIC_OK;
 }
 
 const char* mufric_last_error(void) { return last_error.c_str(); }
