@@ -93,6 +93,24 @@ TEST(Scene, NumbersJsonCannotHoldAreErrors) {
   }
 }
 
+// A draw whose window drifted beyond the threshold and a standard error from too few draws are
+// reported (issue 30: result.json said warnings: [] at 44.8 % drift and from 2 draws).
+TEST(MicroRun, MeasurementWarnsOfDriftAndOfAStandardErrorFromFewDraws) {
+  MuMeasurement m;
+  m.draws.resize(2);
+  m.draws[0].result.drift = 0.448;
+  m.draws[1].result.drift = -0.1;
+  add_measurement_warnings(m);
+  ASSERT_EQ(m.warnings.size(), 2u);
+  EXPECT_NE(m.warnings[0].find("draw 0: mu drifted by 44.8 %"), std::string::npos) << m.warnings[0];
+  EXPECT_NE(m.warnings[1].find("from 2 draws: it is itself uncertain by about +-71 %"), std::string::npos) << m.warnings[1];
+  MuMeasurement steady;
+  steady.draws.resize(kFewDrawsForStdError);
+  for (auto& d : steady.draws) d.result.drift = kDriftWarningFraction * 0.99;
+  add_measurement_warnings(steady);
+  EXPECT_TRUE(steady.warnings.empty());
+}
+
 TEST(MicroRun, FlatToolTransmitsNoTangentialForce) {
   nlohmann::json j = small_scene();
   j["geometry"]["tool_surface"] = {{"flat", true}, {"fit", {{"degree", 3}, {"control_points", 32}}}};

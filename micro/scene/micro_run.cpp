@@ -564,6 +564,31 @@ double MuMeasurement::max_abs_drift() const {
   return d;
 }
 
+void add_measurement_warnings(MuMeasurement& m) {
+  const double n = static_cast<double>(m.draws.size());
+  for (size_t i = 0; i < m.draws.size(); ++i) {
+    const double drift = m.draws[i].result.drift;
+    if (std::abs(drift) > kDriftWarningFraction) {
+      char text[256];
+      std::snprintf(text, sizeof text,
+                    "draw %zu: mu drifted by %.1f %% of mu across its averaging window (first to last block mean, "
+                    "warning above %.0f %%): the slide may not be steady; a longer protocol.window or more draws",
+                    i, 100.0 * drift, 100.0 * kDriftWarningFraction);
+      m.warnings.emplace_back(text);
+    }
+  }
+  if (m.draws.size() > 1 && m.draws.size() < kFewDrawsForStdError) {
+    // The relative standard error of a sample standard deviation from n draws is ≈ 1/√(2(n − 1))
+    // (normal draws; Kendall & Stuart, The Advanced Theory of Statistics, Vol. 1, §10.8).
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the standard error of mu comes from %zu draws: it is itself uncertain by about +-%.0f %%; "
+                  "%zu or more draws make it a figure to rely on",
+                  m.draws.size(), 100.0 / std::sqrt(2.0 * (n - 1.0)), kFewDrawsForStdError);
+    m.warnings.emplace_back(text);
+  }
+}
+
 MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   MuMeasurement m;
@@ -631,6 +656,7 @@ MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
       for (double x : values) squares += (x - m.mu) * (x - m.mu);
       m.std_error = std::sqrt(squares / (n - 1.0) / n);  // sample standard deviation / √n
     }
+    add_measurement_warnings(m);
   }
   m.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return m;

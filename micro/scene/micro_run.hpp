@@ -107,6 +107,14 @@ struct MeasurementTotals {
   nlohmann::json to_json() const;
 };
 
+// A draw whose μ moves by more than this fraction of μ between the first and the last block of its
+// averaging window is reported: its window may not have reached a steady slide (issue 30 saw 44.8 %;
+// the default dry scene at the box centre drifts by 27-36 % within its 2.5 um window, a sign of the
+// roughness passing under a 10 um cell, so the warning starts above that).
+inline constexpr double kDriftWarningFraction = 0.4;
+// A standard error from fewer draws than this is reported as itself uncertain (±71 % from 2 draws, ±50 % from 3).
+inline constexpr size_t kFewDrawsForStdError = 4;
+
 // μ as a property of (p, v, T, roughness statistics): the mean over the draws, with the standard
 // error of that mean (sample standard deviation / √draws; none for a single draw).
 struct MuMeasurement {
@@ -136,6 +144,9 @@ std::vector<Draw> protocol_draws(const Scene& scene);
 // The scene of one draw.
 Scene draw_scene(const Scene& scene, const Draw& draw);
 MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options = {});
+// Warnings of a completed measurement: a draw whose window drifted by more than kDriftWarningFraction,
+// a standard error from fewer than kFewDrawsForStdError draws.
+void add_measurement_warnings(MuMeasurement& m);
 
 // The chip surface and the tool surface as fitted periodic curves, the tool placed above the chip
 // at the scene's initial gap.
