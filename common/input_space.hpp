@@ -17,8 +17,9 @@ struct InputSpec {
   QuantityKind kind() const { return kind_of_input(name); }
   // An angle repeats every 180° (a ply at θ and θ + 180° is the same ply): 270° lies in a box of
   // 0°–90°. Other inputs: the closed interval [lo, hi].
+  // Quiet comparisons: a NaN is outside without raising FE_INVALID in a caller that traps it.
   bool contains(double value) const {
-    if (value >= lo && value <= hi) return true;
+    if (std::isgreaterequal(value, lo) && std::islessequal(value, hi)) return true;
     if (kind() != QuantityKind::angle || !std::isfinite(value)) return false;
     constexpr double kHalfTurn = 3.14159265358979323846;
     const double wrapped = lo + (value - lo) - kHalfTurn * std::floor((value - lo) / kHalfTurn);

@@ -145,7 +145,7 @@ struct LocalOptimum {
 // One bounded L-BFGS run (NLopt's NLOPT_LD_LBFGS, Liu & Nocedal 1989) from `start`.
 LocalOptimum maximise(LogMarginalLikelihood& lml, const Eigen::VectorXd& start, const GpTrainingOptions& options,
                       const LogBounds& bounds, TrainingProgress* progress = nullptr, std::string label = {}) {
-  StartContext ctx{&lml, 0, {}, kFailedLml, start};
+  StartContext ctx{.lml = &lml, .best_theta = start};
   ctx.progress = progress;
   ctx.progress_seconds = options.progress_seconds;
   ctx.label = std::move(label);

@@ -72,6 +72,30 @@ TEST(Scene, ErrorsNameTheKey) {
 // Regression (fuzz_scene_json): a number JSON cannot hold (1e999...) threw nlohmann's out_of_range,
 // which nothing caught, from a scene file and from a --set override. Both are now an Error or a
 // value the key's own check refuses; the fuzzer's inputs are replayed as a file and as an override.
+// A scene that cannot fit is refused before it runs, with its estimate; the estimate of the default
+// scene is its closed form: 2 · 64 · (12 + 2) unknowns, 2 · 25 nonzeros per row (issue 30: 100 000 ×
+// 10 000 elements started and sat in the spline setup with no output).
+TEST(Scene, ASceneThatCannotFitIsRefusedWithItsEstimate) {
+  const Scene base = scene_with_overrides(default_scene_json(), {}, "default");
+  const SceneCost cost = estimate_scene_cost(base);
+  EXPECT_EQ(cost.dofs, 2 * 64 * (12 + 2));
+  EXPECT_EQ(cost.stiffness_nonzeros, cost.dofs * 2 * 25);
+  EXPECT_LT(cost.memory_lower_bound_bytes, 10e6);
+  try {
+    scene_with_overrides(default_scene_json(), {"discretisation.elements_x=100000", "discretisation.elements_y=10000"},
+                         "big");
+    ADD_FAILURE() << "a 1e9-element scene was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("big: discretisation: 100000 x 10000 elements of degree 2"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("need at least"), std::string::npos) << e.what();
+  }
+  const Scene dry = scene_with_overrides(default_scene_json(), {"lubricant.viscosity=0.1"}, "dry");
+  ASSERT_EQ(dry.warnings.size(), 1u);
+  EXPECT_NE(dry.warnings[0].find("lubricant.* is read but has no effect"), std::string::npos);
+  EXPECT_TRUE(base.warnings.empty());
+}
+
 TEST(Scene, NumbersJsonCannotHoldAreErrors) {
   EXPECT_THROW(scene_with_overrides(default_scene_json(), {"load.pressure=1e999"}, "test"), Error);
   const std::string path = (std::filesystem::temp_directory_path() / "mufric_overflow_scene.json").string();

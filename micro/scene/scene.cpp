@@ -1,5 +1,7 @@
 #include "micro/scene/scene.hpp"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -330,7 +332,43 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     v.finish();
   }
   root.finish();
+  if (s.physics == "dry" && j.contains("lubricant")) {
+    s.warnings.push_back("lubricant.* is read but has no effect: the scene's physics is dry (physics=lubricated to use it)");
+  }
+  const SceneCost cost = estimate_scene_cost(s);
+  if (cost.memory_lower_bound_bytes > physical_memory_bytes()) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "%d x %d elements of degree %d (%lld unknowns) need at least %.3g GB for the stiffness and the "
+                  "quadrature state alone, more than this machine's %.3g GB (`mufric micro check` prints the estimate)",
+                  s.elements_x, s.elements_y, s.degree, cost.dofs, cost.memory_lower_bound_bytes / 1e9,
+                  physical_memory_bytes() / 1e9);
+    throw Error(source + ": discretisation: " + text);
+  }
   return s;
+}
+
+SceneCost estimate_scene_cost(const Scene& scene) {
+  // A periodic B-spline of degree p on n spans has n functions along x and n + p across; each
+  // function overlaps (2p + 1)² others in 2D, for each of 2 displacement components.
+  constexpr double kBytesPerNonzero = 8.0 + 4.0;         // value and column index (CSC/CSR)
+  constexpr double kStateDoublesPerQuadraturePoint = 24; // plastic strain, back state, temperature, history
+  constexpr double kVectorsPerDof = 12;                  // displacement, velocity, acceleration, residual, ...
+  SceneCost c;
+  const auto p = static_cast<long long>(scene.degree);
+  c.elements = static_cast<long long>(scene.elements_x) * scene.elements_y;
+  c.dofs = 2LL * scene.elements_x * (scene.elements_y + p);
+  const long long overlap = (2 * p + 1) * (2 * p + 1);
+  c.stiffness_nonzeros = c.dofs * 2 * overlap;
+  const double quadrature_points = static_cast<double>(c.elements) * static_cast<double>((p + 1) * (p + 1));
+  c.memory_lower_bound_bytes = static_cast<double>(c.stiffness_nonzeros) * kBytesPerNonzero +
+                               quadrature_points * kStateDoublesPerQuadraturePoint * 8.0 +
+                               static_cast<double>(c.dofs) * kVectorsPerDof * 8.0;
+  return c;
+}
+
+double physical_memory_bytes() {
+  return static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
 }
 
 nlohmann::json default_scene_json() {

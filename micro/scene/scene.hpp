@@ -160,7 +160,21 @@ struct Scene {
   solid::LinearSolverKind linear_solver = solid::LinearSolverKind::cholesky;  // falls back to LU per matrix
 
   nlohmann::json effective;  // the scene as read, with overrides applied (for the result's provenance)
+  std::vector<std::string> warnings;  // keys read but without effect (lubricant.* in a dry scene)
 };
+
+// What a scene costs before it runs: unknowns, stored nonzeros and a lower bound of the memory the
+// solid's stiffness, its quadrature state and its vectors take (the factor and the lubricant come
+// on top), so that a scene that cannot fit is refused before it starts.
+struct SceneCost {
+  long long elements = 0;
+  long long dofs = 0;             // solid displacement unknowns
+  long long stiffness_nonzeros = 0;
+  double memory_lower_bound_bytes = 0.0;
+};
+SceneCost estimate_scene_cost(const Scene& scene);
+// The machine's physical memory, bytes.
+double physical_memory_bytes();
 
 // Reads a scene file (JSON); relative CSV paths are relative to the file. Throws Error naming the
 // file and key.
