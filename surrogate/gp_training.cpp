@@ -54,7 +54,7 @@ class TrainingProgress {
 };
 
 struct StartContext {
-  LogMarginalLikelihood* lml;
+  LogMarginalLikelihood* lml = nullptr;
   int evaluations = 0;
   std::string last_failure;
   double best_lml = kFailedLml;
@@ -145,7 +145,9 @@ struct LocalOptimum {
 // One bounded L-BFGS run (NLopt's NLOPT_LD_LBFGS, Liu & Nocedal 1989) from `start`.
 LocalOptimum maximise(LogMarginalLikelihood& lml, const Eigen::VectorXd& start, const GpTrainingOptions& options,
                       const LogBounds& bounds, TrainingProgress* progress = nullptr, std::string label = {}) {
-  StartContext ctx{.lml = &lml, .best_theta = start};
+  StartContext ctx;
+  ctx.lml = &lml;
+  ctx.best_theta = start;
   ctx.progress = progress;
   ctx.progress_seconds = options.progress_seconds;
   ctx.label = std::move(label);
