@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
-#include "common/dataset_generation.hpp"
+#include "campaign/dataset_generation.hpp"
 #include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <set>
 
-#include "common/dataset_generation.hpp"
+#include "campaign/dataset_generation.hpp"
 #include "common/error.hpp"
 
 namespace mufric {

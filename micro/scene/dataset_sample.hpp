@@ -2,7 +2,8 @@
 // One dataset sample = one micro-model run of a scene at a plan point: the plan's inputs set the
 // scene's load (contact_pressure → load.pressure, sliding_velocity → load.velocity, temperature →
 // load.temperature); μ and the run's diagnostics become the sample.
-#include "common/dataset_generation.hpp"
+#include "common/input_space.hpp"
+#include "common/sample_outcome.hpp"
 #include "micro/scene/scene.hpp"
 
 namespace mufric::scene {

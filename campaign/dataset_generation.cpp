@@ -1,4 +1,4 @@
-#include "common/dataset_generation.hpp"
+#include "campaign/dataset_generation.hpp"
 
 #include <atomic>
 #include <chrono>

@@ -7,12 +7,12 @@
 // separate files, combined afterwards by merge_datasets.
 #include <cstdint>
 #include <functional>
-#include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "common/dataset_file.hpp"
+#include "common/sample_outcome.hpp"
 
 namespace mufric {
 
@@ -21,20 +21,6 @@ struct Shard {
 };
 // "i/N" with 0 ≤ i < N; throws Error naming `field`.
 Shard parse_shard(const std::string& text, const std::string& field = "--shard");
-
-struct SampleOutcome {
-  bool converged = false;
-  double mu = std::numeric_limits<double>::quiet_NaN();
-  double mu_std = std::numeric_limits<double>::quiet_NaN();  // μ's standard error (NaN: not known)
-  std::string failure_reason;                 // why not converged
-  // A converged sample outside what the model describes (a molten chip): stored with status
-  // outside_model and these sentences as its reason, and never trained on.
-  std::vector<std::string> warnings;
-  std::map<std::string, double> diagnostics;  // SI, named as in /samples/diagnostics
-};
-// Evaluates one point (SI, in the plan's input order). May throw: the sample is then recorded as
-// failed with the exception's message.
-using SampleEvaluator = std::function<SampleOutcome(const Eigen::VectorXd& x)>;
 
 struct GenerationProgress {
   long long finished = 0;   // samples of this invocation finished so far
