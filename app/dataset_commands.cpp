@@ -1,4 +1,6 @@
-// `mufric dataset plan / run / merge`: the micro-model as a dataset factory.
+// `mufric dataset plan / run / refine / status / merge`: the micro-model as a dataset factory. The
+// work (generation, merge, refine) is campaign/'s; here flags are parsed, the micro-model is wired in
+// as the sample evaluator, and progress is printed.
 #include <unistd.h>
 
 #include <cmath>
@@ -7,23 +9,19 @@
 #include <map>
 #include <set>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/commands.hpp"
 #include "campaign/dataset_generation.hpp"
+#include "campaign/refine.hpp"
 #include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
 #include "micro/scene/dataset_sample.hpp"
 #include "micro/scene/micro_run.hpp"
-#include "common/csv_table.hpp"
 #include "surrogate/accuracy.hpp"
-#include "surrogate/active_learning.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
 #include "surrogate/sampling.hpp"
 
 namespace mufric::app {
@@ -175,152 +173,47 @@ void run_command(const RunOptions& o) {
               o.db.c_str(), r.planned, r.already_done, r.ran, r.converged, r.failed, duration_text(r.seconds).c_str());
 }
 
-struct RefineOptions {
-  std::string db, test, candidates_csv, model_out;
-  bool grow = false;
-  double grow_coverage = 1.0;
+struct RefineCommandOptions {
+  RefineOptions refine;  // db, budget, batch, candidates, growth, jobs, seed, ...
+  int threads = 0;
   double sample_timeout = 0.0;  // s, 0: none
-  long long budget = 0;
-  int batch = 8, jobs = 1, threads = 0, restarts = 2;
-  long long candidate_count = 4096;
-  unsigned long long seed = 1;
 };
 
-// The rows of a CSV with unit headers, such as the server's --log-uncertain file, in the box's
-// input order (SI).
-Eigen::MatrixXd csv_candidates(const std::string& path, const InputSpace& box) {
-  const CsvTable table = read_csv_table(path);
-  Eigen::MatrixXd rows(static_cast<Eigen::Index>(table.rows.size()), static_cast<Eigen::Index>(box.size()));
-  for (size_t j = 0; j < box.size(); ++j) {
-    const std::vector<double> column = table.si_column(box[j].name);
-    for (size_t i = 0; i < column.size(); ++i) rows(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = column[i];
-  }
-  return rows;
-}
-
-bool row_inside(const InputSpace& box, const Eigen::MatrixXd& rows, Eigen::Index i) {
-  for (size_t j = 0; j < box.size(); ++j) {
-    if (!box[j].contains(rows(i, static_cast<Eigen::Index>(j)))) return false;
-  }
-  return true;
-}
-
-// Candidate points: a Sobol' set in the box (shifted per round), plus the CSV's rows inside the box
-// (the plan box is what the micro-model is run on; --grow-box moves it toward the others first).
-Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box, int round) {
-  Eigen::MatrixXd c = plan_in_box(PlanDesign::sobol, o.candidate_count, box, o.seed + static_cast<unsigned long long>(round));
-  if (o.candidates_csv.empty()) return c;
-  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, box);
-  std::vector<Eigen::Index> inside;
-  for (Eigen::Index i = 0; i < logged.rows(); ++i) {
-    if (row_inside(box, logged, i)) inside.push_back(i);
-  }
-  Eigen::MatrixXd all(c.rows() + static_cast<Eigen::Index>(inside.size()), c.cols());
-  all.topRows(c.rows()) = c;
-  for (size_t k = 0; k < inside.size(); ++k) all.row(c.rows() + static_cast<Eigen::Index>(k)) = logged.row(inside[k]);
-  return all;
-}
-
-std::string box_text(const InputSpace& box) {
-  std::string text;
-  char cell[160];
-  for (const auto& in : box) {
-    std::snprintf(cell, sizeof cell, "%s%s %.6g..%.6g %s", text.empty() ? "" : ", ", in.name.c_str(), in.lo, in.hi, in.unit.c_str());
-    text += cell;
-  }
-  return text;
-}
-
-// --grow-box: the plan's box grows toward the candidates (where the meso code asks), and the change is
-// recorded in the database's /plan/box_history; samples already run stay valid (the old box is inside).
-void grow_plan_box(const RefineOptions& o, Dataset& db) {
-  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, db.inputs);
-  const InputSpace grown = grow_box(db.inputs, logged, o.grow_coverage);
-  long long outside = 0;
-  for (Eigen::Index i = 0; i < logged.rows(); ++i) outside += !row_inside(db.inputs, logged, i);
-  if (same_input_space(grown, db.inputs)) {
-    std::printf("%s: the box already covers the candidates of %s (%lld rows); not grown\n", o.db.c_str(),
-                o.candidates_csv.c_str(), static_cast<long long>(logged.rows()));
-    return;
-  }
-  char head[128];
-  std::snprintf(head, sizeof head, "%s: grown by dataset refine --grow-box (coverage %g) toward %lld of %lld rows of ",
-                utc_timestamp().c_str(), o.grow_coverage, outside, static_cast<long long>(logged.rows()));
-  const std::string record = head + o.candidates_csv + " outside: " + box_text(db.inputs) + " -> " + box_text(grown);
-  db.inputs = grown;
-  db.box_history.push_back(record);
-  write_dataset(o.db, db);
-  std::printf("%s: box %s\n", o.db.c_str(), record.c_str());
-  std::fflush(stdout);
-}
-
-// `test` is the held-out set (null without --test).
-void report_round(int round, const GaussianProcess& gp, const TrainingSet& data, const TrainingSet* test) {
-  const auto& sum = gp.state().summary;
-  std::printf("round %d: %lld training samples, LOO mean relative error %.3f %%, max %.3f %%", round,
-              static_cast<long long>(data.x.rows()), 100.0 * sum.loo_mean_relative_error, 100.0 * sum.loo_max_relative_error);
-  if (test != nullptr) {
-    const AccuracyReport r = held_out_accuracy(gp, *test, 0.95);
-    std::printf("; held-out (%s, %lld points) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", test->source_path.c_str(),
-                r.points, 100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, 100.0 * r.coverage);
-  }
-  std::printf("\n");
-  std::fflush(stdout);
-}
-
-void refine_command(const RefineOptions& o) {
-  Dataset db = read_dataset_isolated(o.db);
-  if (db.plan.rows() == 0 || db.plan_index.size() != static_cast<size_t>(db.size())) {
-    throw Error(o.db + ": not a micro-model database (no plan rows); start with mufric dataset plan and run");
-  }
-  if (o.grow) grow_plan_box(o, db);
-  const scene::Scene sc = run_scene("", {}, db, o.db);
-  const SampleEvaluator evaluate =
-      scene::micro_evaluator(sc, db.inputs, threads_per_job(o.jobs, o.threads), o.sample_timeout);
-  std::optional<TrainingSet> test;
-  if (!o.test.empty()) test = training_set(read_dataset_isolated(o.test), o.test);
-  GpTrainingOptions training;
-  training.restarts = o.restarts;
-  training.seed = o.seed;
-  long long spent = 0;
-  for (int round = 1;; ++round) {
-    const TrainingSet data = training_set(db, o.db);
-    const GaussianProcess gp = train_gaussian_process(data, training);
-    report_round(round, gp, data, test ? &*test : nullptr);
-    if (!o.model_out.empty()) save_model(o.model_out, gp);
-    if (spent >= o.budget) break;
-    const int batch = static_cast<int>(std::min<long long>(o.batch, o.budget - spent));
-    const Eigen::MatrixXd candidates = refine_candidates(o, db.inputs, round);
-    std::vector<Eigen::Index> failed_rows;
-    for (Eigen::Index i = 0; i < db.size(); ++i) {
-      if (!db.converged(i)) failed_rows.push_back(i);
+void refine_command(const RefineCommandOptions& c) {
+  RefineOptions o = c.refine;
+  // The samples: the micro-model with the database's scene, on the (possibly grown) box's inputs.
+  o.make_evaluator = [&c](const Dataset& db) {
+    const scene::Scene sc = run_scene("", {}, db, c.refine.db);
+    return scene::micro_evaluator(sc, db.inputs, threads_per_job(c.refine.jobs, c.threads), c.sample_timeout);
+  };
+  o.on_box = [&o](const BoxGrowth& g) {
+    if (!g.grown) {
+      std::printf("%s: the box already covers the candidates of %s (%lld rows); not grown\n", o.db.c_str(),
+                  o.candidates_csv.c_str(), g.candidate_rows);
+      return;
     }
-    Eigen::MatrixXd failed(static_cast<Eigen::Index>(failed_rows.size()), db.x.cols());
-    for (size_t k = 0; k < failed_rows.size(); ++k) failed.row(static_cast<Eigen::Index>(k)) = db.x.row(failed_rows[k]);
-    const auto picks = pick_by_posterior_variance(gp, candidates, batch, failed);
-    // The picks become plan rows, so the database accounts for them like any planned point.
-    const Eigen::Index first = db.plan.rows();
-    db.plan.conservativeResize(first + static_cast<Eigen::Index>(picks.size()), Eigen::NoChange);
-    for (size_t k = 0; k < picks.size(); ++k) {
-      db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(picks[k].candidate);
-      std::printf("  pick %zu: plan row %lld, predicted std %.4f\n", k + 1, static_cast<long long>(first) + static_cast<long long>(k),
-                  picks[k].std_at_pick);
+    std::printf("%s: box %s\n", o.db.c_str(), g.record.c_str());
+    std::fflush(stdout);
+  };
+  o.on_round = [](const RefineRound& r) {
+    std::printf("round %d: %lld training samples, LOO mean relative error %.3f %%, max %.3f %%", r.round,
+                r.training_samples, 100.0 * r.loo_mean_relative_error, 100.0 * r.loo_max_relative_error);
+    if (r.held_out != nullptr) {
+      std::printf("; held-out (%s, %lld points) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", r.held_out_source.c_str(),
+                  r.held_out->points, 100.0 * r.held_out->mean_relative_error, 100.0 * r.held_out->max_relative_error,
+                  100.0 * r.held_out->coverage);
     }
-    if (db.plan_design.find("active") == std::string::npos) {
-      db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
-    }
-    write_dataset(o.db, db);
-    GenerationOptions options;
-    options.jobs = o.jobs;
-    options.on_sample = [&](const GenerationProgress& p) {
-      print_progress(p, db.inputs, db.plan.row(p.plan_row).transpose(), false);
-    };
-    const GenerationReport r = generate_dataset(db, o.db, evaluate, options);
-    spent += r.ran;
-    db = read_dataset_isolated(o.db);
-    if (r.ran == 0) break;  // nothing new could be run
-  }
-  std::printf("%s: %lld micro-model runs spent of a budget of %lld%s%s\n", o.db.c_str(), spent, o.budget,
+    std::printf("\n");
+    std::fflush(stdout);
+  };
+  o.on_pick = [](const RefinePick& k) {
+    std::printf("  pick %zu: plan row %lld, predicted std %.4f\n", k.number, k.plan_row, k.std_at_pick);
+  };
+  o.on_sample = [](const GenerationProgress& p, const InputSpace& inputs, const Eigen::VectorXd& x) {
+    print_progress(p, inputs, x, false);
+  };
+  const RefineReport r = refine_dataset(o);
+  std::printf("%s: %lld micro-model runs spent of a budget of %lld%s%s\n", o.db.c_str(), r.spent, o.budget,
               o.model_out.empty() ? "" : "; final model ", o.model_out.c_str());
 }
 
@@ -434,36 +327,36 @@ void add_dataset_commands(CLI::App& app) {
               "with mufric dataset merge.");
   run->callback([r] { run_command(*r); });
 
-  auto f = std::make_shared<RefineOptions>();
+  auto f = std::make_shared<RefineCommandOptions>();
   auto* refine = dataset->add_subcommand(
       "refine", "Active learning: run the micro-model where the surrogate is least certain, retrain, repeat");
-  refine->add_option("--db", f->db, "Micro-model database to extend (from dataset plan + run)")->required()->check(CLI::ExistingFile);
-  refine->add_option("--budget", f->budget, "Micro-model runs to spend")->required()->check(CLI::Range(0LL, 1000000LL));
-  refine->add_option("--batch", f->batch, "Runs per round (picked jointly, then run, then the GP is retrained)")
+  refine->add_option("--db", f->refine.db, "Micro-model database to extend (from dataset plan + run)")->required()->check(CLI::ExistingFile);
+  refine->add_option("--budget", f->refine.budget, "Micro-model runs to spend")->required()->check(CLI::Range(0LL, 1000000LL));
+  refine->add_option("--batch", f->refine.batch, "Runs per round (picked jointly, then run, then the GP is retrained)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
-  refine->add_option("--test", f->test, "Held-out database: its error is reported after every round")->check(CLI::ExistingFile);
-  auto* candidates = refine->add_option("--candidates", f->candidates_csv,
+  refine->add_option("--test", f->refine.test, "Held-out database: its error is reported after every round")->check(CLI::ExistingFile);
+  auto* candidates = refine->add_option("--candidates", f->refine.candidates_csv,
                                         "CSV of extra candidate points with unit headers, e.g. the server's "
                                         "--log-uncertain file (rows outside the box are left out unless --grow-box)")
                           ->check(CLI::ExistingFile);
-  refine->add_flag("--grow-box", f->grow,
+  refine->add_flag("--grow-box", f->refine.grow,
                    "First grow the plan's box toward the --candidates rows outside it (where the meso code asks); "
                    "the new box is recorded in the database (/plan/box_history, shown by dataset status)")
       ->needs(candidates);
-  refine->add_option("--grow-coverage", f->grow_coverage,
+  refine->add_option("--grow-coverage", f->refine.grow_coverage,
                      "With --grow-box: cover this quantile of the outside rows per input and side (0.99 ignores the "
                      "farthest 1 %, e.g. a meso code's spikes)")
       ->capture_default_str()->check(CLI::Range(1e-3, 1.0));
-  refine->add_option("--candidate-count", f->candidate_count, "Sobol' candidates per round")->capture_default_str()
+  refine->add_option("--candidate-count", f->refine.candidate_count, "Sobol' candidates per round")->capture_default_str()
       ->check(CLI::Range(16LL, 100000LL));
-  refine->add_option("--model-out", f->model_out, "Write the GP trained after each round here");
-  refine->add_option("--jobs", f->jobs, "Runs at once")->capture_default_str()->check(CLI::Range(1, 1024));
+  refine->add_option("--model-out", f->refine.model_out, "Write the GP trained after each round here");
+  refine->add_option("--jobs", f->refine.jobs, "Runs at once")->capture_default_str()->check(CLI::Range(1, 1024));
   refine->add_option("--threads", f->threads, "Threads per run (default: cores / jobs)")->check(CLI::Range(1, 1024));
-  refine->add_option("--restarts", f->restarts, "GP optimiser restarts per round")->capture_default_str();
+  refine->add_option("--restarts", f->refine.restarts, "GP optimiser restarts per round")->capture_default_str();
   refine->add_option("--sample-timeout", f->sample_timeout,
                      "Stop a run still going after this many seconds and record it as failed (0: no limit)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e7));
-  refine->add_option("--seed", f->seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
+  refine->add_option("--seed", f->refine.seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
   refine->footer("Each round trains a GP on the converged samples, picks --batch candidates by the largest posterior\n"
                  "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"
                  "scene, and reports the leave-one-out error (and the held-out error with --test).");

@@ -1,0 +1,163 @@
+#include "campaign/refine.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <optional>
+#include <vector>
+
+#include "common/csv_table.hpp"
+#include "common/error.hpp"
+#include "common/version.hpp"
+#include "surrogate/active_learning.hpp"
+#include "surrogate/gp_training.hpp"
+#include "surrogate/model_file.hpp"
+#include "surrogate/sampling.hpp"
+
+namespace mufric {
+namespace {
+
+// The rows of a CSV with unit headers, such as the server's --log-uncertain file, in the box's
+// input order (SI).
+Eigen::MatrixXd csv_candidates(const std::string& path, const InputSpace& box) {
+  const CsvTable table = read_csv_table(path);
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(table.rows.size()), static_cast<Eigen::Index>(box.size()));
+  for (size_t j = 0; j < box.size(); ++j) {
+    const std::vector<double> column = table.si_column(box[j].name);
+    for (size_t i = 0; i < column.size(); ++i) rows(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = column[i];
+  }
+  return rows;
+}
+
+bool row_inside(const InputSpace& box, const Eigen::MatrixXd& rows, Eigen::Index i) {
+  for (size_t j = 0; j < box.size(); ++j) {
+    if (!box[j].contains(rows(i, static_cast<Eigen::Index>(j)))) return false;
+  }
+  return true;
+}
+
+// Candidate points: a Sobol' set in the box (shifted per round), plus the CSV's rows inside the box
+// (the plan box is what the micro-model is run on; `grow` moves it toward the others first).
+Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box, int round) {
+  Eigen::MatrixXd c = plan_in_box(PlanDesign::sobol, o.candidate_count, box, o.seed + static_cast<unsigned long long>(round));
+  if (o.candidates_csv.empty()) return c;
+  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, box);
+  std::vector<Eigen::Index> inside;
+  for (Eigen::Index i = 0; i < logged.rows(); ++i) {
+    if (row_inside(box, logged, i)) inside.push_back(i);
+  }
+  Eigen::MatrixXd all(c.rows() + static_cast<Eigen::Index>(inside.size()), c.cols());
+  all.topRows(c.rows()) = c;
+  for (size_t k = 0; k < inside.size(); ++k) all.row(c.rows() + static_cast<Eigen::Index>(k)) = logged.row(inside[k]);
+  return all;
+}
+
+std::string box_text(const InputSpace& box) {
+  std::string text;
+  char cell[160];
+  for (const auto& in : box) {
+    std::snprintf(cell, sizeof cell, "%s%s %.6g..%.6g %s", text.empty() ? "" : ", ", in.name.c_str(), in.lo, in.hi, in.unit.c_str());
+    text += cell;
+  }
+  return text;
+}
+
+// The plan's box grows toward the candidates (where the meso code asks), and the change is recorded
+// in the database's /plan/box_history; samples already run stay valid (the old box is inside).
+BoxGrowth grow_plan_box(const RefineOptions& o, Dataset& db) {
+  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, db.inputs);
+  const InputSpace grown = grow_box(db.inputs, logged, o.grow_coverage);
+  BoxGrowth growth;
+  growth.candidate_rows = static_cast<long long>(logged.rows());
+  long long outside = 0;
+  for (Eigen::Index i = 0; i < logged.rows(); ++i) outside += !row_inside(db.inputs, logged, i);
+  if (same_input_space(grown, db.inputs)) return growth;
+  char head[128];
+  std::snprintf(head, sizeof head, "%s: grown by dataset refine --grow-box (coverage %g) toward %lld of %lld rows of ",
+                utc_timestamp().c_str(), o.grow_coverage, outside, static_cast<long long>(logged.rows()));
+  growth.record = head + o.candidates_csv + " outside: " + box_text(db.inputs) + " -> " + box_text(grown);
+  growth.grown = true;
+  db.inputs = grown;
+  db.box_history.push_back(growth.record);
+  write_dataset(o.db, db);
+  return growth;
+}
+
+// The database's samples that did not converge (failed or outside the model), as points: picks keep
+// away from them.
+Eigen::MatrixXd unconverged_points(const Dataset& db) {
+  std::vector<Eigen::Index> failed_rows;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    if (!db.converged(i)) failed_rows.push_back(i);
+  }
+  Eigen::MatrixXd failed(static_cast<Eigen::Index>(failed_rows.size()), db.x.cols());
+  for (size_t k = 0; k < failed_rows.size(); ++k) failed.row(static_cast<Eigen::Index>(k)) = db.x.row(failed_rows[k]);
+  return failed;
+}
+
+}  // namespace
+
+RefineReport refine_dataset(const RefineOptions& o) {
+  if (!o.make_evaluator) throw Error("refine_dataset: no make_evaluator given");
+  Dataset db = read_dataset_isolated(o.db);
+  if (db.plan.rows() == 0 || db.plan_index.size() != static_cast<size_t>(db.size())) {
+    throw Error(o.db + ": not a micro-model database (no plan rows); start with mufric dataset plan and run");
+  }
+  if (o.grow) {
+    const BoxGrowth growth = grow_plan_box(o, db);
+    if (o.on_box) o.on_box(growth);
+  }
+  const SampleEvaluator evaluate = o.make_evaluator(db);
+  std::optional<TrainingSet> test;
+  if (!o.test.empty()) test = training_set(read_dataset_isolated(o.test), o.test);
+  GpTrainingOptions training;
+  training.restarts = o.restarts;
+  training.seed = o.seed;
+  RefineReport report;
+  for (int round = 1;; ++round) {
+    const TrainingSet data = training_set(db, o.db);
+    const GaussianProcess gp = train_gaussian_process(data, training);
+    if (o.on_round) {
+      const auto& sum = gp.state().summary;
+      RefineRound r;
+      r.round = round;
+      r.training_samples = static_cast<long long>(data.x.rows());
+      r.loo_mean_relative_error = sum.loo_mean_relative_error;
+      r.loo_max_relative_error = sum.loo_max_relative_error;
+      std::optional<AccuracyReport> held_out;
+      if (test) {
+        held_out = held_out_accuracy(gp, *test, 0.95);
+        r.held_out = &*held_out;
+        r.held_out_source = test->source_path;
+      }
+      o.on_round(r);
+    }
+    if (!o.model_out.empty()) save_model(o.model_out, gp);
+    if (report.spent >= o.budget) break;
+    const int batch = static_cast<int>(std::min<long long>(o.batch, o.budget - report.spent));
+    const Eigen::MatrixXd candidates = refine_candidates(o, db.inputs, round);
+    const auto picks = pick_by_posterior_variance(gp, candidates, batch, unconverged_points(db));
+    // The picks become plan rows, so the database accounts for them like any planned point.
+    const Eigen::Index first = db.plan.rows();
+    db.plan.conservativeResize(first + static_cast<Eigen::Index>(picks.size()), Eigen::NoChange);
+    for (size_t k = 0; k < picks.size(); ++k) {
+      db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(picks[k].candidate);
+      if (o.on_pick) o.on_pick({k + 1, static_cast<long long>(first) + static_cast<long long>(k), picks[k].std_at_pick});
+    }
+    if (db.plan_design.find("active") == std::string::npos) {
+      db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
+    }
+    write_dataset(o.db, db);
+    GenerationOptions options;
+    options.jobs = o.jobs;
+    if (o.on_sample) {
+      options.on_sample = [&](const GenerationProgress& p) { o.on_sample(p, db.inputs, db.plan.row(p.plan_row).transpose()); };
+    }
+    const GenerationReport r = generate_dataset(db, o.db, evaluate, options);
+    report.spent += r.ran;
+    db = read_dataset_isolated(o.db);
+    if (r.ran == 0) break;  // nothing new could be run
+  }
+  return report;
+}
+
+}  // namespace mufric

@@ -1,0 +1,76 @@
+#pragma once
+// Active learning on a plan-based database (`mufric dataset refine`): each round trains a GP on the
+// converged samples, picks a batch of candidates by the largest posterior variance (each pick
+// conditioning the next, away from failed points), appends them to the plan, runs them through
+// generate_dataset and reads the database back, until the budget of runs is spent or nothing new
+// could be run. Candidates are a Sobol' set in the plan box (shifted per round) plus the rows of a
+// CSV (e.g. the server's --log-uncertain file) inside the box; with `grow` the box first grows toward
+// that CSV's rows, and the change is recorded in the database's /plan/box_history. The database is
+// rewritten after the growth, after every round's picks and after every sample.
+#include <cstddef>
+#include <functional>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "campaign/dataset_generation.hpp"
+#include "common/dataset_file.hpp"
+#include "common/sample_outcome.hpp"
+#include "surrogate/accuracy.hpp"
+
+namespace mufric {
+
+// The box growth (with `grow`), written before the first round.
+struct BoxGrowth {
+  bool grown = false;            // false: the box already covered the candidates
+  long long candidate_rows = 0;  // rows of the candidates CSV
+  std::string record;            // the /plan/box_history entry written (when grown)
+};
+
+// After each round's training.
+struct RefineRound {
+  int round = 0;                  // from 1
+  long long training_samples = 0;
+  double loo_mean_relative_error = 0.0, loo_max_relative_error = 0.0;
+  const AccuracyReport* held_out = nullptr;  // on the test set (null without one), at the 95 % level
+  std::string held_out_source;               // the test set's path
+};
+
+// Each candidate picked, in order.
+struct RefinePick {
+  std::size_t number = 0;  // from 1 within the round
+  long long plan_row = 0;  // the plan row it became
+  double std_at_pick = 0.0;
+};
+
+struct RefineOptions {
+  std::string db;              // the database extended in place (made by dataset plan + run)
+  std::string test;            // held-out database reported after every round ("": none)
+  std::string candidates_csv;  // extra candidates with unit headers ("": none)
+  std::string model_out;       // the GP trained after each round is written here ("": not written)
+  bool grow = false;           // grow the box toward candidates_csv's rows first (needs candidates_csv)
+  double grow_coverage = 1.0;  // quantile of the outside rows covered per input and side
+  long long budget = 0;        // runs to spend
+  int batch = 8, jobs = 1, restarts = 2;
+  long long candidate_count = 4096;  // Sobol' candidates per round
+  unsigned long long seed = 1;       // of the candidate sets and GP restarts
+  // The evaluator of the samples, made once after the box growth from the database as it then is
+  // (the mufric executable: the micro-model with the database's scene). Required.
+  std::function<SampleEvaluator(const Dataset& db)> make_evaluator;
+  // Progress, in the order it happens; each may be empty.
+  std::function<void(const BoxGrowth&)> on_box;
+  std::function<void(const RefineRound&)> on_round;
+  std::function<void(const RefinePick&)> on_pick;
+  // Each sample run (under generate_dataset's lock), with its point in the database's inputs.
+  std::function<void(const GenerationProgress&, const InputSpace& inputs, const Eigen::VectorXd& x)> on_sample;
+};
+
+struct RefineReport {
+  long long spent = 0;  // runs made, of options.budget
+};
+
+// Throws Error for a database without plan rows, and whatever reading, training, running or
+// writing throws (the database then holds every sample finished so far).
+RefineReport refine_dataset(const RefineOptions& options);
+
+}  // namespace mufric
