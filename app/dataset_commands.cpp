@@ -80,18 +80,17 @@ void plan_command(const PlanOptions& o) {
   const scene::Scene sc = scene::load_scene(o.scene_path, o.overrides);
   scene::micro_evaluator(sc, box, 1);  // refuses a scene the dataset cannot drive, before anything is written
   const PlanDesign design = parse_plan_design(o.design);
-  Dataset plan;
-  plan.inputs = box;
-  plan.x.resize(0, static_cast<Eigen::Index>(box.size()));
-  plan.mu.resize(0);
-  plan.plan = plan_in_box(design, o.samples, box, o.seed);
-  plan.plan_design = plan_design_name(design);
-  plan.plan_seed = static_cast<long long>(o.seed);
-  plan.scene_json = sc.effective.dump(2);
+  Dataset spec;
+  spec.inputs = box;
+  spec.plan = plan_in_box(design, o.samples, box, o.seed);
+  spec.plan_design = plan_design_name(design);
+  spec.plan_seed = static_cast<long long>(o.seed);
+  spec.scene_json = sc.effective.dump(2);
   // What a reader of `dataset status` needs first: which physics, and whether the named scene was changed.
   const std::string scene_label = sc.source + (o.overrides.empty() ? "" : " with " + std::to_string(o.overrides.size()) + " --set") +
                                   ", physics " + sc.physics;
-  plan.source = "micro-model plan (" + scene_label + ")";
+  spec.source = "micro-model plan (" + scene_label + ")";
+  const Dataset plan = empty_dataset(spec);
   write_dataset(o.out, plan);
   std::printf("wrote %s: %lld points, %s design (seed %llu), scene %s (sha256 %s)\n", o.out.c_str(), o.samples,
               plan.plan_design.c_str(), o.seed, scene_label.c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());

@@ -41,7 +41,9 @@ bool same_plan(const h5::RowMatrix& a, const h5::RowMatrix& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
 }
 
-Dataset empty_database(const Dataset& plan) {
+}  // namespace
+
+Dataset empty_dataset(const Dataset& plan) {
   Dataset d;
   d.inputs = plan.inputs;
   d.x.resize(0, static_cast<Eigen::Index>(plan.inputs.size()));
@@ -57,11 +59,9 @@ Dataset empty_database(const Dataset& plan) {
   return d;
 }
 
-}  // namespace
-
 Dataset open_database(const std::string& db_path, const Dataset& plan) {
   if (plan.plan.rows() == 0) throw Error("the plan has no points (/plan/inputs is empty)");
-  if (!std::filesystem::exists(db_path)) return empty_database(plan);
+  if (!std::filesystem::exists(db_path)) return empty_dataset(plan);
   Dataset d = read_dataset_isolated(db_path);
   if (!same_input_space(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
   if (!same_plan(d.plan, plan.plan)) {
@@ -169,6 +169,9 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
   }
   write_dataset(db_path, db);  // the database exists (and is valid) before the first sample finishes
 
+  // The work pool: `jobs` workers (this thread one of them) take the pending rows in order. measure_mu
+  // (micro/scene/micro_run.cpp) runs its draws in a pool of the same shape, without the stop on a
+  // failed write; one helper for both would sit in common/ and is left for the rest of issue 31.
   std::mutex lock;
   std::atomic<size_t> next{0};
   std::atomic<bool> stop{false};
@@ -262,7 +265,7 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
       if (!converged(it->second) && converged({f, i})) it->second = {f, i};
     }
   }
-  Dataset merged = empty_database(files.front());
+  Dataset merged = empty_dataset(files.front());
   merged.code_version = files.front().code_version;
   merged.created_utc = files.front().created_utc;
   for (const auto& [row, at] : chosen) {

@@ -47,6 +47,10 @@ struct GenerationReport {
   double seconds = 0.0;
 };
 
+// A dataset with no samples carrying `plan`'s inputs, plan (design, seed, box history), source and
+// scene, stamped with this code's version: a new plan file, a new database, a merge's start.
+Dataset empty_dataset(const Dataset& plan);
+
 // The database at `db_path` for `plan`: read and checked against the plan (inputs, box, plan rows
 // and scene must match, else Error naming what differs), or a new, empty one carrying the plan.
 Dataset open_database(const std::string& db_path, const Dataset& plan);
