@@ -30,6 +30,52 @@ double length_option(const std::string& text, const std::string& flag) {
   return parse_quantity(text, QuantityKind::length, flag);
 }
 
+// A periodic profile of period L cannot show a correlation length much above L/5: the longest one
+// any zero-mean profile of that period shows is its lowest harmonic's, cos(2 pi x / L) = 1/e at
+// x = 0.19 L, and the generator's Gaussian spectrum puts nearly all its power there once the
+// requested length approaches L/5 (`--correlation 100um --length 10um` printed 1.9um, the period's
+// figure, not the request's). Hence: the period covers at least this many correlation lengths.
+constexpr double kMinimumCorrelationLengthsPerPeriod = 5.0;
+
+// The correlation length is where the autocorrelation falls to 1/e; with samples farther apart than
+// that, neighbouring samples are already uncorrelated, the spectrum is cut at the Nyquist frequency
+// and the profile is white noise whose measured correlation length (about 0.6 spacings) says
+// nothing about the request. Hence: at least one sample per correlation length.
+void check_synthetic_profile(const spline::RoughnessSpec& spec, const ProfileOptions& o) {
+  if (!(spec.length > 0.0) || !(spec.ra > 0.0) || !(spec.correlation_length > 0.0)) {
+    throw Error("--length, --ra and --correlation must be positive (got " + o.length + ", " + o.ra + ", " +
+                o.correlation + ")");
+  }
+  if (spec.length < kMinimumCorrelationLengthsPerPeriod * spec.correlation_length) {
+    throw Error("--correlation " + o.correlation + " is too long for --length " + o.length +
+                ": a periodic profile cannot show a correlation length above about a fifth of its period; give a "
+                "--length of at least " +
+                format_human(kMinimumCorrelationLengthsPerPeriod * spec.correlation_length, QuantityKind::length) +
+                " or a --correlation of at most " +
+                format_human(spec.length / kMinimumCorrelationLengthsPerPeriod, QuantityKind::length));
+  }
+  const double spacing = spec.length / spec.samples;
+  if (spacing > spec.correlation_length) {
+    const auto samples_needed = static_cast<long long>(std::ceil(spec.length / spec.correlation_length));
+    throw Error("--samples " + std::to_string(spec.samples) + " over --length " + o.length + " puts samples " +
+                format_human(spacing, QuantityKind::length) + " apart, farther than --correlation " + o.correlation +
+                ": the roughness would not be resolved; give --samples of at least " + std::to_string(samples_needed));
+  }
+}
+
+// The fit's own limits, checked before anything is printed and named by their options.
+void check_profile_fit(const spline::Profile& profile, const ProfileOptions& o) {
+  if (o.control_points < o.degree + 1) {
+    throw Error("--control-points " + std::to_string(o.control_points) + " cannot carry --degree " +
+                std::to_string(o.degree) + ": a periodic spline of degree d needs at least d + 1 control points");
+  }
+  if (static_cast<size_t>(o.control_points) >= profile.x.size()) {
+    throw Error("--control-points " + std::to_string(o.control_points) + " needs more samples than that, " +
+                (o.csv.empty() ? "--samples is " : o.csv + " has ") + std::to_string(profile.x.size()) +
+                ": a least-squares fit needs fewer control points than data");
+  }
+}
+
 void run_profile(const ProfileOptions& o) {
   spline::Profile profile;
   if (!o.csv.empty()) {
@@ -41,8 +87,10 @@ void run_profile(const ProfileOptions& o) {
     spec.correlation_length = length_option(o.correlation, "--correlation");
     spec.samples = o.samples;
     spec.seed = o.seed;
+    check_synthetic_profile(spec, o);
     profile = spline::synthetic_rough_profile(spec);
   }
+  check_profile_fit(profile, o);
   const auto r = spline::roughness_figures(profile);
   std::printf("profile %s: %zu samples over one period of %s\n", profile.source.c_str(), profile.x.size(),
               format_human(profile.period, QuantityKind::length).c_str());
@@ -304,15 +352,20 @@ void add_micro_commands(CLI::App& app) {
   auto o = std::make_shared<ProfileOptions>();
   auto* profile = micro->add_subcommand(
       "profile", "Roughness of a surface profile (measured CSV or synthetic) and its periodic spline fit");
-  profile->add_option("--csv", o->csv, "Measured profile: columns x and height with length units, e.g. x[um],height[nm]")
-      ->check(CLI::ExistingFile);
-  profile->add_option("--period", o->period, "Period of the measured profile (default: sampled range + one spacing)");
-  profile->add_option("--length", o->length, "Synthetic: period")->capture_default_str();
-  profile->add_option("--ra", o->ra, "Synthetic: arithmetic mean roughness Ra")->capture_default_str();
-  profile->add_option("--correlation", o->correlation, "Synthetic: correlation length")->capture_default_str();
+  auto* csv = profile->add_option("--csv", o->csv,
+                                  "Measured profile: columns x and height with length units, e.g. x[um],height[nm]")
+                  ->check(CLI::ExistingFile);
+  profile->add_option("--period", o->period, "Period of the measured profile (default: sampled range + one spacing)")
+      ->needs(csv);
+  // The synthetic profile's options mean nothing beside a measured one: refused rather than ignored.
+  profile->add_option("--length", o->length, "Synthetic: period")->capture_default_str()->excludes(csv);
+  profile->add_option("--ra", o->ra, "Synthetic: arithmetic mean roughness Ra")->capture_default_str()->excludes(csv);
+  profile->add_option("--correlation", o->correlation,
+                      "Synthetic: correlation length (at most a fifth of --length, at least the sample spacing)")
+      ->capture_default_str()->excludes(csv);
   profile->add_option("--samples", o->samples, "Synthetic: samples per period")->capture_default_str()
-      ->check(CLI::Range(10, 1 << 20));
-  profile->add_option("--seed", o->seed, "Synthetic: random seed")->capture_default_str();
+      ->check(CLI::Range(10, 1 << 20))->excludes(csv);
+  profile->add_option("--seed", o->seed, "Synthetic: random seed")->capture_default_str()->excludes(csv);
   profile->add_option("--degree", o->degree, "Spline degree of the fit")->capture_default_str()->check(CLI::Range(1, 10));
   profile->add_option("--control-points", o->control_points, "Control points of the fit (one period)")
       ->capture_default_str()->check(CLI::Range(2, 100000));

@@ -404,6 +404,56 @@ TEST_F(Cli, MicroProfileReportsRoughnessAndFitError) {
   EXPECT_NE(r.output.find("bad.csv:5"), std::string::npos) << r.output;
 }
 
+// Issue 30: `--correlation 100um --length 10um` was accepted and printed a correlation length of
+// 1.9um, the period's figure. Impossible option combinations are refused before anything is printed,
+// naming the options; the limits themselves (a fifth of the period, one sample spacing) pass.
+TEST_F(Cli, MicroProfileRefusesOptionsNoProfileCanMeet) {
+  CommandResult r = run("micro profile --correlation 100um --length 10um");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("mufric: error: --correlation 100um is too long for --length 10um"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("profile synthetic"), std::string::npos) << r.output;  // nothing printed first
+  r = run("micro profile --correlation 2.5um --length 10um");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--correlation 2.5um"), std::string::npos) << r.output;
+  r = run("micro profile --correlation 2um --length 10um");  // five correlation lengths: allowed
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+
+  // Samples farther apart than the correlation length: white noise, not the requested roughness.
+  r = run("micro profile --correlation 0.1um --length 10um --samples 64 --control-points 8");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--samples 64"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--correlation 0.1um"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("at least 100"), std::string::npos) << r.output;
+  r = run("micro profile --correlation 0.1um --length 10um --samples 100 --control-points 8");  // one per length
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+
+  // The fit's limits, refused before the roughness is printed and named by their options.
+  r = run("micro profile --samples 20");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--control-points 64"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--samples is 20"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("profile synthetic"), std::string::npos) << r.output;
+  r = run("micro profile --control-points 3 --degree 5");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--control-points 3 cannot carry --degree 5"), std::string::npos) << r.output;
+  r = run("micro profile --length -10um");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--length"), std::string::npos) << r.output;
+
+  // Synthetic options beside a measured profile, and a measured profile's period without one, were
+  // silently ignored.
+  std::ofstream(path("flat.csv")) << "x[um],height[um]\n0,0\n1,0\n";
+  r = run("micro profile --csv " + path("flat.csv") + " --length 20um");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--length"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--csv"), std::string::npos) << r.output;
+  r = run("micro profile --period 20um");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--period"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--csv"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   const std::string small =
       " --set discretisation.elements_x=32 --set discretisation.elements_y=4"
