@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -114,6 +115,14 @@ Measurement replay(const std::string& uri, const client::Options& options, long 
   return m;
 }
 
+// A benchmark with failed calls measured something else than the model (errors answer fast, or
+// time out), so its figures must not pass for a result in a script: exit code 2 (README), after the
+// table, with how many failed and why the first did.
+void refuse_failed_calls(long long failed, const std::string& first_error) {
+  if (failed == 0) return;
+  throw Error("bench: " + std::to_string(failed) + " calls failed, the first: " + first_error);
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -168,6 +177,7 @@ void add_bench_command(CLI::App& app) {
                     "p99 %.4g us, %lld errors\n",
                     o->replay[0], o->replay[1], o->model.c_str(), m.wall_seconds, rate, 1e6 * p50, 1e6 * p99, m.errors);
       }
+      refuse_failed_calls(m.errors, m.first_error);
       return;
     }
     if (!o->json) {
@@ -175,10 +185,14 @@ void add_bench_command(CLI::App& app) {
                   "p99 [us]", "errors", o->model.c_str(), o->with_std ? "mean+std" : "mean only", o->clients,
                   o->clients == 1 ? "" : "s");
     }
+    long long failed_calls = 0;
+    std::string first_error;
     for (const long long batch : o->batches) {
       if (batch <= 0) throw Error("--batch: sizes must be positive");
       const Measurement m = measure(o->model, options, batch, o->clients, o->seconds, what);
       if (m.latencies.empty()) throw Error("bench: no call succeeded: " + m.first_error);
+      failed_calls += m.errors;
+      if (first_error.empty()) first_error = m.first_error;
       const double p50 = m.latencies[m.latencies.size() / 2];
       const double p99 = m.latencies[std::min(m.latencies.size() - 1, m.latencies.size() * 99 / 100)];
       const double points_per_second = static_cast<double>(batch) * static_cast<double>(m.latencies.size()) / m.wall_seconds;
@@ -191,8 +205,8 @@ void add_bench_command(CLI::App& app) {
         std::printf("%10lld %10zu %14.4g %12.4g %12.4g %8lld\n", batch, m.latencies.size(), points_per_second, 1e6 * p50,
                     1e6 * p99, m.errors);
       }
-      if (m.errors > 0) std::fprintf(stderr, "bench: %lld failed calls, first: %s\n", m.errors, m.first_error.c_str());
     }
+    refuse_failed_calls(failed_calls, first_error);
   });
 }
 

@@ -377,6 +377,29 @@ TEST_F(Cli, ServeRefusesAPortInUseAndAnAddressThatIsNoHostAndPort) {
   EXPECT_EQ(first.stop(), 0);
 }
 
+// Regression (issue 30): `mufric bench` with failed calls exited 0, so a script took a table of
+// errors for a measurement. The server stops while the bench runs; the calls after that fail (no
+// retries), the table is still printed and the exit code is 2 with the count and the first error.
+TEST_F(Cli, BenchWithFailedCallsExits2) {
+  std::filesystem::create_directories(path("models"));
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("models/law.h5")).exit_code, 0);
+  ServeProcess server(path("models"), path("serve.log"), path("address"));
+  ASSERT_FALSE(server.address().empty()) << "server did not start";
+  std::thread stop_midway([&server] {
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    server.stop();
+  });
+  const CommandResult r =
+      run("bench --model grpc://" + server.address() + "/law --batch 1 --seconds 4 --client-options retries=0");
+  stop_midway.join();
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  const size_t error = r.output.find("mufric: error: bench: ");
+  ASSERT_NE(error, std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" calls failed, the first: Evaluate on model 'law' failed (", error),
+            std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("points/s"), std::string::npos) << r.output;  // the table, before the error
+}
+
 TEST_F(Cli, MicroProfileReportsRoughnessAndFitError) {
   CommandResult r = run("micro profile --ra 0.25um --correlation 1um --length 20um --seed 3 --out " + path("fit.csv"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
