@@ -63,7 +63,10 @@ Dataset open_database(const std::string& db_path, const Dataset& plan) {
   if (plan.plan.rows() == 0) throw Error("the plan has no points (/plan/inputs is empty)");
   if (!std::filesystem::exists(db_path)) return empty_dataset(plan);
   Dataset d = read_dataset_isolated(db_path);
-  if (!same_input_space(d.inputs, plan.inputs)) throw Error(db_path + ": its inputs or box differ from the plan's");
+  if (const std::string difference = input_space_difference(d.inputs, db_path, plan.inputs, "the plan");
+      !difference.empty()) {
+    throw Error(db_path + ": its inputs or box differ from the plan's: " + difference);
+  }
   if (!same_plan(d.plan, plan.plan)) {
     throw Error(db_path + ": was made from a different plan (" + std::to_string(d.plan.rows()) + " rows, the plan has " +
                 std::to_string(plan.plan.rows()) + " or different points); use another --db");
@@ -239,7 +242,10 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
     files.push_back(read_dataset_isolated(path));
     const Dataset& d = files.back();
     const Dataset& first = files.front();
-    if (!same_input_space(d.inputs, first.inputs)) throw Error("merge: " + path + ": inputs or box differ from " + paths[0]);
+    if (const std::string difference = input_space_difference(d.inputs, path, first.inputs, paths[0]);
+        !difference.empty()) {
+      throw Error("merge: " + path + ": inputs or box differ from " + paths[0] + "'s: " + difference);
+    }
     if (!same_plan(d.plan, first.plan)) throw Error("merge: " + path + ": comes from a different plan than " + paths[0]);
     if (!allow_mixed && d.scene_json != first.scene_json) {
       throw Error("merge: " + path + ": made with a different scene than " + paths[0] + " (--allow-mixed to merge anyway)");

@@ -1,8 +1,10 @@
 #include "common/input_space.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "common/h5_file.hpp"
+#include "common/wording.hpp"
 
 namespace mufric {
 
@@ -20,6 +22,43 @@ void write_input_space(h5::Writer& out, const InputSpace& inputs) {
   out.strings("/inputs/units", units);
   out.doubles("/inputs/box_lo", lo);
   out.doubles("/inputs/box_hi", hi);
+}
+
+namespace {
+
+// "temperature [K] 298.15..1173.15 (25°C..900°C)": the stored unit and SI box, digits enough to show a
+// difference in the last place, and the box in the units a user typed when the input is a known one.
+std::string input_text(const InputSpec& input) {
+  char box[64];
+  std::snprintf(box, sizeof box, "%.10g..%.10g", input.lo, input.hi);
+  std::string text = input.name + " [" + input.unit + "] " + box;
+  const QuantityKind kind = input.kind();
+  if (kind != QuantityKind::dimensionless) {
+    text += " (" + format_human(input.lo, kind) + ".." + format_human(input.hi, kind) + ")";
+  }
+  return text;
+}
+
+std::string names_of(const InputSpace& inputs) {
+  std::string names;
+  for (const auto& input : inputs) names += (names.empty() ? "" : ", ") + input.name;
+  return names;
+}
+
+}  // namespace
+
+std::string input_space_difference(const InputSpace& a, std::string_view a_source, const InputSpace& b,
+                                   std::string_view b_source) {
+  if (a.size() != b.size()) {
+    return std::string(a_source) + " has " + count_of(static_cast<long long>(a.size()), "input", "inputs") + " (" +
+           names_of(a) + "), " + std::string(b_source) + " has " + std::to_string(b.size()) + " (" + names_of(b) + ")";
+  }
+  for (size_t j = 0; j < a.size(); ++j) {
+    if (same_input_space({a[j]}, {b[j]})) continue;
+    return "input " + std::to_string(j + 1) + " differs: " + input_text(a[j]) + " in " + std::string(a_source) + ", " +
+           input_text(b[j]) + " in " + std::string(b_source);
+  }
+  return "";
 }
 
 InputSpace read_input_space(const h5::Reader& in) {

@@ -2,6 +2,7 @@
 // Named, ordered model inputs with SI units and the box they were sampled from.
 #include <cmath>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/units.hpp"
@@ -37,6 +38,13 @@ inline bool same_input_space(const InputSpace& a, const InputSpace& b) {
   }
   return true;
 }
+
+// Where two input spaces differ, for a message that says what to fix: the first input whose name,
+// unit or box differs, both versions side by side and each named by where it came from ("input 3
+// differs: temperature [K] 298.15..1073.15 (25°C..800°C) in b.h5, temperature [K] 298.15..1173.15
+// (25°C..900°C) in a.h5"), or the two lists of names when the counts differ. Empty when they are the same.
+std::string input_space_difference(const InputSpace& a, std::string_view a_source, const InputSpace& b,
+                                   std::string_view b_source);
 
 // The default parameter box of seed 000 section 4: p 300–1300 MPa, v 22.5–200 m/min, T 25–900 °C.
 inline InputSpace default_friction_box() {

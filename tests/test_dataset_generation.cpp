@@ -184,6 +184,41 @@ TEST(DatasetGeneration, MergeRefusesMixedScenesUnlessAsked) {
   EXPECT_EQ(merge_datasets({a, b}, true, report).size(), 4);
 }
 
+// Regression (issue 30): merge said "inputs or box differ" without saying which; now it names the
+// file, the input and both versions of it (name, unit, lo..hi).
+TEST(DatasetGeneration, MergeNamesTheInputWhoseBoxDiffers) {
+  const std::string a = temp_path("box_a.h5"), b = temp_path("box_b.h5");
+  std::filesystem::remove(a);
+  generate_dataset(small_plan(4), a, fake, GenerationOptions{});
+  Dataset other = read_dataset(a);
+  other.inputs[2].hi = 800.0 + 273.15;
+  write_dataset(b, other);
+  MergeReport report;
+  try {
+    merge_datasets({a, b}, false, report);
+    ADD_FAILURE() << "a different box was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "merge: " + b + ": inputs or box differ from " + a +
+                                         "'s: input 3 differs: temperature [K] 298.15..1073.15 (25°C..800°C) in " + b +
+                                         ", temperature [K] 298.15..1173.15 (25°C..900°C) in " + a);
+  }
+  // A different unit or name is named the same way; a different number of inputs lists both.
+  InputSpace renamed = default_friction_box(), fewer = default_friction_box();
+  renamed[0].name = "pressure";
+  renamed[0].unit = "bar";
+  EXPECT_EQ(input_space_difference(renamed, "x.h5", default_friction_box(), "y.h5"),
+            "input 1 differs: pressure [bar] 300000000..1300000000 in x.h5, contact_pressure [Pa] "
+            "300000000..1300000000 (300MPa..1300MPa) in y.h5");
+  fewer.pop_back();
+  EXPECT_EQ(input_space_difference(fewer, "x.h5", default_friction_box(), "y.h5"),
+            "x.h5 has 2 inputs (contact_pressure, sliding_velocity), y.h5 has 3 (contact_pressure, sliding_velocity, "
+            "temperature)");
+  fewer.pop_back();
+  EXPECT_EQ(input_space_difference(fewer, "x.h5", default_friction_box(), "y.h5"),
+            "x.h5 has 1 input (contact_pressure), y.h5 has 3 (contact_pressure, sliding_velocity, temperature)");
+  EXPECT_EQ(input_space_difference(default_friction_box(), "x.h5", default_friction_box(), "y.h5"), "");
+}
+
 TEST(DatasetGeneration, ShardTextIsChecked) {
   EXPECT_EQ(parse_shard("2/5").index, 2);
   EXPECT_EQ(parse_shard("2/5").count, 5);

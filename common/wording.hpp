@@ -1,0 +1,20 @@
+#pragma once
+// Small pieces of the English every message is written in, so "1 files" and "a angle" do not reach a user.
+#include <string>
+#include <string_view>
+
+namespace mufric {
+
+// "1 file", "3 files", "0 files".
+inline std::string count_of(long long n, std::string_view singular, std::string_view plural) {
+  return std::to_string(n) + " " + std::string(n == 1 ? singular : plural);
+}
+
+// "a pressure", "an angle": the indefinite article by the word's first letter, which is right for
+// the words messages put after it (quantity kinds, input names); not for "an hour" or "a unit".
+inline std::string with_article(std::string_view word) {
+  const bool vowel = !word.empty() && std::string_view("aeiouAEIOU").find(word.front()) != std::string_view::npos;
+  return std::string(vowel ? "an " : "a ") + std::string(word);
+}
+
+}  // namespace mufric
