@@ -14,6 +14,7 @@
 #include "app/commands.hpp"
 #include "client/friction_client.hpp"
 #include "common/error.hpp"
+#include "common/wording.hpp"
 
 namespace mufric::app {
 namespace {
@@ -120,7 +121,7 @@ Measurement replay(const std::string& uri, const client::Options& options, long 
 // table, with how many failed and why the first did.
 void refuse_failed_calls(long long failed, const std::string& first_error) {
   if (failed == 0) return;
-  throw Error("bench: " + std::to_string(failed) + " calls failed, the first: " + first_error);
+  throw Error("bench: " + count_of(failed, "call", "calls") + " failed, the first: " + first_error);
 }
 
 }  // namespace

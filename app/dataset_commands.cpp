@@ -19,6 +19,7 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
+#include "common/wording.hpp"
 #include "micro/scene/dataset_sample.hpp"
 #include "micro/scene/micro_run.hpp"
 #include "surrogate/accuracy.hpp"
@@ -163,13 +164,14 @@ void run_command(const RunOptions& o) {
   options.on_sample = [&](const GenerationProgress& p) {
     print_progress(p, plan.inputs, plan.plan.row(p.plan_row).transpose(), terminal);
   };
-  std::printf("%s: shard %s of %s (%lld points), %d job(s) x %d thread(s), scene sha256 %s\n", o.db.c_str(),
-              o.shard.c_str(), o.plan.c_str(), static_cast<long long>(plan.plan.rows()), o.jobs, threads,
-              sha256_hex(plan.scene_json).substr(0, 12).c_str());
+  std::printf("%s: shard %s of %s (%s), %s x %s, scene sha256 %s\n", o.db.c_str(), o.shard.c_str(), o.plan.c_str(),
+              count_of(plan.plan.rows(), "point", "points").c_str(), count_of(o.jobs, "job", "jobs").c_str(),
+              count_of(threads, "thread", "threads").c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());
   std::fflush(stdout);
   const GenerationReport r = generate_dataset(plan, o.db, evaluate, options);
-  std::printf("%s: %lld plan rows in this shard, %lld already done, %lld run now (%lld converged, %lld failed) in %s\n",
-              o.db.c_str(), r.planned, r.already_done, r.ran, r.converged, r.failed, duration_text(r.seconds).c_str());
+  std::printf("%s: %s in this shard, %lld already done, %lld run now (%lld converged, %lld failed) in %s\n", o.db.c_str(),
+              count_of(r.planned, "plan row", "plan rows").c_str(), r.already_done, r.ran, r.converged, r.failed,
+              duration_text(r.seconds).c_str());
 }
 
 struct RefineCommandOptions {
@@ -279,10 +281,12 @@ void merge_command(const MergeOptions& o) {
   MergeReport r;
   const Dataset merged = merge_datasets(o.inputs, o.allow_mixed, r);
   write_dataset(o.out, merged);
-  std::printf("wrote %s: %lld files, %lld samples read, %lld duplicates removed -> %lld samples (%lld converged, "
-              "%lld failed); %lld of %lld plan rows not yet run\n",
-              o.out.c_str(), r.files, r.samples_read, r.duplicates_removed, r.converged + r.failed, r.converged,
-              r.failed, r.plan_rows_missing, r.plan_rows);
+  std::printf("wrote %s: %s, %lld samples read, %s removed -> %s (%lld converged, %lld failed); %lld of %s not "
+              "yet run\n",
+              o.out.c_str(), count_of(r.files, "file", "files").c_str(), r.samples_read,
+              count_of(r.duplicates_removed, "duplicate", "duplicates").c_str(),
+              count_of(r.converged + r.failed, "sample", "samples").c_str(), r.converged, r.failed, r.plan_rows_missing,
+              count_of(r.plan_rows, "plan row", "plan rows").c_str());
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/units.hpp"
+#include "common/wording.hpp"
 #include "micro/fluid/cavity.hpp"
 #include "micro/scene/micro_run.hpp"
 #include "micro/spline/profile.hpp"
@@ -175,11 +176,12 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
     std::printf("mu = %.5f  (seed 000 protocol: one draw, eq. 17 time-averaged over [%.1f, %.1f] ns, %d steps; no "
                 "error bar)\n", m.mu, sc.average_from * 1e9, sc.duration * 1e9, r.averaged_steps);
   } else if (m.completed) {
-    std::printf("mu = %.5f +- %.5f (standard error, %s)  press-slide protocol: mean of %zu draws (%d tool phases x %d "
-                "realisations), each pressed %.0f + %.0f ns, then averaged over %.3f um of sliding after a %.3f um "
+    std::printf("mu = %.5f +- %.5f (standard error, %s)  press-slide protocol: mean of %s (%s x %s), each pressed %.0f + %.0f ns, then averaged over %.3f um of sliding after a %.3f um "
                 "run-in; largest drift over a window %s\n",
-                m.mu, m.std_error.value_or(0.0), relative_percent(m.std_error.value_or(0.0), m.mu).c_str(), m.draws.size(),
-                q.phases, q.realisations, sc.ramp * 1e9, q.press_hold * 1e9, q.window * 1e6, q.run_in * 1e6,
+                m.mu, m.std_error.value_or(0.0), relative_percent(m.std_error.value_or(0.0), m.mu).c_str(),
+                count_of(static_cast<long long>(m.draws.size()), "draw", "draws").c_str(),
+                count_of(q.phases, "tool phase", "tool phases").c_str(),
+                count_of(q.realisations, "realisation", "realisations").c_str(), sc.ramp * 1e9, q.press_hold * 1e9, q.window * 1e6, q.run_in * 1e6,
                 relative_percent(m.max_abs_drift(), 1.0).c_str());
     if (m.draws.size() > 1) {
       std::printf("| draw | tool shift | tool seed | mu | block means | drift | steps | Newton | cut-backs | wall [s] |\n"
@@ -208,10 +210,12 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
               r.max_plastic_strain, format_human(r.max_temperature, QuantityKind::temperature).c_str());
   std::printf("%d elements, %d dofs; first draw: %zu steps, %d Newton iterations (%d assemblies, %d line-search "
               "reductions), %zu cut-backs, %.2f s (assembly %.2f s of which contact %.2f s, solve %.2f s, heat "
-              "conduction %.2f s); all %zu draws on %d thread(s): %.2f s\n",
+              "conduction %.2f s); all %s on %s: %.2f s\n",
               r.elements, r.dofs, r.history.size(), r.solver.newton_iterations, r.solver.assemblies,
               r.solver.line_search_reductions, r.solver.cutbacks.size(), r.wall_seconds, r.solver.seconds_assembly,
-              r.solver.seconds_contact, r.solver.seconds_solve, r.solver.seconds_after_step, m.draws.size(), m.threads,
+              r.solver.seconds_contact, r.solver.seconds_solve, r.solver.seconds_after_step,
+              count_of(static_cast<long long>(m.draws.size()), "draw", "draws").c_str(),
+              count_of(m.threads, "thread", "threads").c_str(),
               m.wall_seconds);
   for (size_t i = 0; i < m.draws.size(); ++i) {
     for (const auto& c : m.draws[i].result.solver.cutbacks) {
@@ -249,8 +253,9 @@ void run_check(const RunCommandOptions& o) {
               static_cast<double>(cost.dofs) / static_cast<double>(base.dofs), base.dofs, cost.stiffness_nonzeros);
   std::printf("  memory: at least %.3g MB (stiffness, quadrature state, vectors; the factor comes on top), this machine "
               "has %.3g GB\n", cost.memory_lower_bound_bytes / 1e6, scene::physical_memory_bytes() / 1e9);
-  std::printf("  %zu draw(s) per measurement; the default scene takes about 30 s per draw on one core here, "
-              "and a step's cost grows faster than the unknowns\n", scene::protocol_draws(sc).size());
+  std::printf("  %s per measurement; the default scene takes about 30 s per draw on one core here, and a step's "
+              "cost grows faster than the unknowns\n",
+              count_of(static_cast<long long>(scene::protocol_draws(sc).size()), "draw", "draws").c_str());
   for (const auto& w : sc.warnings) std::printf("warning: %s\n", w.c_str());
 }
 

@@ -4,6 +4,7 @@
 
 #include "app/commands.hpp"
 #include "client/friction_client.hpp"
+#include "common/wording.hpp"
 #include "server/server.hpp"
 
 namespace mufric::app {
@@ -15,10 +16,11 @@ void add_status_command(CLI::App& app) {
       ->required();
   cmd->callback([uri] {
     const client::ServerStatus s = client::server_status(*uri);
-    std::printf("mufric %s, up %.1f s, %d evaluation threads: %lld requests, %lld points, %lld errors "
+    std::printf("mufric %s, up %.1f s, %s: %lld requests, %lld points, %lld errors "
                 "(%lld abandoned at their deadline), %lld in flight, %lld streams opened; %lld points answered by "
                 "fast evaluators\n",
-                s.code_version.c_str(), s.uptime_seconds, s.evaluation_threads, s.requests, s.points, s.errors,
+                s.code_version.c_str(), s.uptime_seconds,
+                count_of(s.evaluation_threads, "evaluation thread", "evaluation threads").c_str(), s.requests, s.points, s.errors,
                 s.abandoned, s.in_flight, s.streams, s.fast_points);
     std::printf("server-side evaluation time:\n");
     for (size_t i = 0; i < s.latency_counts.size(); ++i) {

@@ -14,6 +14,7 @@
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"
+#include "common/wording.hpp"
 #include "surrogate/accuracy.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/fast_evaluator.hpp"
@@ -218,8 +219,9 @@ void add_train(CLI::App& app) {
     o->gp.noise_term = !o->no_noise;
     const Dataset dataset = read_dataset_isolated(o->data);
     const TrainingSet data = training_set(dataset, o->data);
-    std::printf("training data: %s (%lld converged of %lld samples, %zu inputs)\n", o->data.c_str(),
-                static_cast<long long>(data.x.rows()), static_cast<long long>(dataset.size()), data.inputs.size());
+    std::printf("training data: %s (%lld converged of %s, %s)\n", o->data.c_str(), static_cast<long long>(data.x.rows()),
+                count_of(dataset.size(), "sample", "samples").c_str(),
+                count_of(static_cast<long long>(data.inputs.size()), "input", "inputs").c_str());
     if (data.outside_model > 0) {
       std::printf("left out: %lld samples outside the model (molten chip; `mufric dataset status` lists them)\n",
                   data.outside_model);

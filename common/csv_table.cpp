@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "common/units.hpp"
+#include "common/wording.hpp"
 
 namespace mufric {
 namespace {
@@ -74,8 +75,8 @@ std::vector<double> CsvTable::si_column(const std::string& name, QuantityKind ki
       throw Error(path + ": column '" + name + "': " + e.what());
     }
     if (kind != QuantityKind::dimensionless && map.kind != kind) {
-      throw Error(path + ": column '" + name + "' has unit '" + unit + "', a " + std::string(to_string(map.kind)) +
-                  "; expected a " + std::string(to_string(kind)));
+      throw Error(path + ": column '" + name + "' has unit '" + unit + "', " + with_article(to_string(map.kind)) +
+                  "; expected " + with_article(to_string(kind)));
     }
   }
   std::vector<double> values;

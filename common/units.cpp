@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/error.hpp"
+#include "common/wording.hpp"
 
 namespace mufric {
 namespace {
@@ -129,7 +130,7 @@ double parse_quantity(std::string_view text, QuantityKind expected, std::string_
   }
   const std::string_view unit = trim(std::string_view(end, trimmed.data() + trimmed.size() - end));
   if (unit.empty() && expected != QuantityKind::dimensionless) {
-    throw Error(prefix + " has no unit; a " + std::string(to_string(expected)) +
+    throw Error(prefix + " has no unit; " + with_article(to_string(expected)) +
                 " needs one, e.g. " + std::string(example_quantity(expected)));
   }
   if (unit.empty()) return value;
@@ -140,8 +141,8 @@ double parse_quantity(std::string_view text, QuantityKind expected, std::string_
     throw Error(prefix + ": " + e.what());
   }
   if (map.kind != expected) {
-    throw Error(prefix + " is a " + std::string(to_string(map.kind)) + ", expected a " +
-                std::string(to_string(expected)) + " such as " +
+    throw Error(prefix + " is " + with_article(to_string(map.kind)) + ", expected " +
+                with_article(to_string(expected)) + " such as " +
                 std::string(example_quantity(expected)));
   }
   return map.scale * value + map.offset;
@@ -189,7 +190,7 @@ std::string physical_range_violation(double value_si, QuantityKind kind) {
   const std::string value = format_human(value_si, kind);
   if (value_si < range.lo) {
     if (kind == QuantityKind::temperature) return value + " is below absolute zero (" + format_human(0.0, kind, 6) + ")";
-    return value + " is below " + format_human(range.lo, kind) + ", the least a " + std::string(to_string(kind)) + " can be";
+    return value + " is below " + format_human(range.lo, kind) + ", the least " + with_article(to_string(kind)) + " can be";
   }
   return value + " is above " + format_human(range.hi, kind) + ", beyond any physical " + std::string(to_string(kind));
 }

@@ -24,6 +24,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/version.hpp"
+#include "common/wording.hpp"
 #include "server/friction_service.hpp"
 
 namespace mufric::server {
@@ -186,8 +187,8 @@ void run_server(const ServerOptions& options) {
                                : options.tls_client_ca.empty()     ? "TLS"
                                                                    : "mutual TLS";
   log_line("info", "mufric " + code_version() + " serving " + registry.names() + " on " + address + " (" + security +
-                       (token.empty() ? "" : ", bearer token required") + ", " + std::to_string(threads) +
-                       " evaluation threads)");
+                       (token.empty() ? "" : ", bearer token required") + ", " +
+                       count_of(threads, "evaluation thread", "evaluation threads") + ")");
   if (!options.ready_file.empty()) std::ofstream(options.ready_file) << address << "\n";
 
   std::mutex mutex;

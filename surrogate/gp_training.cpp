@@ -16,6 +16,7 @@
 #include "common/environment.hpp"
 #include "common/error.hpp"
 #include "common/version.hpp"
+#include "common/wording.hpp"
 #include "surrogate/cholesky.hpp"
 
 namespace mufric {
@@ -358,7 +359,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
       options.optimise && options.subset_size > 0 && n > 2 * static_cast<Eigen::Index>(options.subset_size);
   TrainingProgress progress(options.progress);
   if (use_subset) {
-    progress.say(std::to_string(starts.size()) + " start(s) on a subset of " + std::to_string(options.subset_size) +
+    progress.say(count_of(static_cast<long long>(starts.size()), "start", "starts") + " on a subset of " + std::to_string(options.subset_size) +
                  " of the " + std::to_string(n) + " points");
     std::vector<Eigen::Index> order(static_cast<size_t>(n));
     std::iota(order.begin(), order.end(), Eigen::Index{0});
@@ -405,7 +406,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     if (leader[s] == s) leaders.push_back(s);
   }
   if (options.optimise) {
-    progress.say(std::to_string(leaders.size()) + " start(s) on all " + std::to_string(n) + " points" +
+    progress.say(count_of(static_cast<long long>(leaders.size()), "start", "starts") + " on all " + std::to_string(n) + " points" +
                  (n > kSlowFitPoints ? " (a likelihood evaluation costs O(n^3): progress every " +
                                            std::to_string(static_cast<int>(options.progress_seconds)) + " s)"
                                      : std::string()));

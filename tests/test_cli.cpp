@@ -686,6 +686,7 @@ TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
   EXPECT_NE(r.output.find("3 micro-model runs spent of a budget of 3"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("pick 2: plan row 7"), std::string::npos) << r.output;  // picks extend the plan
   r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
+  EXPECT_NE(r.output.find(": 1 file, "), std::string::npos) << r.output;  // not "1 files" (issue 30)
   EXPECT_NE(r.output.find("-> 9 samples"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("0 of 9 plan rows not yet run"), std::string::npos) << r.output;
   EXPECT_NE(run("dataset status " + path("db.h5")).output.find("design sobol+active (seed 0)"), std::string::npos);
@@ -786,12 +787,12 @@ TEST_F(Cli, DefaultThreadCountsFollowTheCpuAffinityAndOmpNumThreads) {
     // Shard 1/2 of a one-row plan is empty: the run says its thread counts and ends.
     const CommandResult r = run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --shard 1/2", launcher);
     EXPECT_EQ(r.exit_code, 0) << launcher << ": " << r.output;
-    EXPECT_NE(r.output.find("1 job(s) x 1 thread(s)"), std::string::npos) << launcher << ": " << r.output;
+    EXPECT_NE(r.output.find("1 job x 1 thread"), std::string::npos) << launcher << ": " << r.output;
     const std::string log = path("serve" + std::to_string(i) + ".log");
     ServeProcess server(path("models"), log, path("address" + std::to_string(i)), launchers[i]);
     ASSERT_FALSE(server.address().empty()) << launcher << ": server did not start: " << read_text(log);
     EXPECT_EQ(server.stop(), 0);
-    EXPECT_NE(read_text(log).find(", 1 evaluation threads)"), std::string::npos) << launcher << ": " << read_text(log);
+    EXPECT_NE(read_text(log).find(", 1 evaluation thread)"), std::string::npos) << launcher << ": " << read_text(log);
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include "common/error.hpp"
 #include "common/units.hpp"
+#include "common/wording.hpp"
 
 namespace mufric {
 namespace {
@@ -36,8 +37,20 @@ TEST(Units, NumberWithoutUnitIsAnErrorNamingTheField) {
 TEST(Units, UnknownAndWrongKindUnitsAreErrors) {
   EXPECT_NE(message_of("800psi", QuantityKind::pressure).find("unknown unit 'psi'"), std::string::npos);
   EXPECT_NE(message_of("800m/s", QuantityKind::pressure).find("is a velocity, expected a pressure"), std::string::npos);
+  // Regression (issue 30): "is a angle", "expected a angle".
+  EXPECT_NE(message_of("90deg", QuantityKind::pressure).find("is an angle, expected a pressure"), std::string::npos);
+  EXPECT_NE(message_of("800MPa", QuantityKind::angle).find("is a pressure, expected an angle such as"), std::string::npos);
+  EXPECT_NE(message_of("90", QuantityKind::angle).find("has no unit; an angle needs one"), std::string::npos);
   EXPECT_NE(message_of("abc", QuantityKind::pressure).find("not a number"), std::string::npos);
   EXPECT_NE(message_of("nanMPa", QuantityKind::pressure).find("not a number"), std::string::npos);
+}
+
+TEST(Wording, CountsAndArticles) {
+  EXPECT_EQ(count_of(1, "file", "files"), "1 file");
+  EXPECT_EQ(count_of(0, "file", "files"), "0 files");
+  EXPECT_EQ(count_of(3, "evaluation thread", "evaluation threads"), "3 evaluation threads");
+  EXPECT_EQ(with_article("angle"), "an angle");
+  EXPECT_EQ(with_article("pressure"), "a pressure");
 }
 
 TEST(Units, FormatsInHumanUnits) {
