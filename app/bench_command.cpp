@@ -142,11 +142,12 @@ void add_bench_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "Throughput and latency of a model: in-process (file://) or a server (grpc://)");
   cmd->add_option("--model", o->model, "file:///path/model.h5 (or a path), grpc://host:port/model")->required();
-  cmd->add_option("--batch", o->batches, "Batch sizes (points per call)")->capture_default_str()->expected(1, 16);
+  cmd->add_option("--batch", o->batches, "Batch sizes (points per call)")->capture_default_str()->expected(1, 16)
+      ->check(CLI::Range(1LL, 100'000'000LL));
   cmd->add_option("--clients", o->clients, "Concurrent clients, each with its own connection")
       ->capture_default_str()->check(CLI::Range(1, 1024));
   cmd->add_option("--seconds", o->seconds, "Measuring time per batch size")->capture_default_str()
-      ->check(CLI::Range(0.01, 3600.0));
+      ->check(FiniteRange(0.01, 3600.0));
   cmd->add_flag("--std", o->with_std, "Also the standard deviation and a 95 % interval");
   cmd->add_flag("--stream", o->streaming, "grpc://: send blocks over one EvaluateStream per client");
   cmd->add_flag("--json", o->json, "One JSON object per batch size instead of a table");
@@ -156,7 +157,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--replay", o->replay,
                   "Meso-trace replay instead of fixed batches: POINTS,INCREMENTS contact points drifting over "
                   "increments, one call per increment")
-      ->delimiter(',')->expected(2);
+      ->delimiter(',')->expected(2)->check(CLI::Range(1LL, 1'000'000'000LL));
   cmd->callback([o] {
     EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
     if (o->exact) what.mu_tolerance = what.std_relative_tolerance = 0.0;
@@ -164,7 +165,6 @@ void add_bench_command(CLI::App& app) {
     options.streaming = options.streaming || o->streaming;
     options.isolate_file_parsing = true;  // a command-line tool: a corrupt file is an error, not a crash
     if (!o->replay.empty()) {
-      if (o->replay[0] <= 0 || o->replay[1] <= 0) throw Error("--replay: POINTS and INCREMENTS must be positive");
       const Measurement m = replay(o->model, options, o->replay[0], o->replay[1], what);
       const double p50 = m.latencies[m.latencies.size() / 2];
       const double p99 = m.latencies[std::min(m.latencies.size() - 1, m.latencies.size() * 99 / 100)];
@@ -189,7 +189,6 @@ void add_bench_command(CLI::App& app) {
     long long failed_calls = 0;
     std::string first_error;
     for (const long long batch : o->batches) {
-      if (batch <= 0) throw Error("--batch: sizes must be positive");
       const Measurement m = measure(o->model, options, batch, o->clients, o->seconds, what);
       if (m.latencies.empty()) throw Error("bench: no call succeeded: " + m.first_error);
       failed_calls += m.errors;

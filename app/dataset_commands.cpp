@@ -323,7 +323,7 @@ void add_dataset_commands(CLI::App& app) {
   run->add_option("--sample-timeout", r->sample_timeout,
                   "Stop a sample still running after this many seconds and record it as failed, with where it stopped "
                      "(0: no limit). A corner of the box where the solver crawls then costs a shard this long, not hours")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e7));
+      ->capture_default_str()->check(FiniteRange(0.0, 1e7));
   run->footer("The database is rewritten atomically after every sample: a killed run loses only the samples in\n"
               "flight, and running the same command again skips every finished plan row. A sample whose run does\n"
               "not converge is recorded as failed with its reason. Shards write separate databases; combine them\n"
@@ -349,7 +349,7 @@ void add_dataset_commands(CLI::App& app) {
   refine->add_option("--grow-coverage", f->refine.grow_coverage,
                      "With --grow-box: cover this quantile of the outside rows per input and side (0.99 ignores the "
                      "farthest 1 %, e.g. a meso code's spikes)")
-      ->capture_default_str()->check(CLI::Range(1e-3, 1.0));
+      ->capture_default_str()->check(FiniteRange(1e-3, 1.0));
   refine->add_option("--candidate-count", f->refine.candidate_count, "Sobol' candidates per round")->capture_default_str()
       ->check(CLI::Range(16LL, 100000LL));
   refine->add_option("--model-out", f->refine.model_out, "Write the GP trained after each round here");
@@ -358,7 +358,7 @@ void add_dataset_commands(CLI::App& app) {
   refine->add_option("--restarts", f->refine.restarts, "GP optimiser restarts per round")->capture_default_str();
   refine->add_option("--sample-timeout", f->sample_timeout,
                      "Stop a run still going after this many seconds and record it as failed (0: no limit)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e7));
+      ->capture_default_str()->check(FiniteRange(0.0, 1e7));
   refine->add_option("--seed", f->refine.seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
   refine->footer("Each round trains a GP on the converged samples, picks --batch candidates by the largest posterior\n"
                  "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"

@@ -414,7 +414,7 @@ void add_micro_commands(CLI::App& app) {
   converge->add_option("scene", c->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
   converge->add_option("--set", c->overrides, "Override a scene value (repeatable)");
   converge->add_option("--tolerance", c->tolerance, "Relative change of mu that counts as converged")
-      ->capture_default_str()->check(CLI::Range(1e-6, 1.0));
+      ->capture_default_str()->check(FiniteRange(1e-6, 1.0));
   converge->add_option("--parameter", c->parameter,
                        "What each level refines: mesh (doubles the elements, see --direction), step (halves\n"
                        "protocol.step_distance), window (doubles protocol.window) or phases (doubles\n"
@@ -442,7 +442,7 @@ void add_micro_commands(CLI::App& app) {
   fluid_check->require_subcommand(1);
   auto* cavity = fluid_check->add_subcommand(
       "cavity", "Lid-driven cavity (steady): both centre lines as CSV, beside Ghia, Ghia & Shin (1982) at Re = 100");
-  cavity->add_option("--reynolds", fc->reynolds, "Reynolds number U L / nu")->capture_default_str()->check(CLI::Range(1e-3, 1e4));
+  cavity->add_option("--reynolds", fc->reynolds, "Reynolds number U L / nu")->capture_default_str()->check(FiniteRange(1e-3, 1e4));
   cavity->add_option("--elements", fc->elements, "Elements per side")->capture_default_str()->check(CLI::Range(4, 512));
   cavity->add_option("--degree", fc->degree, "Spline degree of velocity and pressure")->capture_default_str()->check(CLI::Range(1, 4));
   cavity->footer("The unit square, lid speed 1, steady Navier-Stokes by the same stabilised solver the lubricant uses.\n"

@@ -42,7 +42,7 @@ void add_service_commands(CLI::App& app) {
       ->required();
   cmd->add_option("--listen", o->listen, "Address to listen on (port 0: any free port)")->capture_default_str();
   cmd->add_option("--poll", o->poll_seconds, "Seconds between rescans of the directory for new or changed files")
-      ->capture_default_str()->check(CLI::Range(0.05, 3600.0));
+      ->capture_default_str()->check(FiniteRange(0.05, 3600.0));
   cmd->add_option("--max-message-mb", o->max_message_mb, "Largest request or response, MB")->capture_default_str()
       ->check(CLI::Range(1, 2000));
   cmd->add_option("--max-points", o->max_points, "Most points in one request")->capture_default_str()
@@ -51,7 +51,8 @@ void add_service_commands(CLI::App& app) {
                   "Cores evaluation may use (0: all the CPU affinity allows, at most OMP_NUM_THREADS). A batch "
                   "running alone uses them all; k concurrent batches share them, max(1, threads/k) each")
       ->capture_default_str()->check(CLI::Range(0, 4096));
-  cmd->add_option("--drain", o->drain_seconds, "Seconds requests in flight get on SIGTERM")->capture_default_str();
+  cmd->add_option("--drain", o->drain_seconds, "Seconds requests in flight get on SIGTERM")->capture_default_str()
+      ->check(FiniteRange(0.0, 3600.0));
   cmd->add_option("--ready-file", o->ready_file, "Write the bound address here once serving (for scripts)");
   cmd->add_option("--token-file", o->token_file, "Require 'authorization: Bearer <token>' with the token in this file")
       ->check(CLI::ExistingFile);
@@ -65,7 +66,7 @@ void add_service_commands(CLI::App& app) {
                   "Counts of outside queries per input and side go to DIR/<model>.outside.json (makes every call "
                   "compute the std)");
   cmd->add_option("--uncertain-width", o->uncertain_width, "Interval width (in mu) above which a query is logged")
-      ->capture_default_str()->check(CLI::Range(1e-9, 1e9));
+      ->capture_default_str()->check(FiniteRange(1e-9, 1e9));
   cmd->add_option("--uncertain-max-rows", o->uncertain_max_rows, "Most logged queries per model")->capture_default_str()
       ->check(CLI::Range(1LL, 1'000'000'000LL));
   cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"

@@ -256,7 +256,7 @@ void add_eval(CLI::App& app) {
   cmd->add_option("--model", o->model, "Model file or file:// URI")->required();
   cmd->add_option("--test", o->test, "Test dataset (HDF5 or CSV), not used in training")->required();
   cmd->add_option("--level", o->level, "Confidence level of the interval whose coverage is reported")
-      ->capture_default_str()->check(CLI::Range(0.5, 0.9999));
+      ->capture_default_str()->check(FiniteRange(0.5, 0.9999));
   cmd->callback([o] {
     const auto model = load_model_isolated(model_path_from_uri(o->model));
     const TrainingSet test = training_set(read_dataset_isolated(o->test), o->test);
@@ -330,7 +330,7 @@ void add_predict(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "With --csv: write the answers here (default: standard output)");
   cmd->add_option("--level", o->level, "Confidence level of the interval")->capture_default_str()
-      ->check(CLI::Range(0.5, 0.9999));
+      ->check(FiniteRange(0.5, 0.9999));
   cmd->add_flag("--gradient", o->gradient, "Also print dmu/dinput, per the input's human unit (per MPa, m/min, C)");
   cmd->add_option("--extrapolation", o->extrapolation,
                   "Outside the training box: raw, clamp or refuse (default: the model file's policy)")
@@ -460,7 +460,7 @@ void add_law(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* coulomb = law->add_subcommand("coulomb", "Constant friction coefficient");
-  coulomb->add_option("--mu", o->mu, "The coefficient")->required()->check(CLI::Range(0.0, 10.0));
+  coulomb->add_option("--mu", o->mu, "The coefficient")->required()->check(FiniteRange(0.0, 10.0));
   coulomb->add_option("--out", o->out, "Model file to write")->required();
   coulomb->callback([o] {
     save_model(o->out, CoulombLaw(o->mu));
@@ -506,7 +506,7 @@ void add_dataset_from_model(CLI::App& app) {
       ->check(CLI::Range(1, 10000000));
   from_model->add_option("--seed", o->sampling.seed, "Random seed")->capture_default_str();
   from_model->add_option("--noise", o->sampling.noise_std, "Std of additive Gaussian noise on mu")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()->check(FiniteRange(0.0, 1.0));
   from_model->add_option("--out", o->out, "Dataset file to write (HDF5)")->required();
   from_model->callback([o] {
     const auto model = load_model_isolated(model_path_from_uri(o->model));

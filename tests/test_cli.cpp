@@ -400,6 +400,31 @@ TEST_F(Cli, BenchWithFailedCallsExits2) {
   EXPECT_NE(r.output.find("points/s"), std::string::npos) << r.output;  // the table, before the error
 }
 
+// Regression (issue 30): `serve --drain -5` was accepted, and NaN passed every CLI::Range (each
+// comparison with it is false): `--poll nan` reached the server loop. Each is refused naming the
+// option, before a server starts (`timeout`: a server that starts makes the test fail, not hang).
+TEST_F(Cli, ServeAndBenchRefuseNegativeAndNonFiniteNumbers) {
+  std::filesystem::create_directories(path("models"));
+  const std::string serve = "serve --models " + path("models") + " --listen 127.0.0.1:0 ";
+  for (const std::string bad : {"--drain -5", "--drain nan", "--drain inf", "--drain 1e9", "--poll nan", "--poll -1",
+                                "--uncertain-width nan", "--uncertain-width -0.1"}) {
+    const CommandResult r = run(serve + bad, "timeout 20");
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    const std::string flag = bad.substr(0, bad.find(' '));
+    EXPECT_EQ(r.output.rfind("mufric: error: " + flag + ": Value ", 0), 0u) << bad << ": " << r.output;
+    EXPECT_EQ(line_count(r.output), 1u) << r.output;
+  }
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("law.h5")).exit_code, 0);
+  for (const std::string bad : {"--seconds nan", "--seconds -1", "--seconds inf", "--batch 0", "--batch 64 -1",
+                                "--replay 0,5", "--replay 5,-1"}) {
+    const CommandResult r = run("bench --model " + path("law.h5") + " " + bad, "timeout 20");
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    const std::string flag = bad.substr(0, bad.find(' '));
+    EXPECT_EQ(r.output.rfind("mufric: error: " + flag + ": ", 0), 0u) << bad << ": " << r.output;  // before the table
+  }
+  EXPECT_NE(run("law coulomb --mu nan --out " + path("nan.h5")).exit_code, 0);
+}
+
 TEST_F(Cli, MicroProfileReportsRoughnessAndFitError) {
   CommandResult r = run("micro profile --ra 0.25um --correlation 1um --length 20um --seed 3 --out " + path("fit.csv"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
