@@ -223,6 +223,7 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
     }
   }
   for (const auto& w : m.warnings) std::printf("warning: %s\n", w.c_str());
+  for (const auto& w : m.advisories) std::printf("warning: %s\n", w.c_str());
 }
 
 int run_command(const RunCommandOptions& o) {
@@ -234,7 +235,7 @@ int run_command(const RunCommandOptions& o) {
   if (!o.quiet) options.on_step = std::ref(progress);
   for (const auto& w : sc.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   scene::MuMeasurement m = scene::measure_mu(sc, options);
-  m.warnings.insert(m.warnings.begin(), sc.warnings.begin(), sc.warnings.end());
+  m.advisories.insert(m.advisories.begin(), sc.warnings.begin(), sc.warnings.end());
   write_file_atomically(o.out + "/result.json", m.to_json(sc).dump(2) + "\n");
   print_summary(m, sc);
   std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu%s (first draw)\n", o.out.c_str(), o.out.c_str(), o.out.c_str(),

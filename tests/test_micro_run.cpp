@@ -124,15 +124,17 @@ TEST(MicroRun, MeasurementWarnsOfDriftAndOfAStandardErrorFromFewDraws) {
   m.draws.resize(2);
   m.draws[0].result.drift = 0.448;
   m.draws[1].result.drift = -0.1;
-  add_measurement_warnings(m);
-  ASSERT_EQ(m.warnings.size(), 2u);
-  EXPECT_NE(m.warnings[0].find("draw 0: mu drifted by 44.8 %"), std::string::npos) << m.warnings[0];
-  EXPECT_NE(m.warnings[1].find("from 2 draws: it is itself uncertain by about +-71 %"), std::string::npos) << m.warnings[1];
+  add_measurement_advisories(m);
+  ASSERT_EQ(m.advisories.size(), 2u);
+  EXPECT_NE(m.advisories[0].find("draw 0: mu drifted by 44.8 %"), std::string::npos) << m.advisories[0];
+  EXPECT_NE(m.advisories[1].find("from 2 draws: it is itself uncertain by about +-71 %"), std::string::npos)
+      << m.advisories[1];
+  EXPECT_TRUE(m.warnings.empty());  // advisories: a dataset still trains on such a sample
   MuMeasurement steady;
   steady.draws.resize(kFewDrawsForStdError);
   for (auto& d : steady.draws) d.result.drift = kDriftWarningFraction * 0.99;
-  add_measurement_warnings(steady);
-  EXPECT_TRUE(steady.warnings.empty());
+  add_measurement_advisories(steady);
+  EXPECT_TRUE(steady.advisories.empty());
 }
 
 TEST(MicroRun, FlatToolTransmitsNoTangentialForce) {

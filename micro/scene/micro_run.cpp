@@ -564,7 +564,7 @@ double MuMeasurement::max_abs_drift() const {
   return d;
 }
 
-void add_measurement_warnings(MuMeasurement& m) {
+void add_measurement_advisories(MuMeasurement& m) {
   const double n = static_cast<double>(m.draws.size());
   for (size_t i = 0; i < m.draws.size(); ++i) {
     const double drift = m.draws[i].result.drift;
@@ -574,7 +574,7 @@ void add_measurement_warnings(MuMeasurement& m) {
                     "draw %zu: mu drifted by %.1f %% of mu across its averaging window (first to last block mean, "
                     "warning above %.0f %%): the slide may not be steady; a longer protocol.window or more draws",
                     i, 100.0 * drift, 100.0 * kDriftWarningFraction);
-      m.warnings.emplace_back(text);
+      m.advisories.emplace_back(text);
     }
   }
   if (m.draws.size() > 1 && m.draws.size() < kFewDrawsForStdError) {
@@ -585,7 +585,7 @@ void add_measurement_warnings(MuMeasurement& m) {
                   "the standard error of mu comes from %zu draws: it is itself uncertain by about +-%.0f %%; "
                   "%zu or more draws make it a figure to rely on",
                   m.draws.size(), 100.0 / std::sqrt(2.0 * (n - 1.0)), kFewDrawsForStdError);
-    m.warnings.emplace_back(text);
+    m.advisories.emplace_back(text);
   }
 }
 
@@ -656,14 +656,16 @@ MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
       for (double x : values) squares += (x - m.mu) * (x - m.mu);
       m.std_error = std::sqrt(squares / (n - 1.0) / n);  // sample standard deviation / √n
     }
-    add_measurement_warnings(m);
+    add_measurement_advisories(m);
   }
   m.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return m;
 }
 
 nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
-  nlohmann::json j = result_head(scene, true, completed, reason, warnings, mu);
+  std::vector<std::string> all_warnings = warnings;
+  all_warnings.insert(all_warnings.end(), advisories.begin(), advisories.end());
+  nlohmann::json j = result_head(scene, true, completed, reason, all_warnings, mu);
   j["mu_std_error"] = completed && std_error ? nlohmann::json(*std_error) : nlohmann::json(nullptr);
   const ProtocolSpec& q = scene.protocol;
   nlohmann::json& p = j["protocol"];

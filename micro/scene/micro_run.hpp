@@ -123,7 +123,11 @@ struct MuMeasurement {
   double mu = 0.0;
   std::optional<double> std_error;
   std::vector<Draw> draws;
-  std::vector<std::string> warnings;  // the draws' warnings, each once
+  // The draws' warnings, each once (a molten chip): a dataset keeps such a sample outside the model.
+  std::vector<std::string> warnings;
+  // Warnings that leave μ in the model (a drifting window, few draws, keys without effect): printed
+  // and in result.json's "warnings" beside the above, but a dataset trains on the sample.
+  std::vector<std::string> advisories;
   double wall_seconds = 0.0;
   int threads = 1;  // draws run at once
   double max_abs_drift() const;
@@ -144,9 +148,9 @@ std::vector<Draw> protocol_draws(const Scene& scene);
 // The scene of one draw.
 Scene draw_scene(const Scene& scene, const Draw& draw);
 MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options = {});
-// Warnings of a completed measurement: a draw whose window drifted by more than kDriftWarningFraction,
+// Advisories of a completed measurement: a draw whose window drifted by more than kDriftWarningFraction,
 // a standard error from fewer than kFewDrawsForStdError draws.
-void add_measurement_warnings(MuMeasurement& m);
+void add_measurement_advisories(MuMeasurement& m);
 
 // The chip surface and the tool surface as fitted periodic curves, the tool placed above the chip
 // at the scene's initial gap.
