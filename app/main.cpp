@@ -70,6 +70,10 @@ int main(int argc, char** argv) {
   mufric::app::add_dataset_commands(app);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    // A command's own exit code, thrown from its callback (micro run: 3 when the run did not
+    // complete); it has said why. CLI11 derives it from ParseError, so it is caught first.
+    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     // --help and --version are "errors" with CLI11's success code: their normal output, exit 0.
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
