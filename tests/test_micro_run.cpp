@@ -96,6 +96,17 @@ TEST(Scene, ASceneThatCannotFitIsRefusedWithItsEstimate) {
   EXPECT_TRUE(base.warnings.empty());
 }
 
+// A unit error names the file as every other scene error does (issue 30: it said only
+// "load.pressure: '800Mpa': unknown unit").
+TEST(Scene, AUnitErrorNamesTheFileAndTheKey) {
+  try {
+    scene_with_overrides(default_scene_json(), {"load.pressure=800Mpa"}, "my_scene.json");
+    ADD_FAILURE() << "an unknown unit was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("my_scene.json: load.pressure: '800Mpa': unknown unit 'Mpa'", 0), 0u) << e.what();
+  }
+}
+
 TEST(Scene, NumbersJsonCannotHoldAreErrors) {
   EXPECT_THROW(scene_with_overrides(default_scene_json(), {"load.pressure=1e999"}, "test"), Error);
   const std::string path = (std::filesystem::temp_directory_path() / "mufric_overflow_scene.json").string();

@@ -36,7 +36,12 @@ class Section {
     if (!v->is_string()) {
       fail(key, "give a value with its unit as a string, e.g. \"" + std::string(example_quantity(kind)) + "\"");
     }
-    const double x = parse_quantity(v->get<std::string>(), kind, name(key));
+    double x = 0.0;
+    try {
+      x = parse_quantity(v->get<std::string>(), kind, name(key));
+    } catch (const Error& e) {
+      throw Error(source_ + ": " + e.what());  // the file too, as for every other key's error
+    }
     if (!(x >= lo && x <= hi)) {
       fail(key, v->get<std::string>() + " is outside [" + format_human(lo, kind) + ", " + format_human(hi, kind) + "]");
     }
