@@ -168,7 +168,7 @@ void add_bench_command(CLI::App& app) {
       const Measurement m = replay(o->model, options, o->replay[0], o->replay[1], what);
       const double p50 = m.latencies[m.latencies.size() / 2];
       const double p99 = m.latencies[std::min(m.latencies.size() - 1, m.latencies.size() * 99 / 100)];
-      const double rate = static_cast<double>(o->replay[0] * o->replay[1]) / m.wall_seconds;
+      const double rate = static_cast<double>(o->replay[0] * std::max(0LL, o->replay[1] - m.errors)) / m.wall_seconds;  // answered
       if (o->json) {
         std::printf("{\"replay_points\": %lld, \"increments\": %lld, \"seconds\": %.4g, \"points_per_second\": %.6g, "
                     "\"p50_us\": %.4g, \"p99_us\": %.4g, \"errors\": %lld}\n",
@@ -195,7 +195,9 @@ void add_bench_command(CLI::App& app) {
       if (first_error.empty()) first_error = m.first_error;
       const double p50 = m.latencies[m.latencies.size() / 2];
       const double p99 = m.latencies[std::min(m.latencies.size() - 1, m.latencies.size() * 99 / 100)];
-      const double points_per_second = static_cast<double>(batch) * static_cast<double>(m.latencies.size()) / m.wall_seconds;
+      // Answered points only: a failed call moved no points (it also makes the command exit 2).
+      const double answered_calls = std::max(0.0, static_cast<double>(m.latencies.size()) - static_cast<double>(m.errors));
+      const double points_per_second = static_cast<double>(batch) * answered_calls / m.wall_seconds;
       if (o->json) {
         std::printf("{\"batch\": %lld, \"clients\": %d, \"calls\": %zu, \"points_per_second\": %.6g, \"p50_us\": %.4g, "
                     "\"p99_us\": %.4g, \"errors\": %lld, \"std\": %s}\n",

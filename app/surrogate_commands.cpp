@@ -134,20 +134,23 @@ double fast_evaluator_budget(const FastOptions& o, double fit_seconds) {
 }
 
 void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
+  // Positive and finite (PositiveNumber let "inf" through): a tolerance below rounding cannot be
+  // met, and a budget of 0 builds nothing.
+  constexpr double kLeastTolerance = 1e-15, kLeastBudget = 1e-3;
   cmd->add_option("--fast-mu-tolerance", o.build.mu_tolerance,
                   "Fast evaluator: refine until its measured bound on mu is within this (absolute)")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(FiniteRange(kLeastTolerance, 1.0));
   cmd->add_option("--fast-std-tolerance", o.build.std_relative_tolerance,
                   "Fast evaluator: ... and its bound on std within this fraction of max(std, F), where\n"
                   "F = mu tolerance / std tolerance: the interval's bounds mu +- z std are then accurate to\n"
                   "this fraction of the half-width, or to the mu tolerance where std is smaller than F")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(FiniteRange(kLeastTolerance, 1.0));
   cmd->add_option("--fast-max-mb", o.build.max_megabytes, "Fast evaluator: largest grid, MB")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(FiniteRange(kLeastBudget, 1e6));
   cmd->add_option("--fast-max-seconds", o.max_seconds,
                   "Fast evaluator: time budget; a finer grid whose predicted cost would not fit is not built\n"
                   "(default: the GP fit's wall time, at least 10 s)")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(kLeastBudget, 1e6));
   cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
 }
 

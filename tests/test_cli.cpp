@@ -250,6 +250,9 @@ TEST_F(Cli, DataThatCannotBeAModelsDataIsRefusedByName) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("given by --mu-range"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(path("m.h5")));
+  r = run("train --data " + path("ok.csv") + " --out " + path("m.h5") + " --fast-max-seconds inf");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--fast-max-seconds: Value inf is not a finite number"), std::string::npos) << r.output;
   r = run("dataset plan --out " + path("p.h5") + " --samples 4 --T -400C:25C");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--T '-400C:25C': -400°C is below absolute zero"), std::string::npos) << r.output;
