@@ -67,6 +67,7 @@ struct PlanOptions {
   std::vector<std::string> overrides;
   long long samples = 64;
   unsigned long long seed = 0;
+  bool common_tools = false;
 };
 
 void plan_command(const PlanOptions& o) {
@@ -86,6 +87,7 @@ void plan_command(const PlanOptions& o) {
   spec.plan = plan_in_box(design, o.samples, box, o.seed);
   spec.plan_design = plan_design_name(design);
   spec.plan_seed = static_cast<long long>(o.seed);
+  spec.draws = o.common_tools ? DrawDesign::common : DrawDesign::independent;
   spec.scene_json = sc.effective.dump(2);
   // What a reader of `dataset status` needs first: which physics, and whether the named scene was changed.
   const std::string scene_label = sc.source + (o.overrides.empty() ? "" : " with " + std::to_string(o.overrides.size()) + " --set") +
@@ -93,8 +95,11 @@ void plan_command(const PlanOptions& o) {
   spec.source = "micro-model plan (" + scene_label + ")";
   const Dataset plan = empty_dataset(spec);
   write_dataset(o.out, plan);
-  std::printf("wrote %s: %lld points, %s design (seed %llu), scene %s (sha256 %s)\n", o.out.c_str(), o.samples,
-              plan.plan_design.c_str(), o.seed, scene_label.c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());
+  std::printf("wrote %s: %lld points, %s design (seed %llu), %s, scene %s (sha256 %s)\n", o.out.c_str(), o.samples,
+              plan.plan_design.c_str(), o.seed,
+              o.common_tools ? "every row on the scene's own tool and chip surfaces (common draws)"
+                             : "every row its own tool and chip surfaces (independent draws)",
+              scene_label.c_str(), sha256_hex(plan.scene_json).substr(0, 12).c_str());
   print_box(box);
 }
 
@@ -241,6 +246,9 @@ void status_command(const std::string& path) {
   std::printf("  plan: %lld points%s%s", static_cast<long long>(d.plan.rows()), d.plan_design.empty() ? "" : ", design ",
               d.plan_design.c_str());
   if (!d.plan_design.empty()) std::printf(" (seed %lld)", d.plan_seed);
+  std::printf("; draws %s", d.draws == DrawDesign::independent ? "independent (every row its own tool and chip surfaces)"
+                            : d.draws == DrawDesign::common    ? "common (every row the scene's own surfaces)"
+                                                               : "common (a file from before draws were recorded)");
   std::printf("\n  samples: %lld (%lld converged, %lld outside the model, %lld failed)", static_cast<long long>(d.size()),
               converged, outside, static_cast<long long>(d.size()) - converged - outside);
   if (!d.plan_index.empty() || d.size() == 0) {
@@ -306,6 +314,11 @@ void add_dataset_commands(CLI::App& app) {
   plan->add_option("--scene", p->scene_path, "Scene file (JSON) stored with the plan; default: the default dry scene")
       ->check(CLI::ExistingFile);
   plan->add_option("--set", p->overrides, "Override a scene value, e.g. --set time.duration=100ns (repeatable)");
+  plan->add_flag("--common-tools", p->common_tools,
+                 "Every row on the scene's own tool and chip surfaces (common random numbers), as before issue 33: "
+                 "for a trend or a difference between scenes, where shared surfaces cancel. Default: every row its "
+                 "own surfaces, drawn from seeds derived from --seed and the row, so that their error averages out "
+                 "over the campaign and the model's interval shrinks with it");
   plan->footer("Every planned point is kept in the file, so a database made from it accounts for each one.");
   plan->callback([p] { plan_command(*p); });
 

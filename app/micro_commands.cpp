@@ -184,8 +184,8 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
                 count_of(q.realisations, "realisation", "realisations").c_str(), sc.ramp * 1e9, q.press_hold * 1e9, q.window * 1e6, q.run_in * 1e6,
                 relative_percent(m.max_abs_drift(), 1.0).c_str());
     if (m.draws.size() > 1) {
-      std::printf("| draw | tool shift | tool seed | mu | block means | drift | steps | Newton | cut-backs | wall [s] |\n"
-                  "|---|---|---|---|---|---|---|---|---|---|\n");
+      std::printf("| draw | tool shift | tool seed | chip seed | mu | block means | drift | steps | Newton | cut-backs | wall [s] |\n"
+                  "|---|---|---|---|---|---|---|---|---|---|---|\n");
       for (size_t i = 0; i < m.draws.size(); ++i) {
         const auto& d = m.draws[i];
         std::string blocks;
@@ -194,8 +194,9 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
           std::snprintf(t, sizeof t, "%s%.4f", blocks.empty() ? "" : " ", b);
           blocks += t;
         }
-        std::printf("| %zu | %.3f | %llu | %.5f | %s | %s | %zu | %d | %zu | %.1f |\n", i + 1, d.shift_fraction,
-                    static_cast<unsigned long long>(d.seed), d.result.mu, blocks.c_str(),
+        const std::string chip = d.chip_seed ? std::to_string(*d.chip_seed) : "scene's";
+        std::printf("| %zu | %.3f | %llu | %s | %.5f | %s | %s | %zu | %d | %zu | %.1f |\n", i + 1, d.shift_fraction,
+                    static_cast<unsigned long long>(d.seed), chip.c_str(), d.result.mu, blocks.c_str(),
                     relative_percent(d.result.drift, 1.0).c_str(), d.result.history.size(),
                     d.result.solver.newton_iterations, d.result.solver.cutbacks.size(), d.result.wall_seconds);
       }
@@ -389,8 +390,10 @@ void add_micro_commands(CLI::App& app) {
   run->add_flag("--quiet", r->quiet, "No per-step progress on stderr");
   run->footer("The scene's protocol says what mu means. press-slide (the default): the chip is pressed, then slid;\n"
               "mu is averaged over protocol.window of sliding after protocol.run_in, for protocol.phases tool\n"
-              "positions (x protocol.realisations tools of the same roughness), run in parallel on the cores\n"
-              "OMP_NUM_THREADS allows, and printed with its standard error and each draw's block means and drift.\n"
+              "positions (x protocol.realisations tools of the same roughness; with protocol.draws tools-and-chip,\n"
+              "the default for a synthetic chip, each realisation also draws the chip surface anew), run in parallel\n"
+              "on the cores OMP_NUM_THREADS allows, and printed with its standard error and each draw's block means\n"
+              "and drift; protocol.draws=tools keeps the scene's one chip surface for every draw.\n"
               "seed-000 (--set protocol.name=seed-000): the paper's one draw, pressure ramped while sliding, mu\n"
               "averaged over [time.average_from, time.duration].\n"
               "Exit code 0 when the run completed and mu was averaged, 3 when it did not (result.json says why),\n"

@@ -43,6 +43,25 @@ bool same_plan(const h5::RowMatrix& a, const h5::RowMatrix& b) {
 
 }  // namespace
 
+namespace {
+
+// SplitMix64's output function (Steele, Lea & Flood 2014; Vigna's reference constants).
+std::uint64_t splitmix64(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+constexpr std::uint64_t kRowSeedMask = (std::uint64_t{1} << 30) - 1;
+
+}  // namespace
+
+DrawSeeds row_draw_seeds(long long plan_seed, long long row) {
+  const std::uint64_t h = splitmix64(static_cast<std::uint64_t>(plan_seed) ^ splitmix64(static_cast<std::uint64_t>(row)));
+  return {h & kRowSeedMask, (h >> 32) & kRowSeedMask};
+}
+
 Dataset empty_dataset(const Dataset& plan) {
   Dataset d;
   d.inputs = plan.inputs;
@@ -52,6 +71,8 @@ Dataset empty_dataset(const Dataset& plan) {
   d.plan = plan.plan;
   d.plan_design = plan.plan_design;
   d.plan_seed = plan.plan_seed;
+  d.draws = plan.draws;
+  d.draw_mu.resize(0, 0);
   d.box_history = plan.box_history;
   d.source = plan.source;
   d.scene_json = plan.scene_json;
@@ -75,12 +96,28 @@ Dataset open_database(const std::string& db_path, const Dataset& plan) {
     throw Error(db_path + ": was made with a different scene (sha256 " + sha256_hex(d.scene_json).substr(0, 12) +
                 ", now " + sha256_hex(plan.scene_json).substr(0, 12) + "); use another --db");
   }
+  if (d.draws != plan.draws || d.plan_seed != plan.plan_seed) {
+    throw Error(db_path + ": draws its roughness differently from the plan (draws '" + std::string(draw_design_name(d.draws)) +
+                "', plan seed " + std::to_string(d.plan_seed) + "; the plan: '" + draw_design_name(plan.draws) + "', " +
+                std::to_string(plan.plan_seed) + "); use another --db");
+  }
   if (d.plan_index.size() != static_cast<size_t>(d.size())) throw Error(db_path + ": has samples without plan rows");
   return d;
 }
 
-void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, const SampleOutcome& outcome) {
+void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, const SampleOutcome& outcome,
+                   const std::optional<DrawSeeds>& seeds) {
   const Eigen::Index n = d.size();
+  d.tool_seed.resize(static_cast<size_t>(n), -1);
+  d.chip_seed.resize(static_cast<size_t>(n), -1);
+  d.tool_seed.push_back(seeds ? static_cast<long long>(seeds->tool) : -1);
+  d.chip_seed.push_back(seeds ? static_cast<long long>(seeds->chip) : -1);
+  const auto draws = static_cast<Eigen::Index>(outcome.draw_mu.size());
+  const Eigen::Index columns = std::max(d.draw_mu.cols(), draws);
+  h5::RowMatrix draw_mu = h5::RowMatrix::Constant(n + 1, columns, std::numeric_limits<double>::quiet_NaN());
+  if (d.draw_mu.rows() == n) draw_mu.topLeftCorner(n, d.draw_mu.cols()) = d.draw_mu;
+  for (Eigen::Index k = 0; k < draws; ++k) draw_mu(n, k) = outcome.draw_mu[static_cast<size_t>(k)];
+  d.draw_mu = std::move(draw_mu);
   d.x.conservativeResize(n + 1, Eigen::NoChange);
   d.x.row(n) = x.transpose();
   d.mu.conservativeResize(n + 1);
@@ -127,6 +164,9 @@ void remove_rows(Dataset& d, const std::set<long long>& rows) {
   k.status.clear();
   k.failure_reason.clear();
   k.plan_index.clear();
+  k.tool_seed.clear();
+  k.chip_seed.clear();
+  k.draw_mu.resize(m, d.draw_mu.cols());
   for (auto& [name, values] : k.diagnostics) values.resize(m);
   for (Eigen::Index r = 0; r < m; ++r) {
     const Eigen::Index i = keep[static_cast<size_t>(r)];
@@ -136,6 +176,9 @@ void remove_rows(Dataset& d, const std::set<long long>& rows) {
     k.status.push_back(d.status[static_cast<size_t>(i)]);
     k.failure_reason.push_back(d.failure_reason[static_cast<size_t>(i)]);
     k.plan_index.push_back(d.plan_index[static_cast<size_t>(i)]);
+    if (!d.tool_seed.empty()) k.tool_seed.push_back(d.tool_seed[static_cast<size_t>(i)]);
+    if (!d.chip_seed.empty()) k.chip_seed.push_back(d.chip_seed[static_cast<size_t>(i)]);
+    if (d.draw_mu.cols() > 0) k.draw_mu.row(r) = d.draw_mu.row(i);
     for (auto& [name, values] : k.diagnostics) values(r) = d.diagnostics.at(name)(i);
   }
   d = std::move(k);
@@ -184,11 +227,15 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
       const size_t k = next++;
       if (k >= pending.size()) return;
       const long long row = pending[k];
-      const Eigen::VectorXd x = plan.plan.row(row).transpose();
+      SampleRequest request;
+      request.x = plan.plan.row(row).transpose();
+      request.plan_row = row;
+      if (plan.draws == DrawDesign::independent) request.seeds = row_draw_seeds(plan.plan_seed, row);
+      const Eigen::VectorXd& x = request.x;
       const auto sample_start = std::chrono::steady_clock::now();
       SampleOutcome outcome;
       try {
-        outcome = evaluate(x);
+        outcome = evaluate(request);
         if (outcome.converged && !std::isfinite(outcome.mu)) {
           outcome.converged = false;
           outcome.failure_reason = "the evaluator returned a non-finite mu";
@@ -202,7 +249,7 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
       std::lock_guard<std::mutex> guard(lock);
       if (stop) return;
       try {
-        append_sample(db, x, row, outcome);
+        append_sample(db, x, row, outcome, request.seeds);
         write_dataset(db_path, db);
       } catch (...) {
         write_failure = std::current_exception();
@@ -250,6 +297,11 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
     if (!allow_mixed && d.scene_json != first.scene_json) {
       throw Error("merge: " + path + ": made with a different scene than " + paths[0] + " (--allow-mixed to merge anyway)");
     }
+    if (d.draws != first.draws || d.plan_seed != first.plan_seed) {
+      throw Error("merge: " + path + ": its plan draws its roughness differently from " + paths[0] + "'s (draws " +
+                  draw_design_name(d.draws) + ", plan seed " + std::to_string(d.plan_seed) + " against " +
+                  draw_design_name(first.draws) + ", " + std::to_string(first.plan_seed) + ")");
+    }
     if (!allow_mixed && d.code_version != first.code_version) {
       throw Error("merge: " + path + ": made by code version " + d.code_version + ", " + paths[0] + " by " +
                   first.code_version + " (--allow-mixed to merge anyway)");
@@ -284,7 +336,14 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
     if (d.failed(i)) o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
     if (d.outside_model(i)) o.warnings = {d.failure_reason[static_cast<size_t>(i)]};
     for (const auto& [name, values] : d.diagnostics) o.diagnostics[name] = values(i);
-    append_sample(merged, d.x.row(i).transpose(), row, o);
+    for (Eigen::Index k = 0; k < d.draw_mu.cols(); ++k) o.draw_mu.push_back(d.draw_mu(i, k));
+    while (!o.draw_mu.empty() && std::isnan(o.draw_mu.back())) o.draw_mu.pop_back();  // the padding
+    std::optional<DrawSeeds> seeds;
+    if (!d.tool_seed.empty() && d.tool_seed[static_cast<size_t>(i)] >= 0) {
+      seeds = DrawSeeds{static_cast<std::uint64_t>(d.tool_seed[static_cast<size_t>(i)]),
+                        static_cast<std::uint64_t>(d.chip_seed[static_cast<size_t>(i)])};
+    }
+    append_sample(merged, d.x.row(i).transpose(), row, o, seeds);
     (o.converged ? report.converged : report.failed) += 1;
   }
   report.plan_rows = merged.plan.rows();

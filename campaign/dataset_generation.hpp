@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,13 @@ struct GenerationReport {
   double seconds = 0.0;
 };
 
+// The base seeds of plan row `row` of a plan with independent draws: reproducible from the plan's seed
+// and the row alone (the same plan gives the same seeds on any machine, shard or order), distinct
+// between rows. SplitMix64 (Steele, Lea & Flood, OOPSLA 2014) mixes them; each seed is kept below
+// 2^30 so that seed + draw stays a valid scene seed (0 … 2^31 − 1) for a `micro run --set` that
+// reproduces the sample.
+DrawSeeds row_draw_seeds(long long plan_seed, long long row);
+
 // A dataset with no samples carrying `plan`'s inputs, plan (design, seed, box history), source and
 // scene, stamped with this code's version: a new plan file, a new database, a merge's start.
 Dataset empty_dataset(const Dataset& plan);
@@ -58,8 +66,10 @@ Dataset open_database(const std::string& db_path, const Dataset& plan);
 GenerationReport generate_dataset(const Dataset& plan, const std::string& db_path, const SampleEvaluator& evaluate,
                                   const GenerationOptions& options);
 
-// Appends one sample (diagnostics missing on either side are NaN).
-void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, const SampleOutcome& outcome);
+// Appends one sample (diagnostics missing on either side are NaN), with the seeds its draws used
+// (none: the scene's own) and its draws' μ.
+void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, const SampleOutcome& outcome,
+                   const std::optional<DrawSeeds>& seeds = std::nullopt);
 
 struct MergeReport {
   long long files = 0, samples_read = 0, duplicates_removed = 0, converged = 0, failed = 0;

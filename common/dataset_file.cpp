@@ -85,6 +85,17 @@ Dataset read_hdf5_dataset(const std::string& path) {
   }
   if (in.has_attribute("/plan", "design")) d.plan_design = in.string_attribute("/plan", "design");
   if (in.has_attribute("/plan", "seed")) d.plan_seed = in.int_attribute("/plan", "seed");
+  if (in.has_attribute("/plan", "draws")) d.draws = parse_draw_design(in.string_attribute("/plan", "draws"), path + ": /plan attribute draws");
+  for (auto [name, seeds] : {std::pair{"/samples/tool_seed", &d.tool_seed}, std::pair{"/samples/chip_seed", &d.chip_seed}}) {
+    if (!in.has(name)) continue;
+    *seeds = in.ints(name);
+    if (static_cast<Eigen::Index>(seeds->size()) != n) in.fail(name, "length differs from /samples/inputs");
+  }
+  if (in.has("/samples/draw_mu")) {
+    d.draw_mu = in.matrix("/samples/draw_mu");
+    if (d.draw_mu.rows() != n && d.draw_mu.cols() > 0) in.fail("/samples/draw_mu", "has " + std::to_string(d.draw_mu.rows()) + " rows, " + std::to_string(n) + " samples");
+  }
+  if (d.draw_mu.rows() != n) d.draw_mu.resize(n, 0);
   if (in.has("/plan/box_history")) d.box_history = in.strings("/plan/box_history");
   if (in.has_attribute("/", "source")) d.source = in.string_attribute("/", "source");
   if (in.has_attribute("/", "scene_json")) d.scene_json = in.string_attribute("/", "scene_json");
@@ -153,6 +164,21 @@ Dataset read_csv_dataset(const std::string& path) {
 
 }  // namespace
 
+const char* draw_design_name(DrawDesign d) {
+  switch (d) {
+    case DrawDesign::independent: return "independent";
+    case DrawDesign::common: return "common";
+    case DrawDesign::unknown: break;
+  }
+  return "";
+}
+
+DrawDesign parse_draw_design(const std::string& text, const std::string& field) {
+  if (text == "independent") return DrawDesign::independent;
+  if (text == "common") return DrawDesign::common;
+  throw Error(field + ": '" + text + "' is not a draw design (independent or common)");
+}
+
 Dataset read_dataset(const std::string& path) {
   if (ends_with(path, ".csv")) return read_csv_dataset(path);
   try {
@@ -174,6 +200,9 @@ void write_dataset(const std::string& path, const Dataset& d) {
   const auto n = d.x.rows();
   if (d.mu.size() != n || (d.mu_std.size() != 0 && d.mu_std.size() != n) || static_cast<Eigen::Index>(d.status.size()) != n ||
       static_cast<Eigen::Index>(d.failure_reason.size()) != n ||
+      (!d.tool_seed.empty() && static_cast<Eigen::Index>(d.tool_seed.size()) != n) ||
+      (!d.chip_seed.empty() && static_cast<Eigen::Index>(d.chip_seed.size()) != n) ||
+      (d.draw_mu.cols() > 0 && d.draw_mu.rows() != n) ||
       (!d.plan_index.empty() && static_cast<Eigen::Index>(d.plan_index.size()) != n)) {
     throw Error("write_dataset '" + path + "': samples arrays differ in length");
   }
@@ -195,12 +224,16 @@ void write_dataset(const std::string& path, const Dataset& d) {
   out.group("/samples/diagnostics");
   for (const auto& [name, values] : d.diagnostics) out.doubles("/samples/diagnostics/" + name, values);
   if (!d.plan_index.empty()) out.ints("/samples/plan_index", d.plan_index);
+  if (!d.tool_seed.empty()) out.ints("/samples/tool_seed", d.tool_seed);
+  if (!d.chip_seed.empty()) out.ints("/samples/chip_seed", d.chip_seed);
+  if (d.draw_mu.cols() > 0) out.matrix("/samples/draw_mu", d.draw_mu);
   out.group("/plan");
   out.matrix("/plan/inputs", d.plan);
   if (!d.plan_design.empty()) {
     out.string_attribute("/plan", "design", d.plan_design);
     out.int_attribute("/plan", "seed", d.plan_seed);
   }
+  if (d.draws != DrawDesign::unknown) out.string_attribute("/plan", "draws", draw_design_name(d.draws));
   if (!d.box_history.empty()) out.strings("/plan/box_history", d.box_history);
   out.commit();
 }
@@ -229,7 +262,11 @@ TrainingSet training_set(const Dataset& d, const std::string& path) {
   t.x.resize(static_cast<Eigen::Index>(rows.size()), d.x.cols());
   t.mu.resize(static_cast<Eigen::Index>(rows.size()));
   t.mu_std.resize(static_cast<Eigen::Index>(rows.size()));
+  t.draws = d.draws;
+  const bool with_draws = d.draw_mu.cols() > 0 && d.draw_mu.rows() == d.size();
+  t.draw_mu.resize(static_cast<Eigen::Index>(rows.size()), with_draws ? d.draw_mu.cols() : 0);
   for (size_t k = 0; k < rows.size(); ++k) {
+    if (with_draws) t.draw_mu.row(static_cast<Eigen::Index>(k)) = d.draw_mu.row(rows[k]);
     t.x.row(static_cast<Eigen::Index>(k)) = d.x.row(rows[k]);
     t.mu(static_cast<Eigen::Index>(k)) = d.mu(rows[k]);
     t.mu_std(static_cast<Eigen::Index>(k)) = d.mu_std.size() == d.size() ? d.mu_std(rows[k]) : std::numeric_limits<double>::quiet_NaN();

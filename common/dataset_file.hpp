@@ -5,7 +5,10 @@
 //   model: completed, but e.g. molten), /samples/failure_reason n (why failed / outside the model),
 //   /samples/diagnostics/<name> n (optional), /plan/inputs m×d;
 //   /samples/plan_index n (optional: the plan row each sample answers, −1 for none), /plan
-//   attributes design and seed (optional);
+//   attributes design and seed (optional), draws ("independent": every plan row its own roughness
+//   draws, "common": every row the scene's; optional), /samples/tool_seed and /samples/chip_seed n
+//   (the row's base seeds, −1: the scene's own; optional), /samples/draw_mu n×D (each draw's μ, NaN
+//   padded; optional);
 //   root attributes: format, schema_version, input_names/units (in /inputs), box, provenance.
 // A CSV with unit-annotated header ("contact_pressure[MPa],...,mu") is accepted for training too.
 #include <map>
@@ -21,12 +24,23 @@
 namespace mufric {
 
 // Version 2 added /samples/mu_std and status 2; version-1 files are still read (μ's standard error
-// unknown: NaN, and Dataset::note says so).
-inline constexpr long long kDatasetSchemaVersion = 2;
+// unknown: NaN, and Dataset::note says so). Version 3 added the draws' design (/plan attribute
+// draws), each sample's seeds (/samples/tool_seed, /samples/chip_seed) and each draw's μ
+// (/samples/draw_mu); older files read as common draws with unknown per-draw μ.
+inline constexpr long long kDatasetSchemaVersion = 3;
 inline constexpr long long kOldestReadableDatasetSchema = 1;
 inline constexpr const char* kDatasetFormat = "mufric-dataset";
 
 enum class SampleStatus : long long { converged = 0, failed = 1, outside_model = 2 };
+
+// How a plan's rows draw their roughness (issue 33). Independent: each row its own tools and chip
+// surfaces, so that their error is independent between samples and averages out over a campaign
+// (stochastic kriging; Ankenman, Nelson & Staum 2010). Common: every row the scene's own surfaces
+// (common random numbers: good for trends and differences, but their shared error never averages
+// out; Chen, Ankenman & Nelson 2012). Unknown: a file from before the choice existed (common).
+enum class DrawDesign { unknown, independent, common };
+const char* draw_design_name(DrawDesign d);  // "", "independent", "common"
+DrawDesign parse_draw_design(const std::string& text, const std::string& field);
 
 struct Dataset {
   InputSpace inputs;                // names, SI units, box
@@ -40,6 +54,9 @@ struct Dataset {
   std::vector<long long> plan_index;  // n, row of `plan` each sample answers (−1: none); empty: unknown
   std::string plan_design;          // how the plan was drawn ("sobol", ...), empty if unknown
   long long plan_seed = 0;
+  DrawDesign draws = DrawDesign::unknown;
+  std::vector<long long> tool_seed, chip_seed;  // n each, the row's base seeds (−1: the scene's); empty: unknown
+  h5::RowMatrix draw_mu;            // n × D, each draw's μ (NaN padded); 0 columns: unknown
   std::vector<std::string> box_history;  // one line per change of the box (dataset refine --grow-box)
   std::string source;               // how the samples were made (scene hash, law name, ...)
   std::string scene_json;           // scene text when made by the micro-model
@@ -62,6 +79,8 @@ struct TrainingSet {
   Eigen::MatrixXd x;   // n × d, SI
   Eigen::VectorXd mu;  // n
   Eigen::VectorXd mu_std;  // n, μ's standard error; NaN where not known
+  DrawDesign draws = DrawDesign::unknown;  // the dataset's
+  Eigen::MatrixXd draw_mu;  // n × D, each draw's μ (NaN padded); 0 columns: not known
   long long outside_model = 0;  // samples left out because they lie outside the model (molten)
   std::string source_path;
   std::string source_hash;  // SHA-256 of the file bytes, for model provenance

@@ -95,6 +95,36 @@ TEST(DatasetFile, StandardErrorsAndOutsideModelSamplesRoundTripAndOldFilesLoad) 
   EXPECT_NE(old.note.find("schema version 1"), std::string::npos) << old.note;
   EXPECT_EQ(training_set(old, path).mu_std.size(), 2);
 
+  // Schema 3: the draws' design, each sample's seeds and each draw's μ round-trip; a schema-2 file
+  // (none of them) reads as common draws of unknown per-draw μ.
+  d.draws = DrawDesign::independent;
+  d.tool_seed = {11, 12, -1};
+  d.chip_seed = {21, 22, -1};
+  d.draw_mu.resize(3, 2);
+  d.draw_mu << 0.29, 0.31, 0.27, std::numeric_limits<double>::quiet_NaN(), 0.05, 0.05;
+  write_dataset(path, d);
+  const Dataset three = read_dataset(path);
+  EXPECT_EQ(three.draws, DrawDesign::independent);
+  EXPECT_EQ(three.tool_seed, d.tool_seed);
+  EXPECT_EQ(three.chip_seed, d.chip_seed);
+  ASSERT_EQ(three.draw_mu.cols(), 2);
+  EXPECT_EQ(three.draw_mu(0, 1), 0.31);
+  EXPECT_TRUE(std::isnan(three.draw_mu(1, 1)));
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    for (const char* name : {"/samples/tool_seed", "/samples/chip_seed", "/samples/draw_mu"}) file.unlink(name);
+    file.openGroup("/plan").removeAttr("draws");
+    H5::Attribute version = file.openGroup("/").openAttribute("schema_version");
+    const long long two = 2;
+    version.write(H5::PredType::NATIVE_LLONG, &two);
+  }
+  const Dataset two = read_dataset(path);
+  EXPECT_EQ(two.draws, DrawDesign::unknown);
+  EXPECT_TRUE(two.tool_seed.empty());
+  EXPECT_EQ(two.draw_mu.cols(), 0);
+  EXPECT_EQ(two.draw_mu.rows(), 3);
+  EXPECT_EQ(two.mu, d.mu);
+
   // A status this build does not know is refused, naming the field and the row.
   d.status[1] = 7;
   write_dataset(path, d);

@@ -34,7 +34,8 @@ Dataset small_plan(Eigen::Index rows, const std::string& scene = "{\"scene\": 1}
 double exact_mu(const Eigen::VectorXd& x) { return 0.1 + 1e-10 * x(0) + 0.01 * x(1) + 1e-5 * x(2); }
 
 // Converges everywhere except at plan rows whose pressure ends in 30 MPa steps (rows 3, 6, ...).
-SampleOutcome fake(const Eigen::VectorXd& x) {
+SampleOutcome fake(const SampleRequest& request) {
+  const Eigen::VectorXd& x = request.x;
   SampleOutcome o;
   const auto row = static_cast<long long>(std::lround((x(0) - 300e6) / 10e6));
   if (row % 3 == 0 && row > 0) {
@@ -92,7 +93,7 @@ TEST(DatasetGeneration, AnInterruptedRunResumesWhereItStopped) {
   const std::string db = temp_path("resume.h5");
   std::filesystem::remove(db);
   std::atomic<int> calls{0};
-  const SampleEvaluator counting = [&](const Eigen::VectorXd& x) {
+  const SampleEvaluator counting = [&](const SampleRequest& x) {
     ++calls;
     return fake(x);
   };
@@ -120,7 +121,7 @@ TEST(DatasetGeneration, AnEvaluatorExceptionIsAFailedSampleNotACrash) {
   const Dataset plan = small_plan(3);
   const std::string db = temp_path("throws.h5");
   std::filesystem::remove(db);
-  const SampleEvaluator throwing = [](const Eigen::VectorXd&) -> SampleOutcome { throw Error("scene exploded"); };
+  const SampleEvaluator throwing = [](const SampleRequest&) -> SampleOutcome { throw Error("scene exploded"); };
   EXPECT_EQ(generate_dataset(plan, db, throwing, GenerationOptions{}).failed, 3);
   const Dataset d = read_dataset(db);
   EXPECT_EQ(d.failure_reason[0], "exception: scene exploded");
@@ -225,6 +226,92 @@ TEST(DatasetGeneration, ShardTextIsChecked) {
   for (const char* bad : {"5/5", "-1/3", "1", "a/b", "1/0", "1/2x"}) EXPECT_THROW(parse_shard(bad), Error) << bad;
 }
 
+// Independent draws (issue 33): every plan row gets its own seeds, derived from the plan's seed and
+// the row alone, so that the same plan gives the same seeds (and, the evaluator being deterministic,
+// the same μ bit for bit) whatever the shards, jobs or order; rows never share them.
+TEST(DatasetGeneration, IndependentDrawsGiveEachRowItsOwnReproducibleSeeds) {
+  std::set<std::uint64_t> tools, chips;
+  constexpr long long kRows = 10000;
+  for (long long row = 0; row < kRows; ++row) {
+    const DrawSeeds s = row_draw_seeds(7, row);
+    EXPECT_LT(s.tool, std::uint64_t{1} << 30);
+    EXPECT_LT(s.chip, std::uint64_t{1} << 30);
+    tools.insert(s.tool);
+    chips.insert(s.chip);
+    const DrawSeeds again = row_draw_seeds(7, row);
+    ASSERT_EQ(again.tool, s.tool);
+    ASSERT_EQ(again.chip, s.chip);
+  }
+  // Distinct between rows (10 000 draws from 2^30 values collide with probability ~5 %: allow one).
+  EXPECT_GE(tools.size(), static_cast<size_t>(kRows - 1));
+  EXPECT_GE(chips.size(), static_cast<size_t>(kRows - 1));
+  EXPECT_NE(row_draw_seeds(8, 0).tool, row_draw_seeds(7, 0).tool);  // another plan, other surfaces
+
+  Dataset plan = small_plan(6);
+  plan.draws = DrawDesign::independent;
+  plan.plan_seed = 7;
+  // A deterministic stand-in for the micro-model: each draw's μ a function of the point and its seeds.
+  const SampleEvaluator seeded = [](const SampleRequest& r) {
+    SampleOutcome o;
+    EXPECT_TRUE(r.seeds.has_value());
+    o.converged = true;
+    for (std::uint64_t k = 0; k < 3; ++k) {
+      o.draw_mu.push_back(exact_mu(r.x) + 1e-12 * static_cast<double>((r.seeds->tool + k) % 1000) +
+                          1e-9 * static_cast<double>((r.seeds->chip + k) % 1000));
+    }
+    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2]) / 3.0;
+    return o;
+  };
+  const std::string whole = temp_path("independent.h5"), half0 = temp_path("independent0.h5"),
+                    half1 = temp_path("independent1.h5");
+  for (const auto& f : {whole, half0, half1}) std::filesystem::remove(f);
+  GenerationOptions two_jobs;
+  two_jobs.jobs = 2;
+  generate_dataset(plan, whole, seeded, two_jobs);
+  GenerationOptions shard;
+  shard.shard = {0, 2};
+  generate_dataset(plan, half0, seeded, shard);
+  shard.shard = {1, 2};
+  generate_dataset(plan, half1, seeded, shard);
+  MergeReport report;
+  const Dataset merged = merge_datasets({half1, half0}, false, report);
+  const Dataset d = read_dataset(whole);
+  EXPECT_EQ(d.draws, DrawDesign::independent);
+  ASSERT_EQ(d.draw_mu.cols(), 3);
+  for (const Dataset* db : {&d, &merged}) {
+    for (Eigen::Index i = 0; i < db->size(); ++i) {
+      const long long row = db->plan_index[static_cast<size_t>(i)];
+      const DrawSeeds s = row_draw_seeds(7, row);
+      EXPECT_EQ(db->tool_seed[static_cast<size_t>(i)], static_cast<long long>(s.tool));
+      EXPECT_EQ(db->chip_seed[static_cast<size_t>(i)], static_cast<long long>(s.chip));
+      SampleRequest again{plan.plan.row(row).transpose(), row, s};
+      const SampleOutcome o = seeded(again);
+      for (Eigen::Index k = 0; k < 3; ++k) EXPECT_EQ(db->draw_mu(i, k), o.draw_mu[static_cast<size_t>(k)]);
+      EXPECT_EQ(db->mu(i), o.mu);
+    }
+  }
+  // A database of the same plan points drawn in common is another database.
+  Dataset common = plan;
+  common.draws = DrawDesign::common;
+  try {
+    generate_dataset(common, whole, seeded, {});
+    ADD_FAILURE() << "a database of independent draws was resumed with a plan of common ones";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("draws its roughness differently"), std::string::npos) << e.what();
+  }
+  // With common draws the evaluator gets no seeds, and the samples record the scene's own (-1).
+  const std::string shared = temp_path("common.h5");
+  std::filesystem::remove(shared);
+  generate_dataset(common, shared, [](const SampleRequest& r) {
+    EXPECT_FALSE(r.seeds.has_value());
+    return fake(r);
+  }, {});
+  const Dataset c = read_dataset(shared);
+  EXPECT_EQ(c.draws, DrawDesign::common);
+  for (long long seed : c.tool_seed) EXPECT_EQ(seed, -1);
+  EXPECT_EQ(c.draw_mu.cols(), 0);
+}
+
 // A run that completes with a warning (a molten chip) is kept with its μ and standard error, as
 // outside the model: training leaves it out, --retry-failed does not rerun it, merging keeps it so.
 TEST(DatasetGeneration, SamplesOutsideTheModelAreKeptFlaggedAndNeverTrainedOn) {
@@ -232,7 +319,8 @@ TEST(DatasetGeneration, SamplesOutsideTheModelAreKeptFlaggedAndNeverTrainedOn) {
   const std::string db = temp_path("molten.h5");
   std::filesystem::remove(db);
   std::atomic<int> calls{0};
-  const auto molten_last = [&](const Eigen::VectorXd& x) {
+  const auto molten_last = [&](const SampleRequest& request) {
+    const Eigen::VectorXd& x = request.x;
     ++calls;
     SampleOutcome o;
     o.converged = true;

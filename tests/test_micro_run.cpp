@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "micro/scene/dataset_sample.hpp"
 #include "micro/scene/micro_run.hpp"
 
 namespace mufric::scene {
@@ -356,6 +357,69 @@ TEST(PressSlide, ResultSaysHowMuWasObtained) {
   apply_override(csv, "protocol.realisations=2");
   csv["geometry"]["tool_surface"] = {{"flat", true}, {"fit", {{"degree", 3}, {"control_points", 32}}}};
   EXPECT_THROW(parse_scene(csv, "flat realisations"), Error);
+}
+
+// A draw is a new tool and, by default for a synthetic chip, a new chip surface (issue 33): the
+// protocol's draws carry both seeds, draw_scene applies them, and protocol.draws=tools keeps the
+// scene's chip; a chip that cannot be drawn anew is refused by name.
+TEST(PressSlide, DrawsRedrawTheChipUnlessToldToKeepIt) {
+  nlohmann::json j = small_press_slide();
+  apply_override(j, "protocol.realisations=3");
+  apply_override(j, "protocol.phases=1");
+  const Scene both = parse_scene(j, "both");
+  EXPECT_EQ(both.protocol.draws, DrawnSurfaces::tools_and_chip);
+  const std::vector<Draw> draws = protocol_draws(both);
+  ASSERT_EQ(draws.size(), 3u);
+  for (std::uint64_t r = 0; r < 3; ++r) {
+    EXPECT_EQ(draws[r].seed, both.tool_surface.synthetic.seed + r);
+    ASSERT_TRUE(draws[r].chip_seed.has_value());
+    EXPECT_EQ(*draws[r].chip_seed, both.chip_surface.synthetic.seed + r);
+    const Scene s = draw_scene(both, draws[r]);
+    EXPECT_EQ(s.chip_surface.synthetic.seed, both.chip_surface.synthetic.seed + r);
+    EXPECT_EQ(s.tool_surface.synthetic.seed, both.tool_surface.synthetic.seed + r);
+  }
+  apply_override(j, "protocol.draws=\"tools\"");
+  const Scene tools = parse_scene(j, "tools");
+  for (const Draw& d : protocol_draws(tools)) {
+    EXPECT_FALSE(d.chip_seed.has_value());
+    EXPECT_EQ(draw_scene(tools, d).chip_surface.synthetic.seed, tools.chip_surface.synthetic.seed);
+  }
+  // A flat chip has nothing to draw: tools is its default, tools-and-chip an error naming the key.
+  nlohmann::json flat = small_press_slide();
+  flat["geometry"]["chip_surface"] = {{"flat", true}, {"fit", {{"degree", 2}, {"control_points", 32}}}};
+  EXPECT_EQ(parse_scene(flat, "flat chip").protocol.draws, DrawnSurfaces::tools);
+  apply_override(flat, "protocol.draws=\"tools-and-chip\"");
+  const std::string message = error_of(flat);
+  EXPECT_NE(message.find("protocol.draws"), std::string::npos) << message;
+  // Seed 000's protocol is one draw of the scene's own surfaces.
+  EXPECT_EQ(parse_scene(small_scene(), "seed 000").protocol.draws, DrawnSurfaces::tools);
+}
+
+// A dataset sample with its own seeds: the same request gives the same μ bit for bit, another row's
+// seeds another μ, and the per-draw μ come back in draw order.
+TEST(PressSlide, ASamplesOwnSeedsReproduceItsMuBitForBit) {
+  nlohmann::json j = small_press_slide();
+  apply_override(j, "protocol.phases=1");
+  apply_override(j, "protocol.realisations=2");
+  const Scene scene = parse_scene(j, "seeded");
+  const SampleEvaluator evaluate = micro_evaluator(scene, default_friction_box(), 1);
+  SampleRequest request;
+  request.x = Eigen::Vector3d(400e6, 100.0 / 60.0, 773.15);
+  request.plan_row = 3;
+  request.seeds = DrawSeeds{12345, 67890};
+  const SampleOutcome a = evaluate(request), b = evaluate(request);
+  ASSERT_TRUE(a.converged) << a.failure_reason;
+  ASSERT_EQ(a.draw_mu.size(), 2u);
+  EXPECT_EQ(a.mu, b.mu);
+  EXPECT_EQ(a.draw_mu, b.draw_mu);
+  EXPECT_DOUBLE_EQ(a.mu, 0.5 * (a.draw_mu[0] + a.draw_mu[1]));
+  request.seeds = DrawSeeds{12346, 67890};  // another tool under the first draw
+  const SampleOutcome c = evaluate(request);
+  ASSERT_TRUE(c.converged) << c.failure_reason;
+  EXPECT_NE(c.draw_mu[0], a.draw_mu[0]);
+  request.seeds.reset();  // the scene's own surfaces
+  const SampleOutcome own = evaluate(request);
+  EXPECT_NE(own.mu, a.mu);
 }
 
 // The lubricated chip on the small press-slide scene (one tool phase), seed 000's liquid (no

@@ -32,9 +32,14 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
   if (pressure < 0 || velocity < 0 || temperature < 0) {
     throw Error("a micro-model dataset needs the inputs contact_pressure, sliding_velocity and temperature");
   }
-  return [scene, pressure, velocity, temperature, threads_per_sample, sample_wall_seconds](const Eigen::VectorXd& x) {
+  return [scene, pressure, velocity, temperature, threads_per_sample, sample_wall_seconds](const SampleRequest& request) {
     omp_set_num_threads(std::max(threads_per_sample, 1));  // this thread's parallel regions
+    const Eigen::VectorXd& x = request.x;
     Scene s = scene;
+    if (request.seeds) {  // the row's own surfaces (a measured or flat surface has no seed and stays)
+      s.tool_surface.synthetic.seed = request.seeds->tool;
+      s.chip_surface.synthetic.seed = request.seeds->chip;
+    }
     s.pressure = x(pressure);
     s.velocity = x(velocity);
     s.temperature = x(temperature);
@@ -53,6 +58,7 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     o.diagnostics["draws"] = static_cast<double>(m.draws.size());
     o.diagnostics["max_abs_drift"] = m.max_abs_drift();
     o.diagnostics["micro_wall_seconds"] = m.wall_seconds;
+    for (const auto& d : m.draws) o.draw_mu.push_back(d.result.completed ? d.result.mu : std::numeric_limits<double>::quiet_NaN());
     return o;
   };
 }

@@ -511,12 +511,16 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
 
 
 std::vector<Draw> protocol_draws(const Scene& scene) {
-  if (scene.protocol.name == Protocol::seed000) return {Draw{0, 0, 0.0, scene.tool_surface.synthetic.seed, {}}};
+  if (scene.protocol.name == Protocol::seed000) return {Draw{0, 0, 0.0, scene.tool_surface.synthetic.seed, {}, {}}};
   std::vector<Draw> draws;
   const int phases = scene.protocol.phases, realisations = scene.protocol.realisations;
+  const bool chip_drawn = scene.protocol.draws == DrawnSurfaces::tools_and_chip;
   for (int r = 0; r < realisations; ++r) {
+    const auto offset = static_cast<std::uint64_t>(r);
     for (int k = 0; k < phases; ++k) {
-      draws.push_back({k, r, static_cast<double>(k) / phases, scene.tool_surface.synthetic.seed + static_cast<std::uint64_t>(r), {}});
+      Draw d{k, r, static_cast<double>(k) / phases, scene.tool_surface.synthetic.seed + offset, {}, {}};
+      if (chip_drawn) d.chip_seed = scene.chip_surface.synthetic.seed + offset;
+      draws.push_back(d);
     }
   }
   return draws;
@@ -528,6 +532,7 @@ Scene draw_scene(const Scene& scene, const Draw& draw) {
   const double shift = scene.tool_surface.shift_fraction + draw.shift_fraction;
   s.tool_surface.shift_fraction = shift - std::floor(shift);
   s.tool_surface.synthetic.seed = draw.seed;
+  if (draw.chip_seed) s.chip_surface.synthetic.seed = *draw.chip_seed;
   return s;
 }
 
@@ -677,7 +682,8 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
   } else {
     p = {{"name", "press-slide"},
          {"means", "pressed (ramp, then hold), then slid; mu averaged over a sliding-distance window after a run-in, "
-                   "then over tool phases and realisations; mu_std_error is the standard error of that mean"},
+                   "then over the draws (tool phases and realisations, each realisation a new tool and, with drawn_surfaces "
+                   "tools-and-chip, a new chip surface); mu_std_error is the standard error of that mean"},
          {"press_ramp_s", scene.ramp},
          {"press_hold_s", q.press_hold},
          {"run_in_m", q.run_in},
@@ -689,6 +695,7 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
          {"step_distance_m", q.step_distance},
          {"phases", q.phases},
          {"realisations", q.realisations},
+         {"drawn_surfaces", drawn_surfaces_name(q.draws)},
          {"draws", draws.size()},
          {"max_abs_drift", max_abs_drift()}};
   }
@@ -706,6 +713,10 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
     one["realisation"] = d.realisation;
     one["tool_shift_fraction"] = d.shift_fraction;
     one["tool_seed"] = d.seed;
+    const bool synthetic_chip = scene.chip_surface.csv.empty() && !scene.chip_surface.flat;
+    one["chip_seed"] = d.chip_seed        ? nlohmann::json(*d.chip_seed)
+                       : synthetic_chip ? nlohmann::json(scene.chip_surface.synthetic.seed)
+                                        : nlohmann::json(nullptr);
     if (!d.result.block_means.empty()) {
       one["block_means"] = d.result.block_means;
       one["drift"] = d.result.drift;

@@ -87,11 +87,13 @@ struct RunOptions {
 };
 
 // One draw of a press-slide measurement: the tool shifted by `shift_fraction` of the interval (on top
-// of the scene's own shift) and, for a synthetic tool, drawn with `seed`.
+// of the scene's own shift) and, for a synthetic tool, drawn with `seed`; the chip surface drawn with
+// `chip_seed` when the protocol draws it too (else the scene's own chip).
 struct Draw {
   int phase = 0, realisation = 0;
   double shift_fraction = 0.0;
   std::uint64_t seed = 0;
+  std::optional<std::uint64_t> chip_seed;
   MicroResult result;
 };
 

@@ -133,6 +133,10 @@ SurfaceSpec read_surface(Section s, const std::string& base_directory) {
 
 }  // namespace
 
+const char* drawn_surfaces_name(DrawnSurfaces d) {
+  return d == DrawnSurfaces::tools ? "tools" : "tools-and-chip";
+}
+
 nlohmann::json read_scene_json(const std::string& path) {
   const auto text = read_whole_file(path);
   if (!text) throw Error(path + ": cannot read the scene file");
@@ -273,7 +277,16 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
                                    " (use phases to average over its positions)");
       }
       if (q.step_distance > q.window) p.fail("step_distance", "is longer than the window");
+      const bool chip_drawable = s.chip_surface.csv.empty() && !s.chip_surface.flat;
+      q.draws = p.text("draws", chip_drawable ? "tools-and-chip" : "tools", {"tools", "tools-and-chip"}) == "tools"
+                    ? DrawnSurfaces::tools
+                    : DrawnSurfaces::tools_and_chip;
+      if (q.draws == DrawnSurfaces::tools_and_chip && !chip_drawable) {
+        p.fail("draws", "tools-and-chip draws the chip surface anew; this chip is " +
+                            std::string(s.chip_surface.flat ? "flat" : "a measured profile") + " (use tools)");
+      }
     }
+    if (q.name == Protocol::seed000) q.draws = DrawnSurfaces::tools;  // one draw, the scene's own surfaces
     p.finish();
   }
   {

@@ -29,6 +29,13 @@ struct SurfaceSpec {
 // slides and averages one draw over a fixed time window; press-slide presses first, then slides, and
 // averages over a sliding distance and over tool phases / realisations, with a standard error.
 enum class Protocol { press_slide, seed000 };
+// What a press-slide draw draws anew: the tool alone, on the scene's one chip surface (the model of
+// issue 14, kept for trend studies where shared surfaces cancel), or the tool and the chip surface
+// both, from the scene's roughness statistics (μ as a property of those statistics; the default for a
+// synthetic chip: with the chip fixed, every run shares its error, measured at about 15 % of μ at the
+// box centre, issue 33).
+enum class DrawnSurfaces { tools, tools_and_chip };
+const char* drawn_surfaces_name(DrawnSurfaces d);
 
 struct ProtocolSpec {
   Protocol name = Protocol::press_slide;
@@ -44,6 +51,8 @@ struct ProtocolSpec {
   double step_distance = 25e-9;   // m, the longest step while sliding (dt = step_distance / |v|)
   int phases = 1;                 // tool shifts by k/phases of the interval, k = 0…phases−1
   int realisations = 4;           // synthetic tools with seeds seed, seed+1, … (same statistics)
+  // With tools_and_chip, realisation r also draws the chip with seed chip_seed + r (a synthetic chip).
+  DrawnSurfaces draws = DrawnSurfaces::tools_and_chip;
   int blocks = 4;                 // equal-distance blocks of the window, for the drift check
 };
 inline constexpr double kAccelerationShareOfRunIn = 0.25;
