@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
+#include "surrogate/stochastic_kriging.hpp"
 
 namespace mufric::app {
 namespace {
@@ -62,14 +64,14 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
                 s.y_scale * std::sqrt(s.hyper.noise_variance));
   }
   if (s.known_noise.size() != 0) {
-    std::printf("  known per-sample noise on the diagonal (--sample-noise): mean variance %.6g, max %.6g (normalised)\n",
+    std::printf("  known per-sample noise on the diagonal: mean variance %.6g, max %.6g (normalised)\n",
                 s.known_noise.mean(), s.known_noise.maxCoeff());
   }
   if (s.micro_std_error > 0) {
     std::printf("  micro-model scatter (RMS standard error of the samples' mu) %.4g = %.2f %% of mean mu: part of the "
                 "served interval\n", s.micro_std_error, 100.0 * s.micro_std_error / std::max(std::abs(s.y_mean), 1e-300));
   }
-  std::printf("interval: %s\n", gp_interval_meaning(s.micro_std_error > 0).c_str());
+  std::printf("interval: %s\n", gp_interval_meaning(gp.interval_meaning()).c_str());
   if (s.jitter > 0) std::printf("  jitter %.3g\n", s.jitter);
   const auto& t = s.summary;
   std::printf("cross-validation (leave-one-out, closed form): mean relative error %.4f %%, max %.4f %%, "
@@ -188,6 +190,7 @@ void add_train(CLI::App& app) {
     std::string data, out;
     GpTrainingOptions gp;
     bool no_noise = false;
+    bool no_stochastic_kriging = false;
     FastOptions fast;
     BoxOptions box;
   };
@@ -211,9 +214,17 @@ void add_train(CLI::App& app) {
                 "Put each sample's own variance (/samples/mu_std squared) on the covariance diagonal beside the\n"
                 "learned noise. For samples whose errors are independent; a micro-model plan's samples share\n"
                 "their tool draws, so their errors are correlated and this is off by default");
+  cmd->add_flag("--no-stochastic-kriging", o->no_stochastic_kriging,
+                "For a dataset of independent draws (dataset plan's default): train as for common draws instead\n"
+                "(one GP, the samples' RMS standard error added to the interval), e.g. to compare the two");
   add_fast_evaluator_options(cmd, o->fast);
   add_box_options(cmd, o->box);
-  cmd->footer("Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
+  cmd->footer("A dataset of independent draws (each sample its own tool and chip surfaces, per-draw mu recorded)\n"
+              "is trained by stochastic kriging: first the patch scatter, a GP of the log per-draw variance of mu,\n"
+              "then the mean, each sample's smoothed variance of its mean on the diagonal; the served interval is\n"
+              "that of mu averaged over all draws and shrinks as the campaign grows, and the patch scatter is\n"
+              "served on its own (patch_std). Other data: one GP, as before.\n"
+              "Prints every start, the chosen hyper-parameters, the log marginal likelihood and a leave-one-out\n"
               "cross-validated error. Bounds: signal variance 1e-3..1e5, length scales 1e-2..1e3 box widths,\n"
               "noise variance 1e-6..1e-1 (outputs normalised to zero mean and unit variance).\n"
               "Then builds the certified fast evaluator (a grid of mu and log std with a measured error bound;\n"
@@ -239,7 +250,31 @@ void add_train(CLI::App& app) {
       std::printf("  fit: %s\n", line.c_str());
       std::fflush(stdout);
     };
-    GaussianProcess gp = train_gaussian_process(data, o->gp, &report);
+    const bool kriging = suits_stochastic_kriging(data) && !o->no_stochastic_kriging;
+    if (kriging && o->gp.sample_noise) {
+      throw Error("--sample-noise: a dataset of independent draws is trained by stochastic kriging, which puts each "
+                  "sample's smoothed variance on the diagonal; give --no-stochastic-kriging to use the raw ones");
+    }
+    std::optional<GaussianProcess> trained;
+    if (kriging) {
+      StochasticKrigingReport sk;
+      std::printf("stochastic kriging: %s of independent draws; first the patch scatter (a GP of the log per-draw "
+                  "variance of mu), then the mean\n", count_of(data.x.rows(), "sample", "samples").c_str());
+      std::fflush(stdout);
+      trained.emplace(train_stochastic_kriging(data, o->gp, &sk));
+      report = sk.mean;
+      std::printf("patch scatter: %lld samples, %lld draws; per-draw std of mu at the training points, median %.4g "
+                  "(%.1f %% of mean mu); a sample's mean's smoothed standard error, median %.4g\n",
+                  sk.scatter_samples, sk.draws, sk.median_patch_std,
+                  100.0 * sk.median_patch_std / std::max(std::abs(data.mu.mean()), 1e-300), sk.median_sample_std_error);
+    } else {
+      if (data.draws == DrawDesign::independent && !o->no_stochastic_kriging) {
+        std::printf("note: the dataset's draws are independent but its samples carry no per-draw mu: one GP, as for "
+                    "common draws\n");
+      }
+      trained.emplace(train_gaussian_process(data, o->gp, &report));
+    }
+    GaussianProcess& gp = *trained;
     print_training_report(gp, report);
     apply_box_options(gp, o->box);  // before the grid: it tabulates μ as served (clipped to the range)
     attach_fast_evaluator(gp, o->fast, report.seconds);
@@ -373,9 +408,10 @@ void add_predict(CLI::App& app) {
     for (size_t j = 0; j < inputs.size(); ++j) {
       if (const auto field = client::Block::field_for(inputs[j].name)) block.*field = points.columns[j].data();
     }
-    EvaluationRequest what{.std = true, .ci_level = o->level, .gradient = o->gradient};
+    EvaluationRequest what{.std = true, .ci_level = o->level, .gradient = o->gradient, .patch_std = true};
     if (!o->extrapolation.empty()) what.extrapolation = extrapolation_from_string(o->extrapolation);
     const client::Answer a = client->evaluate(block, what);
+    const bool patch = a.patch_std.size() == n && n > 0;  // the model has a patch scatter
     std::vector<double> x(inputs.size());
     auto reason_of = [&](size_t i) {
       for (size_t j = 0; j < inputs.size(); ++j) x[j] = points.columns[j][i];
@@ -395,12 +431,14 @@ void add_predict(CLI::App& app) {
       std::FILE* out = o->out.empty() ? stdout : std::fopen(o->out.c_str(), "w");
       if (out == nullptr) throw Error(o->out + ": cannot write");
       for (const auto& input : inputs) std::fprintf(out, "%s[%s],", input.name.c_str(), std::string(human_unit(input.kind())).c_str());
-      std::fprintf(out, "mu,std,lo,hi,status,reason\n");
+      std::fprintf(out, "mu,std,lo,hi,status,reason%s\n", patch ? ",patch_std" : "");
       for (size_t i = 0; i < n; ++i) {
         for (size_t j = 0; j < inputs.size(); ++j) std::fprintf(out, "%.10g,", si_to_human(points.columns[j][i], inputs[j].kind()));
         const std::string reason = a.status[i] == PointStatus::ok ? std::string() : reason_of(i);
-        std::fprintf(out, "%.10g,%.6g,%.10g,%.10g,%s,\"%s\"\n", a.mu[i], a.std[i], a.lo[i], a.hi[i],
+        std::fprintf(out, "%.10g,%.6g,%.10g,%.10g,%s,\"%s\"", a.mu[i], a.std[i], a.lo[i], a.hi[i],
                      std::string(to_string(a.status[i])).c_str(), reason.c_str());
+        if (patch) std::fprintf(out, ",%.6g", a.patch_std[i]);
+        std::fprintf(out, "\n");
       }
       if (out != stdout && std::fclose(out) != 0) throw Error(o->out + ": write failed");
       std::fprintf(stderr, "%zu points (%lld answered by the fast evaluator)\n", n, a.fast_points);
@@ -412,6 +450,10 @@ void add_predict(CLI::App& app) {
                   100 * o->level, a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str(),
                   a.fast_points > 0 ? "fast evaluator" : "exact model");
       if (a.status[0] == PointStatus::extrapolated) std::printf("  outside the training box: %s\n", reason_of(0).c_str());
+      if (patch) {
+        std::printf("  patch scatter %.3g: one contact patch's mu scatters about this mean with this standard deviation "
+                    "(the micro-model's per-draw spread; not part of the interval)\n", a.patch_std[0]);
+      }
       if (o->gradient && a.status[0] != PointStatus::invalid_input && a.status[0] != PointStatus::out_of_box) {
         for (size_t j = 0; j < inputs.size(); ++j) {
           std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(),

@@ -35,7 +35,7 @@ void fill_unanswered(Answer& answer, double value) {
   const size_t gradient_width = points > 0 ? answer.gradient.size() / points : 0;
   for (size_t i = 0; i < points; ++i) {
     if (answer.status[i] != PointStatus::invalid_input && answer.status[i] != PointStatus::out_of_box) continue;
-    for (auto* output : {&answer.mu, &answer.std, &answer.lo, &answer.hi}) {
+    for (auto* output : {&answer.mu, &answer.std, &answer.lo, &answer.hi, &answer.patch_std}) {
       if (i < output->size()) (*output)[i] = value;
     }
     std::fill_n(answer.gradient.begin() + static_cast<std::ptrdiff_t>(i * gradient_width), gradient_width, value);
@@ -71,6 +71,7 @@ class InProcessClient final : public FrictionClient {
     a.std.assign(e.std.data(), e.std.data() + e.std.size());
     a.lo.assign(e.lo.data(), e.lo.data() + e.lo.size());
     a.hi.assign(e.hi.data(), e.hi.data() + e.hi.size());
+    a.patch_std.assign(e.patch_std.data(), e.patch_std.data() + e.patch_std.size());
     if (what.gradient) {
       const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
       a.gradient.assign(rows.data(), rows.data() + rows.size());
@@ -85,7 +86,8 @@ class InProcessClient final : public FrictionClient {
   }
 
   ModelInfo describe() override {
-    return {path_, "", std::string(model_->kind()), model_->inputs(), model_->has_uncertainty(), model_->summary()};
+    return {path_, "", std::string(model_->kind()), model_->inputs(), model_->has_uncertainty(), model_->summary(),
+            model_->has_patch_scatter()};
   }
 
  private:
@@ -202,7 +204,7 @@ class GrpcClient final : public FrictionClient {
     request.set_model(model_);
     mufric::v1::ModelDescription d;
     call("DescribeModel", [&](grpc::ClientContext* context) { return stub_->DescribeModel(context, request, &d); });
-    ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary()};
+    ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary(), d.has_patch_scatter()};
     for (const auto& input : d.inputs()) info.inputs.push_back({input.name(), input.unit(), input.lo(), input.hi()});
     return info;
   }
@@ -263,6 +265,7 @@ class GrpcClient final : public FrictionClient {
     request.set_std(what.std);
     request.set_ci_level(what.ci_level);
     request.set_gradient(what.gradient);
+    request.set_patch_std(what.patch_std);
     request.set_extrapolation(static_cast<mufric::v1::Extrapolation>(what.extrapolation));
     if (what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0) {
       request.set_mu_tolerance(-1.0);  // the exact model only
@@ -288,6 +291,7 @@ class GrpcClient final : public FrictionClient {
     answer.std.insert(answer.std.end(), response.std().begin(), response.std().end());
     answer.lo.insert(answer.lo.end(), response.lo().begin(), response.lo().end());
     answer.hi.insert(answer.hi.end(), response.hi().begin(), response.hi().end());
+    answer.patch_std.insert(answer.patch_std.end(), response.patch_std().begin(), response.patch_std().end());
     answer.gradient.insert(answer.gradient.end(), response.gradient().begin(), response.gradient().end());
     answer.gradient_inputs.assign(response.gradient_inputs().begin(), response.gradient_inputs().end());
     for (const int s : response.status()) answer.status.push_back(static_cast<PointStatus>(s));

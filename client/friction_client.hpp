@@ -45,6 +45,9 @@ struct Answer {
   std::string model, version;
   std::vector<double> mu, std, lo, hi;  // std/lo/hi empty unless requested
   std::vector<double> gradient;         // row-major points × gradient_inputs, if requested
+  // If requested (EvaluationRequest::patch_std) and the model has one: the per-draw standard deviation
+  // of μ at each point, how much one contact patch's μ scatters about the mean; empty otherwise.
+  std::vector<double> patch_std;
   std::vector<std::string> gradient_inputs;
   std::vector<PointStatus> status;
   long long fast_points = 0;  // answered by the model's fast evaluator; the rest by the exact model
@@ -59,6 +62,7 @@ struct ModelInfo {
   InputSpace inputs;
   bool has_uncertainty = false;
   std::string summary;
+  bool has_patch_scatter = false;  // answers EvaluationRequest::patch_std
 };
 
 struct Options {

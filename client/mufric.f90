@@ -8,6 +8,7 @@ module mufric
   implicit none
   private
   public :: mufric_connect, mufric_error, c_mufric_evaluate, c_mufric_close, c_mufric_evaluate_ex, c_mufric_box
+  public :: c_mufric_patch_std, c_mufric_has_patch_scatter
   integer(c_int), parameter, public :: MUFRIC_OK = 0, MUFRIC_INVALID_ARGUMENT = 1, MUFRIC_FAILED = 2
   integer(c_int), parameter, public :: MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, &
                                        MUFRIC_POINT_INVALID_INPUT = 2, MUFRIC_POINT_OUT_OF_BOX = 3
@@ -67,6 +68,22 @@ module mufric
       integer(c_int), intent(out) :: used(4)
       real(c_double), intent(out) :: lo(4), hi(4)
       integer(c_int) :: code
+    end function
+    ! The patch scatter: per point, the micro-model's per-draw standard deviation of mu about the mean
+    ! (c_loc of an array of length n); MUFRIC_INVALID_ARGUMENT when c_mufric_has_patch_scatter is 0.
+    function c_mufric_patch_std(client, n, contact_pressure, sliding_velocity, temperature, fibre_angle, &
+                                patch_std, status) bind(C, name="mufric_patch_std") result(code)
+      import :: c_ptr, c_size_t, c_int
+      type(c_ptr), value :: client
+      integer(c_size_t), value :: n
+      type(c_ptr), value :: contact_pressure, sliding_velocity, temperature, fibre_angle
+      type(c_ptr), value :: patch_std, status
+      integer(c_int) :: code
+    end function
+    function c_mufric_has_patch_scatter(client) bind(C, name="mufric_has_patch_scatter") result(has)
+      import :: c_ptr, c_int
+      type(c_ptr), value :: client
+      integer(c_int) :: has
     end function
     function c_mufric_last_error() bind(C, name="mufric_last_error") result(message)
       import :: c_ptr

@@ -121,6 +121,17 @@ int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pr
  * Read when the handle was opened (no call to the server). */
 int mufric_box(mufric_client* client, int used[4], double lo[4], double hi[4]);
 
+/* The patch scatter (issue 33): at each of n points, how much one contact patch's mu scatters about
+ * the mean mufric_evaluate serves there (the micro-model's per-draw standard deviation), for a meso
+ * code that wants a spatially varying mu along the rake face; never part of std or the interval.
+ * Same inputs as mufric_evaluate; a point without an answer gets NaN or the fill=V value, and its
+ * status (if status is not NULL). MUFRIC_INVALID_ARGUMENT when the model has none (one trained on common
+ * draws, or not a GP): mufric_has_patch_scatter says so beforehand. */
+int mufric_patch_std(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
+                     const double* temperature, const double* fibre_angle, double* patch_std, int* status);
+/* 1 when the model serves mufric_patch_std, 0 when not (or client is NULL). */
+int mufric_has_patch_scatter(mufric_client* client);
+
 /* The message of the last failure on this thread, or of the last evaluation's points without an
  * answer ("" if none). Valid until the next call. */
 const char* mufric_last_error(void);

@@ -19,6 +19,7 @@ struct mufric_client {
                                                                "fibre_angle"};
   std::array<bool, 4> used{};
   std::array<mufric::InputSpec, 4> box{};
+  bool has_patch_scatter = false;  // read at open too
 };
 
 namespace {
@@ -59,7 +60,9 @@ int mufric_open_with_options(const char* uri, const char* options, mufric_client
     handle->std_tolerance = parsed.std_tolerance;
     handle->extrapolation = parsed.extrapolation;
     // Fails now, not at the first evaluation, if the model is not there.
-    for (const auto& input : handle->impl->describe().inputs) {
+    const mufric::client::ModelInfo info = handle->impl->describe();
+    handle->has_patch_scatter = info.has_patch_scatter;
+    for (const auto& input : info.inputs) {
       for (size_t k = 0; k < mufric_client::input_names.size(); ++k) {
         if (input.name != mufric_client::input_names[k]) continue;
         handle->used[k] = true;
@@ -145,6 +148,37 @@ int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pr
     return fail(MUFRIC_FAILED, std::string("mufric_evaluate: ") + e.what());
   }
 }
+
+int mufric_patch_std(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
+                     const double* temperature, const double* fibre_angle, double* patch_std, int* status) {
+  if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: client is NULL");
+  if (patch_std == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: patch_std must not be NULL");
+  if (!client->has_patch_scatter) {
+    return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: the model has no patch scatter (it was not trained by "
+                                         "stochastic kriging on a dataset of independent draws)");
+  }
+  try {
+    const mufric::client::Block block{n, contact_pressure, sliding_velocity, temperature, fibre_angle};
+    mufric::EvaluationRequest what;
+    what.patch_std = true;
+    what.mu_tolerance = client->mu_tolerance;
+    what.std_relative_tolerance = client->std_tolerance;
+    what.extrapolation = client->extrapolation;
+    const auto answer = client->impl->evaluate(block, what);
+    for (size_t i = 0; i < n; ++i) {  // copies only, as in mufric_evaluate_ex
+      patch_std[i] = answer.patch_std[i];
+      if (status) status[i] = static_cast<int>(answer.status[i]);
+    }
+    last_error = answer.message;
+    return MUFRIC_OK;
+  } catch (const mufric::client::InvalidArgument& e) {
+    return fail(MUFRIC_INVALID_ARGUMENT, std::string("mufric_patch_std: ") + e.what());
+  } catch (const std::exception& e) {
+    return fail(MUFRIC_FAILED, std::string("mufric_patch_std: ") + e.what());
+  }
+}
+
+int mufric_has_patch_scatter(mufric_client* client) { return client != nullptr && client->has_patch_scatter ? 1 : 0; }
 
 int mufric_box(mufric_client* client, int used[4], double lo[4], double hi[4]) {
   if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_box: client is NULL");

@@ -112,9 +112,11 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
     out.set_loo_mean_relative_error(state.summary.loo_mean_relative_error);
     out.set_loo_max_relative_error(state.summary.loo_max_relative_error);
     out.set_loo_coverage_95(state.summary.loo_coverage_95);
-    out.set_interval_meaning(gp_interval_meaning(state.micro_std_error > 0.0));
+    out.set_interval_meaning(gp_interval_meaning(gp->interval_meaning()));
+    out.set_interval(std::string(to_string(gp->interval_meaning())));
     out.set_micro_std_error(state.micro_std_error);
   }
+  out.set_has_patch_scatter(model.has_patch_scatter());
   out.set_summary(model.summary());
 }
 
@@ -147,7 +149,9 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   if (!std::isfinite(request.mu_tolerance()) || !std::isfinite(request.std_tolerance())) {
     return {grpc::StatusCode::INVALID_ARGUMENT, "fields mu_tolerance and std_tolerance must be finite"};
   }
-  EvaluationRequest what{.std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient()};
+  EvaluationRequest what{
+      .std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient(), .patch_std = request.patch_std()};
+  const bool patch = what.patch_std && model.has_patch_scatter();
   if (!mufric::v1::Extrapolation_IsValid(request.extrapolation())) {
     return {grpc::StatusCode::INVALID_ARGUMENT,
             "field extrapolation: unknown value " + std::to_string(static_cast<int>(request.extrapolation()))};
@@ -172,6 +176,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
     response.mutable_gradient()->Reserve(n * static_cast<int>(batch.cols()));
     for (const auto& input : model.inputs()) response.add_gradient_inputs(input.name);
   }
+  if (patch) response.mutable_patch_std()->Reserve(n);
   auto* statuses = response.mutable_status();
   statuses->Reserve(n);
   uint64_t extrapolated = 0, invalid = 0, fast = 0, out_of_box = 0, clipped = 0;
@@ -198,6 +203,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
       const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
       response.mutable_gradient()->Add(rows.data(), rows.data() + rows.size());
     }
+    if (patch) response.mutable_patch_std()->Add(e.patch_std.data(), e.patch_std.data() + count);
     for (const PointStatus s : e.status) {
       statuses->Add(static_cast<int>(s));
       extrapolated += s == PointStatus::extrapolated;

@@ -101,6 +101,10 @@ void FrictionModel::widen_clamped_intervals(const QueryBatch& x, const std::vect
   clamped.clamped_variances += raw.clamped_variances;
 }
 
+Eigen::VectorXd FrictionModel::patch_std_valid(const QueryBatch& x) const {
+  return Eigen::VectorXd::Constant(x.rows(), std::numeric_limits<double>::quiet_NaN());
+}
+
 Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest& what) const {
   const auto d = static_cast<Eigen::Index>(inputs_.size());
   if (x.cols() != d) {
@@ -134,8 +138,10 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
   const auto n_valid = static_cast<Eigen::Index>(valid.size());
   const bool clamp = policy == Extrapolation::clamp && any_outside;
   Evaluation inner;
+  const bool patch = what.patch_std && has_patch_scatter();
   if (n_valid == m && !clamp) {
     evaluate_valid(x, what, inner);
+    if (patch) inner.patch_std = patch_std_valid(x);
   } else if (n_valid > 0) {
     QueryBatch compact(n_valid, d);
     for (Eigen::Index k = 0; k < n_valid; ++k) compact.row(k) = x.row(valid[static_cast<size_t>(k)]);
@@ -146,6 +152,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
       }
     }
     evaluate_valid(compact, what, inner);
+    if (patch) inner.patch_std = patch_std_valid(compact);  // the face's, for a clamped point
     if (clamp && need_std && has_uncertainty()) widen_clamped_intervals(x, valid, what, inner);
     if (clamp && what.gradient) {
       // μ is constant along a clamped input beyond the box.
@@ -167,9 +174,11 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
     out.mu = std::move(inner.mu);
     if (need_std) out.std = std::move(inner.std);
     if (what.gradient) out.gradient = std::move(inner.gradient);
+    if (patch) out.patch_std = std::move(inner.patch_std);
   } else {
     scatter(inner.mu, out.mu);
     if (need_std) scatter(inner.std, out.std);
+    if (patch) scatter(n_valid > 0 ? inner.patch_std : Eigen::VectorXd(), out.patch_std);
     if (what.gradient) {
       out.gradient.setConstant(m, d, nan);
       for (Eigen::Index k = 0; k < n_valid; ++k) out.gradient.row(valid[static_cast<size_t>(k)]) = inner.gradient.row(k);

@@ -36,6 +36,9 @@ struct EvaluationRequest {
   bool std = false;         // predictive standard deviation
   double ci_level = 0.0;    // 0: no interval; else two-sided level in (0, 1), e.g. 0.95
   bool gradient = false;    // dμ/dinput, SI
+  // The patch scatter: the per-draw standard deviation of μ about its mean, how much one contact
+  // patch's μ varies from another's at the same (p, v, T) (a model trained on independent draws).
+  bool patch_std = false;
   // Threads this evaluation may use; 0: as many as OpenMP allows. Never more than 1 inside a
   // parallel region of the caller (evaluation_team_size).
   int max_threads = 0;
@@ -56,6 +59,9 @@ struct Evaluation {
   Eigen::VectorXd std;            // m, or empty
   Eigen::VectorXd lo, hi;         // m each, or empty
   Eigen::MatrixXd gradient;       // m × d, or empty
+  // m, when asked and the model has a patch scatter (else empty); NaN where μ is NaN. Outside the
+  // box it is the nearest face's, under every policy that answers.
+  Eigen::VectorXd patch_std;
   std::vector<PointStatus> status;  // m
   long long clamped_variances = 0;  // negative predictive variances clamped to zero
   long long fast_points = 0;        // points answered by the fast evaluator (the rest: the exact model)
@@ -69,6 +75,8 @@ class FrictionModel {
   const InputSpace& inputs() const { return inputs_; }
   // Whether std/CI carry information (a GP) or are identically zero (a deterministic law).
   virtual bool has_uncertainty() const = 0;
+  // Whether the model serves a patch scatter (EvaluationRequest::patch_std).
+  virtual bool has_patch_scatter() const { return false; }
 
   // The policy for points outside the box when a request does not choose one; and the physical
   // range μ is kept in (μ, lo and hi are clipped to it): both declared by the model file.
@@ -96,6 +104,8 @@ class FrictionModel {
   // Evaluates valid points only (x has no invalid rows); fills mu and whatever `what` asks for.
   // std is filled when what.std or what.ci_level > 0.
   virtual void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const = 0;
+  // The patch scatter at valid points (only called when has_patch_scatter()).
+  virtual Eigen::VectorXd patch_std_valid(const QueryBatch& x) const;
 
  private:
   // σ of the clamped answers (rows of `clamped`, evaluated at the box face) of points outside the box.

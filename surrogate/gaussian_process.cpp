@@ -212,7 +212,7 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
     }
     const double s2 = state_.hyper.signal_variance;
     const double scatter = state_.micro_std_error / state_.y_scale;
-    const double prior = s2 + state_.hyper.noise_variance + scatter * scatter;
+    const double prior = state_.interval_of_mean ? s2 : s2 + state_.hyper.noise_variance + scatter * scatter;
     for (Eigen::Index b = 0; b < count; ++b) {
       double variance = prior - s2 * s2 * norms2(b);
       if (variance < 0.0) {
@@ -360,14 +360,73 @@ void GaussianProcess::evaluate_exact(const QueryBatch& x, const EvaluationReques
   out.clamped_variances += clamped;
 }
 
-std::string gp_interval_meaning(bool with_micro_scatter) {
-  return with_micro_scatter
-             ? "std = sqrt(model variance + learned noise + micro-model scatter): where the micro-model's mu, averaged "
-               "over all tools of the training scene's roughness statistics, is expected; the model part shrinks with "
-               "more training data, the scatter part (the RMS standard error of the training samples) only with more "
-               "tool phases/realisations per sample"
-             : "std = sqrt(model variance + learned noise): where a new micro-model run of the training scene is "
-               "expected (the training data carry no standard errors of their own)";
+std::string_view to_string(IntervalMeaning m) {
+  switch (m) {
+    case IntervalMeaning::new_run: return "new-run";
+    case IntervalMeaning::shared_scatter: return "shared-scatter";
+    case IntervalMeaning::mean_over_draws: return "mean-over-draws";
+  }
+  return "?";
+}
+
+std::string gp_interval_meaning(IntervalMeaning m) {
+  switch (m) {
+    case IntervalMeaning::mean_over_draws:
+      return "std = sqrt(model variance): where the micro-model's mu averaged over all draws (tool and chip "
+             "surfaces) of the training scene's roughness statistics is expected; stochastic kriging of independent "
+             "draws, so it shrinks as the campaign grows. How much one contact patch's mu scatters about it is the "
+             "separate patch_std";
+    case IntervalMeaning::shared_scatter:
+      return "std = sqrt(model variance + learned noise + micro-model scatter): where the micro-model's mu, averaged "
+             "over all tools of the training scene's roughness statistics, is expected; the model part shrinks with "
+             "more training data, the scatter part (the RMS standard error of the training samples, whose draws every "
+             "sample shared) does not: only a dataset of independent draws (dataset plan's default) narrows it";
+    case IntervalMeaning::new_run: break;
+  }
+  return "std = sqrt(model variance + learned noise): where a new micro-model run of the training scene is "
+         "expected (the training data carry no standard errors of their own)";
+}
+
+IntervalMeaning GaussianProcess::interval_meaning() const {
+  if (state_.interval_of_mean) return IntervalMeaning::mean_over_draws;
+  return state_.micro_std_error > 0.0 ? IntervalMeaning::shared_scatter : IntervalMeaning::new_run;
+}
+
+void GaussianProcess::attach_patch_scatter(std::shared_ptr<const GaussianProcess> scatter) {
+  if (scatter && !same_input_space(scatter->inputs(), inputs())) {
+    throw Error("Gaussian process: the patch scatter's inputs or box differ from the model's");
+  }
+  patch_scatter_ = std::move(scatter);
+}
+
+Eigen::VectorXd GaussianProcess::patch_std(const QueryBatch& x) const {
+  if (!patch_scatter_) return {};
+  return std_from_log_variance(*patch_scatter_, x);
+}
+
+Eigen::VectorXd GaussianProcess::std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x) {
+  // The scatter GP's output is a log variance: not a μ, so not FrictionModel::evaluate's μ range or
+  // policies. A point outside the box takes its nearest face's value; a non-finite one none.
+  QueryBatch clamped = x;
+  std::vector<Eigen::Index> finite_rows;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    if (!x.row(i).allFinite()) continue;
+    finite_rows.push_back(i);
+    for (Eigen::Index j = 0; j < x.cols(); ++j) {
+      const InputSpec& input = log_variance.inputs()[static_cast<size_t>(j)];
+      clamped(i, j) = std::clamp(x(i, j), input.lo, input.hi);
+    }
+  }
+  QueryBatch finite(static_cast<Eigen::Index>(finite_rows.size()), x.cols());
+  for (size_t k = 0; k < finite_rows.size(); ++k) finite.row(static_cast<Eigen::Index>(k)) = clamped.row(finite_rows[k]);
+  Evaluation e;
+  e.mu.resize(finite.rows());
+  EvaluationRequest mean_only;
+  mean_only.mu_tolerance = 0.0;  // the exact model: the scatter GP carries no grid
+  if (finite.rows() > 0) log_variance.evaluate_valid(finite, mean_only, e);
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(x.rows(), std::numeric_limits<double>::quiet_NaN());
+  for (size_t k = 0; k < finite_rows.size(); ++k) out(finite_rows[k]) = std::exp(0.5 * e.mu(static_cast<Eigen::Index>(k)));
+  return out;
 }
 
 std::string GaussianProcess::summary() const {
@@ -381,7 +440,15 @@ std::string GaussianProcess::summary() const {
       << ", max " << state_.known_noise.maxCoeff() << " (normalised); RMS standard error of mu "
       << state_.micro_std_error << "\n";
   }
-  s << "  interval: " << gp_interval_meaning(state_.micro_std_error > 0.0) << "\n";
+  s << "  interval: " << gp_interval_meaning(interval_meaning()) << "\n";
+  if (patch_scatter_) {
+    const auto& p = patch_scatter_->state();
+    s << "  patch scatter: a GP of the log per-draw variance of mu on " << p.x_train.rows()
+      << " samples; per-draw std from the samples' own draws " << std::exp(0.5 * p.y_train.minCoeff()) << " .. "
+      << std::exp(0.5 * p.y_train.maxCoeff()) << " (bias-corrected logs), length scales";
+    for (Eigen::Index j = 0; j < p.hyper.length_scales.size(); ++j) s << " " << p.hyper.length_scales(j);
+    s << "\n";
+  }
   for (size_t j = 0; j < state_.inputs.size(); ++j) {
     s << "  length scale " << state_.inputs[j].name << ": " << h.length_scales(static_cast<Eigen::Index>(j))
       << " (box widths)\n";

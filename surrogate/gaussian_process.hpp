@@ -35,8 +35,16 @@ struct GpHyperParameters {
 // own is started inside the caller's and the cores are not oversubscribed; at most max_threads if > 0.
 int evaluation_team_size(int max_threads = 0);
 
-// What a GP's standard deviation and interval mean, for DescribeModel and `describe`.
-std::string gp_interval_meaning(bool with_micro_scatter);
+// What a GP's standard deviation stands for.
+//   new_run           a new micro-model run's μ (model variance + learned noise): data without their own errors
+//   shared_scatter    the mean over all draws, plus the samples' common scatter added as one constant
+//                     (data whose samples share their draws: the common error cannot average out)
+//   mean_over_draws   the mean over all draws of the roughness statistics (stochastic kriging of
+//                     independent draws: the model variance alone, which shrinks with the campaign)
+enum class IntervalMeaning { new_run, shared_scatter, mean_over_draws };
+std::string_view to_string(IntervalMeaning m);  // "new-run", "shared-scatter", "mean-over-draws"
+// For DescribeModel and `describe`.
+std::string gp_interval_meaning(IntervalMeaning m);
 
 // Figures from training, stored in the model file and shown by `describe`.
 struct GpTrainingSummary {
@@ -72,6 +80,10 @@ class GaussianProcess final : public FrictionModel {
     // the served interval: the spread of the μ a converged micro-model would give about the mean
     // over all tools of the same roughness statistics.
     double micro_std_error = 0.0;
+    // mean_over_draws: the served variance is the latent mean's alone (Ankenman, Nelson & Staum 2010,
+    // eq. 7's MSE), without the learned noise or micro_std_error: both belong to a sample, not to
+    // the mean. Otherwise new_run or shared_scatter, by micro_std_error.
+    bool interval_of_mean = false;
     Eigen::VectorXd alpha;     // K⁻¹ (y − mean)/scale
     Eigen::MatrixXd cholesky;  // lower factor of K, n × n
     GpTrainingSummary summary;
@@ -82,6 +94,7 @@ class GaussianProcess final : public FrictionModel {
 
   std::string_view kind() const override { return "gp"; }
   bool has_uncertainty() const override { return true; }
+  bool has_patch_scatter() const override { return patch_scatter_ != nullptr; }
   void write(h5::Writer& out) const override;
   std::string summary() const override;
   const State& state() const { return state_; }
@@ -95,12 +108,30 @@ class GaussianProcess final : public FrictionModel {
   void attach_fast_evaluator(std::shared_ptr<const FastEvaluator> fast);
   const FastEvaluator* fast_evaluator() const { return fast_.get(); }
 
+  IntervalMeaning interval_meaning() const;
+
+  // The patch scatter (issue 33): a GP of the log per-draw variance of μ over the same inputs
+  // (surrogate/stochastic_kriging.hpp), served as its own output, never mixed into the interval.
+  void attach_patch_scatter(std::shared_ptr<const GaussianProcess> scatter);
+  const GaussianProcess* patch_scatter() const { return patch_scatter_.get(); }
+  // The per-draw standard deviation of μ at SI points (rows), exp(½ m(x)) of the scatter GP's mean;
+  // empty when the model has none. Outside the box, m at the nearest face (clamped).
+  Eigen::VectorXd patch_std(const QueryBatch& x) const;
+  // exp(½ m(x)) of a GP `log_variance` of a log variance, each point clamped to its box (NaN for a
+  // non-finite point): what patch_std serves, and what stochastic kriging puts on its diagonal.
+  static Eigen::VectorXd std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x);
+
+  // The model file's groups under `group` ("/gp"; the patch scatter's under "/gp/patch_scatter").
+  void write_group(h5::Writer& out, const std::string& group) const;
+  static GaussianProcess read_group(const h5::Reader& in, InputSpace inputs, const std::string& group);
+
   // Store the n × n factor in model files up to this size; larger models refactorise on load.
   static constexpr Eigen::Index kStoreCholeskyUpTo = 2000;
 
 
  protected:
   void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const override;
+  Eigen::VectorXd patch_std_valid(const QueryBatch& x) const override { return patch_std(x); }
 
  private:
   void evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const;
@@ -123,6 +154,7 @@ class GaussianProcess final : public FrictionModel {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse_factor_;
   Eigen::Index row_split_ = 0;  // rows [0, split) and [split, n) hold equal halves of the entries
   std::shared_ptr<const FastEvaluator> fast_;
+  std::shared_ptr<const GaussianProcess> patch_scatter_;
   Eigen::RowVectorXd box_lo_;
   Eigen::RowVectorXd inverse_box_width_;
   Eigen::MatrixXd scaled_train_;       // x_unit / l, n × d

@@ -311,7 +311,10 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   // The samples' own standard errors: their RMS widens the served interval; on request, each one's
   // variance also goes on the diagonal.
   const bool all_std = data.mu_std.size() == n && data.mu_std.allFinite();
-  if (all_std) {
+  state.interval_of_mean = options.interval_of_mean;
+  if (options.interval_of_mean) {
+    if (!options.sample_noise) throw Error("an interval of the mean needs the samples' own variances on the diagonal");
+  } else if (all_std) {
     state.micro_std_error = std::sqrt(data.mu_std.array().square().mean());
     report.micro_std_error = state.micro_std_error;
   } else if (data.mu_std.size() == n && data.mu_std.array().isFinite().any()) {

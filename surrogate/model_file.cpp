@@ -64,8 +64,6 @@ constexpr std::pair<const char*, std::string GpTrainingSummary::*> kSummaryTexts
     {"dataset_sha256", &GpTrainingSummary::dataset_sha256},
     {"code_version", &GpTrainingSummary::code_version},
     {"created_utc", &GpTrainingSummary::created_utc}};
-constexpr const char* kSummaryGroup = "/gp/training";
-constexpr const char* kFastGroup = "/gp/fast_evaluator";
 // Nodes of a stored fast evaluator recomputed with the exact model at load. A node is the exact
 // model's value, but computed in another batch: near the noise floor σ is the square root of a
 // difference of nearly equal numbers, and two evaluation paths differ there far beyond 1e-9 (issue
@@ -229,15 +227,15 @@ MlrLaw MlrLaw::read(const h5::Reader& in, InputSpace inputs) {
 namespace {
 
 // A stored fast evaluator, refused unless its checksum matches and sampled nodes are the exact model's.
-std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, const GaussianProcess& gp) {
-  const std::string group = kFastGroup;
+std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, const GaussianProcess& gp,
+                                                         const std::string& group) {
   const std::vector<long long> cells = in.ints(group + "/cells");
   const std::vector<double> values = in.doubles(group + "/values");
   const FastEvaluatorBounds bounds{
-      in.double_attribute(kFastGroup, "bound_mu_absolute"), in.double_attribute(kFastGroup, "bound_std_relative"),
-      in.has_attribute(kFastGroup, "std_floor") ? in.double_attribute(kFastGroup, "std_floor") : 0.0};
+      in.double_attribute(group, "bound_mu_absolute"), in.double_attribute(group, "bound_std_relative"),
+      in.has_attribute(group, "std_floor") ? in.double_attribute(group, "std_floor") : 0.0};
   if (fast_evaluator_digest(cells, values, bounds) !=
-      in.string_attribute(kFastGroup, "sha256")) {
+      in.string_attribute(group, "sha256")) {
     in.fail(group, "checksum mismatch: the interpolant or its bounds changed after it was certified");
   }
   if (cells.size() != gp.inputs().size()) {
@@ -303,84 +301,101 @@ std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, c
 
 }  // namespace
 
-void GaussianProcess::write(h5::Writer& out) const {
+void GaussianProcess::write(h5::Writer& out) const { write_group(out, "/gp"); }
+
+void GaussianProcess::write_group(h5::Writer& out, const std::string& group) const {
   const auto& s = state_;
-  out.group("/gp");
-  out.string_attribute("/gp", "kernel", "constant*RBF(ARD)+white; inputs scaled to the unit box, outputs (mu-mean)/scale");
-  out.double_attribute("/gp", "y_mean", s.y_mean);
-  out.double_attribute("/gp", "y_scale", s.y_scale);
-  out.double_attribute("/gp", "signal_variance", s.hyper.signal_variance);
-  out.double_attribute("/gp", "noise_variance", s.hyper.noise_variance);
-  out.int_attribute("/gp", "noise_term", s.hyper.noise_term ? 1 : 0);
-  out.double_attribute("/gp", "jitter", s.jitter);
-  out.doubles("/gp/length_scales", s.hyper.length_scales);
-  out.matrix("/gp/x_train", s.x_train);
-  out.doubles("/gp/y_train", s.y_train);
-  out.doubles("/gp/alpha", s.alpha);
-  if (s.x_train.rows() <= kStoreCholeskyUpTo) out.matrix("/gp/cholesky_lower", s.cholesky);
-  if (s.known_noise.size() != 0) out.doubles("/gp/known_noise", s.known_noise);
-  out.double_attribute("/gp", "micro_std_error", s.micro_std_error);
-  out.group(kSummaryGroup);
-  for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(kSummaryGroup, name, s.summary.*field);
-  for (const auto& [name, field] : kSummaryCounts) out.int_attribute(kSummaryGroup, name, s.summary.*field);
-  for (const auto& [name, field] : kSummaryTexts) out.string_attribute(kSummaryGroup, name, s.summary.*field);
+  const std::string summary_group = group + "/training", fast_group = group + "/fast_evaluator";
+  out.group(group);
+  out.string_attribute(group, "kernel", "constant*RBF(ARD)+white; inputs scaled to the unit box, outputs (mu-mean)/scale");
+  out.double_attribute(group, "y_mean", s.y_mean);
+  out.double_attribute(group, "y_scale", s.y_scale);
+  out.double_attribute(group, "signal_variance", s.hyper.signal_variance);
+  out.double_attribute(group, "noise_variance", s.hyper.noise_variance);
+  out.int_attribute(group, "noise_term", s.hyper.noise_term ? 1 : 0);
+  out.double_attribute(group, "jitter", s.jitter);
+  out.doubles(group + "/length_scales", s.hyper.length_scales);
+  out.matrix(group + "/x_train", s.x_train);
+  out.doubles(group + "/y_train", s.y_train);
+  out.doubles(group + "/alpha", s.alpha);
+  if (s.x_train.rows() <= kStoreCholeskyUpTo) out.matrix(group + "/cholesky_lower", s.cholesky);
+  if (s.known_noise.size() != 0) out.doubles(group + "/known_noise", s.known_noise);
+  out.double_attribute(group, "micro_std_error", s.micro_std_error);
+  out.string_attribute(group, "interval", std::string(to_string(interval_meaning())));
+  out.group(summary_group);
+  for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(summary_group, name, s.summary.*field);
+  for (const auto& [name, field] : kSummaryCounts) out.int_attribute(summary_group, name, s.summary.*field);
+  for (const auto& [name, field] : kSummaryTexts) out.string_attribute(summary_group, name, s.summary.*field);
   if (fast_) {
     const std::vector<long long> cells(fast_->grid().cells().begin(), fast_->grid().cells().end());
     const FastEvaluatorBounds& b = fast_->bounds();
-    out.group(kFastGroup);
-    out.string_attribute(kFastGroup, "interpolation",
+    out.group(fast_group);
+    out.string_attribute(fast_group, "interpolation",
                          "piecewise-cubic tensor Lagrange on a uniform grid over the unit box; node values (mu, log std), "
                          "node-major, last input fastest; bounds measured against the exact GP");
-    out.ints(std::string(kFastGroup) + "/cells", cells);
-    out.doubles(std::string(kFastGroup) + "/values", fast_->grid().values());
-    out.double_attribute(kFastGroup, "bound_mu_absolute", b.mu_absolute);
-    out.double_attribute(kFastGroup, "bound_std_relative", b.std_relative);
-    out.double_attribute(kFastGroup, "std_floor", b.std_floor);
-    out.string_attribute(kFastGroup, "sha256", fast_evaluator_digest(cells, fast_->grid().values(), b));
+    out.ints(fast_group + "/cells", cells);
+    out.doubles(fast_group + "/values", fast_->grid().values());
+    out.double_attribute(fast_group, "bound_mu_absolute", b.mu_absolute);
+    out.double_attribute(fast_group, "bound_std_relative", b.std_relative);
+    out.double_attribute(fast_group, "std_floor", b.std_floor);
+    out.string_attribute(fast_group, "sha256", fast_evaluator_digest(cells, fast_->grid().values(), b));
   }
+  if (patch_scatter_) patch_scatter_->write_group(out, group + "/patch_scatter");
 }
 
-GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
+GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) { return read_group(in, std::move(inputs), "/gp"); }
+
+GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inputs, const std::string& group) {
+  const std::string summary_group = group + "/training", fast_group = group + "/fast_evaluator";
   State s;
   s.inputs = std::move(inputs);
   const auto d = static_cast<Eigen::Index>(s.inputs.size());
-  s.x_train = in.matrix("/gp/x_train");
+  s.x_train = in.matrix(group + "/x_train");
   if (s.x_train.cols() != d) {
-    in.fail("/gp/x_train", "has " + std::to_string(s.x_train.cols()) + " columns for " + std::to_string(d) + " inputs");
+    in.fail(group + "/x_train", "has " + std::to_string(s.x_train.cols()) + " columns for " + std::to_string(d) + " inputs");
   }
   const Eigen::Index n = s.x_train.rows();
-  if (n == 0) in.fail("/gp/x_train", "no training points");
-  if (!s.x_train.allFinite()) in.fail("/gp/x_train", "contains non-finite values");
-  s.y_train = in.vector("/gp/y_train", n);
-  s.alpha = in.vector("/gp/alpha", n);
-  if (!s.alpha.allFinite()) in.fail("/gp/alpha", "contains non-finite values");
-  s.y_mean = in.double_attribute("/gp", "y_mean");
-  s.y_scale = in.double_attribute("/gp", "y_scale");
-  s.hyper.signal_variance = in.double_attribute("/gp", "signal_variance");
-  s.hyper.noise_variance = in.double_attribute("/gp", "noise_variance");
-  s.hyper.noise_term = in.int_attribute("/gp", "noise_term") != 0;
-  s.hyper.length_scales = in.vector("/gp/length_scales", d);
-  s.jitter = in.double_attribute("/gp", "jitter");
+  if (n == 0) in.fail(group + "/x_train", "no training points");
+  if (!s.x_train.allFinite()) in.fail(group + "/x_train", "contains non-finite values");
+  s.y_train = in.vector(group + "/y_train", n);
+  s.alpha = in.vector(group + "/alpha", n);
+  if (!s.alpha.allFinite()) in.fail(group + "/alpha", "contains non-finite values");
+  s.y_mean = in.double_attribute(group, "y_mean");
+  s.y_scale = in.double_attribute(group, "y_scale");
+  s.hyper.signal_variance = in.double_attribute(group, "signal_variance");
+  s.hyper.noise_variance = in.double_attribute(group, "noise_variance");
+  s.hyper.noise_term = in.int_attribute(group, "noise_term") != 0;
+  s.hyper.length_scales = in.vector(group + "/length_scales", d);
+  s.jitter = in.double_attribute(group, "jitter");
   if (!(s.hyper.length_scales.array() > 0).all() || !s.hyper.length_scales.allFinite()) {
-    in.fail("/gp/length_scales", "must be positive and finite");
+    in.fail(group + "/length_scales", "must be positive and finite");
   }
   if (!(s.hyper.signal_variance > 0) || !std::isfinite(s.hyper.signal_variance)) {
-    in.fail("/gp", "attribute signal_variance must be positive and finite");
+    in.fail(group, "attribute signal_variance must be positive and finite");
   }
   if (!(s.hyper.noise_variance >= 0) || !std::isfinite(s.hyper.noise_variance)) {
-    in.fail("/gp", "attribute noise_variance must be >= 0 and finite");
+    in.fail(group, "attribute noise_variance must be >= 0 and finite");
   }
-  if (!(s.jitter >= 0) || !std::isfinite(s.jitter)) in.fail("/gp", "attribute jitter must be >= 0 and finite");
-  if (!(s.y_scale > 0) || !std::isfinite(s.y_scale)) in.fail("/gp", "attribute y_scale must be positive and finite");
-  if (in.has("/gp/known_noise")) {
-    s.known_noise = in.vector("/gp/known_noise", n);
-    if (!s.known_noise.allFinite() || !(s.known_noise.array() >= 0).all()) in.fail("/gp/known_noise", "must be finite and >= 0");
+  if (!(s.jitter >= 0) || !std::isfinite(s.jitter)) in.fail(group, "attribute jitter must be >= 0 and finite");
+  if (!(s.y_scale > 0) || !std::isfinite(s.y_scale)) in.fail(group, "attribute y_scale must be positive and finite");
+  if (in.has(group + "/known_noise")) {
+    s.known_noise = in.vector(group + "/known_noise", n);
+    if (!s.known_noise.allFinite() || !(s.known_noise.array() >= 0).all()) in.fail(group + "/known_noise", "must be finite and >= 0");
   }
-  if (in.has_attribute("/gp", "micro_std_error")) {
-    s.micro_std_error = in.double_attribute("/gp", "micro_std_error");
+  if (in.has_attribute(group, "micro_std_error")) {
+    s.micro_std_error = in.double_attribute(group, "micro_std_error");
     if (!(s.micro_std_error >= 0) || !std::isfinite(s.micro_std_error)) {
-      in.fail("/gp", "attribute micro_std_error must be >= 0 and finite");
+      in.fail(group, "attribute micro_std_error must be >= 0 and finite");
     }
+  }
+
+  // Absent (files before issue 33): new-run or shared-scatter, by micro_std_error.
+  if (in.has_attribute(group, "interval")) {
+    const std::string meaning = in.string_attribute(group, "interval");
+    if (meaning != "new-run" && meaning != "shared-scatter" && meaning != "mean-over-draws") {
+      in.fail(group, "attribute interval '" + meaning + "' is not new-run, shared-scatter or mean-over-draws");
+    }
+    s.interval_of_mean = meaning == "mean-over-draws";
   }
 
   Eigen::MatrixXd kf;
@@ -388,45 +403,49 @@ GaussianProcess GaussianProcess::read(const h5::Reader& in, InputSpace inputs) {
   // Known per-point noise belongs to the covariance the factor was made of.
   if (s.known_noise.size() != 0) kf.diagonal() += s.known_noise;
   const double diagonal = s.hyper.noise_variance + s.jitter;
-  if (in.has("/gp/cholesky_lower")) {
-    s.cholesky = in.matrix("/gp/cholesky_lower");
-    if (s.cholesky.rows() != n || s.cholesky.cols() != n) in.fail("/gp/cholesky_lower", "is not n × n");
+  if (in.has(group + "/cholesky_lower")) {
+    s.cholesky = in.matrix(group + "/cholesky_lower");
+    if (s.cholesky.rows() != n || s.cholesky.cols() != n) in.fail(group + "/cholesky_lower", "is not n × n");
     if (!s.cholesky.allFinite() || !(s.cholesky.diagonal().array() > 0).all()) {
-      in.fail("/gp/cholesky_lower", "is not a valid Cholesky factor (non-finite or non-positive diagonal)");
+      in.fail(group + "/cholesky_lower", "is not a valid Cholesky factor (non-finite or non-positive diagonal)");
     }
     if (!factor_matches_kernel(s.cholesky, kf, diagonal)) {
-      in.fail("/gp/cholesky_lower", "is inconsistent with x_train and the hyper-parameters (L·Lᵀ != K)");
+      in.fail(group + "/cholesky_lower", "is inconsistent with x_train and the hyper-parameters (L·Lᵀ != K)");
     }
   } else {
     const auto chol = cholesky_with_jitter(kf, diagonal, s.cholesky);
-    if (!chol.ok || chol.jitter > 0.0) in.fail("/gp", "covariance cannot be refactorised with the stored jitter");
+    if (!chol.ok || chol.jitter > 0.0) in.fail(group, "covariance cannot be refactorised with the stored jitter");
   }
   // Consistency, O(n²): α̂ = (L Lᵀ)⁻¹ y from the factor, then K α = y and α = α̂ entry by entry. Every
   // scale below comes from α̂ as well as from α: scaled by ‖α‖ alone, one entry blown up to 1e180 by a
   // flipped exponent bit inflated its own tolerance and passed.
-  if (!s.y_train.allFinite()) in.fail("/gp/y_train", "contains non-finite values");
-  if (!std::isfinite(s.y_mean)) in.fail("/gp", "attribute y_mean must be finite");
+  if (!s.y_train.allFinite()) in.fail(group + "/y_train", "contains non-finite values");
+  if (!std::isfinite(s.y_mean)) in.fail(group, "attribute y_mean must be finite");
   const Eigen::VectorXd y = (s.y_train.array() - s.y_mean) / s.y_scale;
   Eigen::VectorXd alpha_from_factor = s.cholesky.triangularView<Eigen::Lower>().solve(y);
   s.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(alpha_from_factor);
   const double alpha_size = std::min(s.alpha.lpNorm<Eigen::Infinity>(), alpha_from_factor.lpNorm<Eigen::Infinity>());
   if ((alpha_from_factor - s.alpha).lpNorm<Eigen::Infinity>() > kAlphaRecomputeTolerance * alpha_size) {
-    in.fail("/gp/alpha", "is inconsistent with the Cholesky factor and y_train (alpha != K⁻¹y)");
+    in.fail(group + "/alpha", "is inconsistent with the Cholesky factor and y_train (alpha != K⁻¹y)");
   }
   Eigen::VectorXd k_alpha = kf.selfadjointView<Eigen::Lower>() * s.alpha;
   k_alpha += diagonal * s.alpha;
   const double n_alpha = static_cast<double>(n) * alpha_size;
   const double scale = (kf.lpNorm<Eigen::Infinity>() + diagonal) * n_alpha + y.lpNorm<Eigen::Infinity>();
   if ((k_alpha - y).lpNorm<Eigen::Infinity>() > kLoadBackwardErrorTolerance * scale) {
-    in.fail("/gp/alpha", "is inconsistent with x_train, y_train and the hyper-parameters (K·alpha != y)");
+    in.fail(group + "/alpha", "is inconsistent with x_train, y_train and the hyper-parameters (K·alpha != y)");
   }
-  if (in.has(kSummaryGroup)) {
-    for (const auto& [name, field] : kSummaryNumbers) s.summary.*field = in.double_attribute(kSummaryGroup, name);
-    for (const auto& [name, field] : kSummaryCounts) s.summary.*field = in.int_attribute(kSummaryGroup, name);
-    for (const auto& [name, field] : kSummaryTexts) s.summary.*field = in.string_attribute(kSummaryGroup, name);
+  if (in.has(summary_group)) {
+    for (const auto& [name, field] : kSummaryNumbers) s.summary.*field = in.double_attribute(summary_group, name);
+    for (const auto& [name, field] : kSummaryCounts) s.summary.*field = in.int_attribute(summary_group, name);
+    for (const auto& [name, field] : kSummaryTexts) s.summary.*field = in.string_attribute(summary_group, name);
   }
+  const InputSpace inputs_of_model = s.inputs;
   GaussianProcess gp(std::move(s));
-  if (in.has(kFastGroup)) gp.attach_fast_evaluator(read_fast_evaluator(in, gp));
+  if (in.has(fast_group)) gp.attach_fast_evaluator(read_fast_evaluator(in, gp, fast_group));
+  if (in.has(group + "/patch_scatter")) {
+    gp.attach_patch_scatter(std::make_shared<const GaussianProcess>(read_group(in, inputs_of_model, group + "/patch_scatter")));
+  }
   return gp;
 }
 

@@ -15,7 +15,10 @@ namespace mufric {
 // scatter, part of the interval); version-1 files still load (no scatter: the interval as before).
 // Version 3 added a GP's optional /gp/fast_evaluator (cells, values, bounds, sha256): the certified
 // fast evaluator; older files load without one (`mufric upgrade` adds it).
-inline constexpr long long kModelSchemaVersion = 3;
+// Version 4 added a GP's interval attribute (new-run, shared-scatter or mean-over-draws) and its
+// optional /gp/patch_scatter (a GP of the same layout for the log per-draw variance of μ, issue 33);
+// older files load with the interval their micro_std_error implies and no patch scatter.
+inline constexpr long long kModelSchemaVersion = 4;
 inline constexpr long long kOldestReadableModelSchema = 1;
 inline constexpr const char* kModelFormat = "mufric-model";
 

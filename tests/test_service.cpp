@@ -34,6 +34,7 @@
 #include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
+#include "surrogate/stochastic_kriging.hpp"
 
 namespace mufric {
 namespace {
@@ -742,6 +743,78 @@ TEST_F(Service, ExtrapolationPolicyIsChosenPerRequest) {
 // over one stream (the server counts the streams opened), and a misspelt key is refused by name.
 // (A deadline cannot be shown to bite on loopback without a slow model: a 1 µs call sometimes
 // completes; parse_options is checked above and the C++ client's deadlines in their own tests.)
+// The patch scatter (issue 33) of a model trained by stochastic kriging reaches every interface with
+// the same bits: in-process, unary gRPC, the stream and the C ABI; DescribeModel says the model has
+// one and what its interval is; a model without one refuses the C call and sends none.
+TEST_F(Service, ThePatchScatterReachesEveryInterface) {
+  TrainingSet t = test::smooth_training_set(40, 8);
+  t.draws = DrawDesign::independent;
+  t.draw_mu.resize(40, 4);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (Eigen::Index i = 0; i < 40; ++i) {
+    const double spread = 0.01 + 0.02 * (t.x(i, 0) - t.inputs[0].lo) / (t.inputs[0].hi - t.inputs[0].lo);
+    for (Eigen::Index k = 0; k < 4; ++k) t.draw_mu(i, k) = t.mu(i) + spread * normal(rng);
+    t.mu(i) = t.draw_mu.row(i).mean();
+  }
+  GpTrainingOptions options;
+  options.restarts = 1;
+  const GaussianProcess sk = train_stochastic_kriging(t, options);
+  save_model((dir_ / "sk.h5").string(), sk);
+  LoopbackServer server(dir_);
+  const Points pts = random_points(300);
+  Points outside = pts;
+  outside.p[7] = 5e9;  // above the box: the nearest face's patch scatter under clamp
+  EvaluationRequest what{.std = true, .ci_level = 0.95, .patch_std = true};
+  const client::Answer local = client::connect("file://" + (dir_ / "sk.h5").string())->evaluate(outside.block(), what);
+  ASSERT_EQ(local.patch_std.size(), 300u);
+  QueryBatch x(300, 3);
+  for (Eigen::Index i = 0; i < 300; ++i) x.row(i) << outside.p[static_cast<size_t>(i)], outside.v[static_cast<size_t>(i)], outside.t[static_cast<size_t>(i)];
+  const Eigen::VectorXd direct = sk.patch_std(x);
+  for (size_t i = 0; i < 300; ++i) EXPECT_EQ(local.patch_std[i], direct(static_cast<Eigen::Index>(i))) << i;
+  QueryBatch face = x.row(7);
+  face(0, 0) = t.inputs[0].hi;
+  EXPECT_EQ(local.patch_std[7], sk.patch_std(face)(0));
+  for (const bool stream : {false, true}) {
+    client::Options o;
+    o.streaming = stream;
+    o.chunk_points = 128;
+    const auto remote = client::connect("grpc://" + server.address() + "/sk", o);
+    EXPECT_TRUE(remote->describe().has_patch_scatter);
+    const client::Answer a = remote->evaluate(outside.block(), what);
+    EXPECT_EQ(a.patch_std, local.patch_std) << "stream " << stream;
+    EXPECT_EQ(a.hi, local.hi);
+  }
+  // A model without one: nothing asked of it is sent back, and the C call is refused.
+  const client::Answer plain = client::connect("grpc://" + server.address() + "/gp")->evaluate(pts.block(), what);
+  EXPECT_TRUE(plain.patch_std.empty());
+  EXPECT_FALSE(client::connect("grpc://" + server.address() + "/gp")->describe().has_patch_scatter);
+  for (const std::string uri : {"grpc://" + server.address() + "/sk", "file://" + (dir_ / "sk.h5").string()}) {
+    mufric_client* c = nullptr;
+    ASSERT_EQ(mufric_open_with_options(uri.c_str(), "fill=-1", &c), MUFRIC_OK) << mufric_last_error();
+    EXPECT_EQ(mufric_has_patch_scatter(c), 1);
+    std::vector<double> out(300);
+    std::vector<int> status(300);
+    Points bad = outside;
+    bad.t[9] = -1.0;  // no answer: the fill value
+    ASSERT_EQ(mufric_patch_std(c, 300, bad.p.data(), bad.v.data(), bad.t.data(), nullptr, out.data(), status.data()),
+              MUFRIC_OK)
+        << mufric_last_error();
+    EXPECT_EQ(out[9], -1.0);
+    EXPECT_EQ(status[9], MUFRIC_POINT_INVALID_INPUT);
+    EXPECT_EQ(out[8], local.patch_std[8]) << uri;
+    mufric_close(c);
+  }
+  mufric_client* c = nullptr;
+  ASSERT_EQ(mufric_open(("grpc://" + server.address() + "/gp").c_str(), &c), MUFRIC_OK);
+  EXPECT_EQ(mufric_has_patch_scatter(c), 0);
+  std::vector<double> out(1);
+  EXPECT_EQ(mufric_patch_std(c, 1, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, out.data(), nullptr),
+            MUFRIC_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(mufric_last_error()).find("no patch scatter"), std::string::npos) << mufric_last_error();
+  mufric_close(c);
+}
+
 TEST_F(Service, CAbiOptionsReachTheConnection) {
   LoopbackServer server(dir_, 0, {.max_points_per_request = 1000000, .bearer_token = "s3cret"});
   const std::string uri = "grpc://" + server.address() + "/coulomb";
