@@ -263,10 +263,15 @@ void add_train(CLI::App& app) {
       std::fflush(stdout);
       trained.emplace(train_stochastic_kriging(data, o->gp, &sk));
       report = sk.mean;
-      std::printf("patch scatter: %lld samples, %lld draws; per-draw std of mu at the training points, median %.4g "
-                  "(%.1f %% of mean mu); a sample's mean's smoothed standard error, median %.4g\n",
-                  sk.scatter_samples, sk.draws, sk.median_patch_std,
-                  100.0 * sk.median_patch_std / std::max(std::abs(data.mu.mean()), 1e-300), sk.median_sample_std_error);
+      if (sk.homoscedastic) {
+        std::printf("one draw per sample (%lld draws): no patch scatter to learn; the learned noise is the per-draw "
+                    "variance, left out of the served interval (the mean's)\n", sk.draws);
+      } else {
+        std::printf("patch scatter: %lld samples, %lld draws; per-draw std of mu at the training points, median %.4g "
+                    "(%.1f %% of mean mu); a sample's mean's smoothed standard error, median %.4g\n",
+                    sk.scatter_samples, sk.draws, sk.median_patch_std,
+                    100.0 * sk.median_patch_std / std::max(std::abs(data.mu.mean()), 1e-300), sk.median_sample_std_error);
+      }
     } else {
       if (data.draws == DrawDesign::independent && !o->no_stochastic_kriging) {
         std::printf("note: the dataset's draws are independent but its samples carry no per-draw mu: one GP, as for "

@@ -313,7 +313,9 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   const bool all_std = data.mu_std.size() == n && data.mu_std.allFinite();
   state.interval_of_mean = options.interval_of_mean;
   if (options.interval_of_mean) {
-    if (!options.sample_noise) throw Error("an interval of the mean needs the samples' own variances on the diagonal");
+    if (!options.sample_noise && !options.noise_term) {
+      throw Error("an interval of the mean needs the samples' own variances on the diagonal or a learned noise term");
+    }
   } else if (all_std) {
     state.micro_std_error = std::sqrt(data.mu_std.array().square().mean());
     report.micro_std_error = state.micro_std_error;

@@ -43,7 +43,8 @@ struct GpTrainingOptions {
   // across samples, which the diagonal would wrongly smooth away. Needs every sample's μ_std.
   bool sample_noise = false;
   // The served interval is the latent mean's alone (IntervalMeaning::mean_over_draws): for samples
-  // whose errors are independent and on the diagonal (stochastic kriging). micro_std_error is then 0.
+  // whose errors are independent, on the diagonal (stochastic kriging) or in the learned noise (one
+  // draw per sample). micro_std_error is then 0.
   bool interval_of_mean = false;
   // Progress lines for long fits (thread-safe calls): when each stage starts, and during a start's
   // full-data climb at most every kTrainingProgressSeconds. May be empty.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -22,6 +23,8 @@ double median(std::vector<double> values) {
 
 // A GP of log s² needs at least two values to learn anything of how it varies.
 constexpr int kMinimumScatterSamples = 2;
+// Normalised noise variance allowed with one draw per sample: up to ten times μ's variance.
+constexpr double kSingleDrawNoiseBound = 10.0;
 
 }  // namespace
 
@@ -80,9 +83,21 @@ GaussianProcess train_stochastic_kriging(const TrainingSet& data, const GpTraini
   const DrawVariances v = draw_variances(data);
   report.scatter_samples = static_cast<long long>(v.rows.size());
   if (report.scatter_samples < kMinimumScatterSamples) {
-    throw Error(data.source_path + ": stochastic kriging needs at least " + std::to_string(kMinimumScatterSamples) +
-                " samples with two draws or more (protocol.realisations >= 2); it has " +
-                std::to_string(report.scatter_samples));
+    // One draw per sample: the learned noise is the per-draw variance, the same everywhere, and the
+    // mean's interval leaves it out (independent draws average it away).
+    report.homoscedastic = true;
+    GpTrainingOptions mean_options = options;
+    mean_options.sample_noise = false;
+    mean_options.noise_term = true;
+    mean_options.interval_of_mean = true;
+    // Single draws may scatter by more than μ varies over the box: the noise may then exceed the
+    // signal, which the default bound (a tenth of μ's variance, for nearly deterministic data) forbids.
+    mean_options.bounds.noise_variance_hi = std::max(options.bounds.noise_variance_hi, kSingleDrawNoiseBound);
+    TrainingSet mean_data = data;
+    mean_data.mu_std.setConstant(std::numeric_limits<double>::quiet_NaN());
+    GaussianProcess gp = train_gaussian_process(mean_data, mean_options, &report.mean);
+    if (report_out) *report_out = report;
+    return gp;
   }
   TrainingSet scatter_data;
   scatter_data.inputs = data.inputs;

@@ -32,13 +32,16 @@ DrawVariances draw_variances(const TrainingSet& data);
 struct StochasticKrigingReport {
   GpTrainingReport scatter, mean;
   long long scatter_samples = 0;        // samples with ≥ 2 draws, the patch scatter's data
+  // Fewer than two such samples: no patch scatter; the mean's GP learns one noise level, the per-draw
+  // variance, and serves the mean's interval without it.
+  bool homoscedastic = false;
   long long draws = 0;                  // finite draws in all samples
   double median_patch_std = 0.0;        // the patch scatter at the training points, μ units
   double median_sample_std_error = 0.0; // the smoothed standard error of a sample's mean there
 };
 
-// The patch scatter, then the mean. Throws Error naming the sample when one has no draws, or when
-// fewer than two samples have two draws or more.
+// The patch scatter, then the mean. Throws Error naming the sample when one has no draws. With
+// fewer than two samples of two draws or more (one draw per sample), the mean alone (homoscedastic).
 GaussianProcess train_stochastic_kriging(const TrainingSet& data, const GpTrainingOptions& options,
                                          StochasticKrigingReport* report = nullptr);
 

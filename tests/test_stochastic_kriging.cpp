@@ -3,6 +3,7 @@
 // heteroscedastic simulator; both through the model file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -96,8 +97,9 @@ TEST(StochasticKriging, AKnownDiagonalGivesTheDensePosterior) {
 // A heteroscedastic stochastic simulator with a known mean and a known per-draw spread.
 double true_mean(const Eigen::RowVectorXd& x) { return 0.2 + 0.04 * std::sin(3.0 * x(0)) - 0.03 * x(2); }
 double true_spread(const Eigen::RowVectorXd& x) { return 0.01 + 0.04 * x(0); }
+constexpr double kConstantSpread = 0.03;
 
-TrainingSet independent_draws(Eigen::Index samples, int draws, std::uint64_t seed) {
+TrainingSet independent_draws(Eigen::Index samples, int draws, std::uint64_t seed, bool heteroscedastic = true) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -110,7 +112,8 @@ TrainingSet independent_draws(Eigen::Index samples, int draws, std::uint64_t see
   t.draw_mu.resize(samples, draws);
   for (Eigen::Index i = 0; i < samples; ++i) {
     for (Eigen::Index j = 0; j < 3; ++j) t.x(i, j) = unit(rng);
-    for (int k = 0; k < draws; ++k) t.draw_mu(i, k) = true_mean(t.x.row(i)) + true_spread(t.x.row(i)) * normal(rng);
+    const double spread = heteroscedastic ? true_spread(t.x.row(i)) : kConstantSpread;
+    for (int k = 0; k < draws; ++k) t.draw_mu(i, k) = true_mean(t.x.row(i)) + spread * normal(rng);
     t.mu(i) = t.draw_mu.row(i).mean();
     const double variance = (t.draw_mu.row(i).array() - t.mu(i)).square().sum() / (draws - 1);
     t.mu_std(i) = std::sqrt(variance / draws);
@@ -184,8 +187,41 @@ TEST(StochasticKriging, RefusesSamplesWithoutDraws) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("training sample 7"), std::string::npos) << e.what();
   }
-  TrainingSet single = independent_draws(10, 1, 6);
-  EXPECT_THROW(train_stochastic_kriging(single, GpTrainingOptions{}), Error);
+}
+
+// One draw per sample: no patch scatter to learn, but the draws are still independent, so the learned
+// noise is the per-draw variance and the served interval is the mean's, without it.
+TEST(StochasticKriging, OneDrawPerSampleServesTheMeanWithoutAPatchScatter) {
+  GpTrainingOptions options;
+  options.restarts = 2;
+  StochasticKrigingReport report;
+  const GaussianProcess gp = train_stochastic_kriging(independent_draws(240, 1, 6, false), options, &report);
+  EXPECT_TRUE(report.homoscedastic);
+  EXPECT_EQ(gp.patch_scatter(), nullptr);
+  EXPECT_FALSE(gp.has_patch_scatter());
+  EXPECT_EQ(gp.interval_meaning(), IntervalMeaning::mean_over_draws);
+  // The learned noise is the per-draw spread (0.03; above the default bound of a tenth of μ's
+  // variance, which the single-draw fit lifts) ...
+  const double noise_std = gp.state().y_scale * std::sqrt(gp.state().hyper.noise_variance);
+  EXPECT_NEAR(noise_std, kConstantSpread, 0.2 * kConstantSpread);
+  // ... and the served std, the mean's, is well below it, covering the true mean.
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> unit(0.1, 0.9);
+  Eigen::MatrixXd q(200, 3);
+  for (Eigen::Index i = 0; i < q.rows(); ++i) {
+    for (Eigen::Index j = 0; j < 3; ++j) q(i, j) = unit(rng);
+  }
+  EvaluationRequest what;
+  what.ci_level = 0.95;
+  what.std = true;
+  what.mu_tolerance = 0.0;
+  const Evaluation e = gp.evaluate(q, what);
+  long long covered = 0;
+  for (Eigen::Index i = 0; i < q.rows(); ++i) covered += true_mean(q.row(i)) >= e.lo(i) && true_mean(q.row(i)) <= e.hi(i);
+  EXPECT_GE(covered, 170) << covered;
+  std::vector<double> stds(e.std.data(), e.std.data() + e.std.size());
+  std::nth_element(stds.begin(), stds.begin() + 100, stds.end());
+  EXPECT_LT(stds[100], 0.5 * noise_std) << "median std of the mean";
 }
 
 // A draw's log sample variance, bias-corrected, is unbiased for log σ² (checked by brute force over
