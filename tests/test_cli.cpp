@@ -640,8 +640,25 @@ TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
   EXPECT_NE(r.output.find("design latin-hypercube (seed 4)"), std::string::npos) << r.output;
   r = run("dataset status " + path("s1.h5"));  // one shard: the other rows are not run (in this file)
   EXPECT_NE(r.output.find("3 of 6 plan points not yet run"), std::string::npos) << r.output;
-  r = run("train --data " + path("all.h5") + " --out " + path("gp.h5"));
+  EXPECT_NE(r.output.find("draws independent"), std::string::npos) << r.output;
+  // Independent draws: stochastic kriging, the mean's interval, and the patch scatter served beside it.
+  r = run("train --data " + path("all.h5") + " --out " + path("gp.h5") + " --restarts 1");
   EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("stochastic kriging: 6 samples of independent draws"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("interval: std = sqrt(model variance): where the micro-model's mu averaged over all draws"),
+            std::string::npos) << r.output;
+  r = run("predict --model " + path("gp.h5") + " --p 700MPa --v 100m/min --T 500C");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("patch scatter "), std::string::npos) << r.output;
+  r = run("describe " + path("gp.h5"));
+  EXPECT_NE(r.output.find("patch scatter: a GP of the log per-draw variance"), std::string::npos) << r.output;
+  // The same data trained as common draws (as every dataset from before issue 33 is): one GP, the
+  // samples' scatter added to the interval, no patch scatter.
+  r = run("train --data " + path("all.h5") + " --out " + path("gp-common.h5") + " --restarts 1 --no-stochastic-kriging");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("only a dataset of independent draws"), std::string::npos) << r.output;
+  r = run("predict --model " + path("gp-common.h5") + " --p 700MPa --v 100m/min --T 500C");
+  EXPECT_EQ(r.output.find("patch scatter"), std::string::npos) << r.output;
   // A database of this plan refuses another scene.
   r = run("dataset run --plan " + path("plan.h5") + " --db " + path("s0.h5") + " --shard 0/2 --set load.ramp=2ns");
   EXPECT_NE(r.exit_code, 0);

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The production campaign behind the shipped default model (issue 33): the default dry scene
+# (micro/scene/dry_default.json, 64 x 12, 4 draws of tool and chip surfaces per sample) over the box
+# real meso codes ask for, each plan row its own surfaces (independent draws). The box: seed 000's
+# grown to p 300 MPa-3.1 GPa, v 1-2000 m/min, T 25-900 C, where every corner converges at this mesh
+# (bench/RESULTS.md, "The production campaign"). Resumable: run it again after a stop; the database
+# is rewritten after every sample. Never part of CI.
+#   nohup bash campaigns/dry_default/run.sh > campaign.log 2>&1 &       # one core, one free for builds
+#   JOBS=2 bash campaigns/dry_default/run.sh                              # both cores
+# Then: mufric train --data campaigns/dry_default/db.h5 --out models/dry_default.h5
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+mufric=${MUFRIC:-$here/../../build/app/mufric}
+jobs=${JOBS:-1}
+plan=$here/plan.h5
+db=$here/db.h5
+if [[ ! -f $plan ]]; then
+  "$mufric" dataset plan --out "$plan" --samples 256 --design sobol --seed 1 \
+    --p 300MPa:3100MPa --v 1m/min:2000m/min --T 25C:900C
+fi
+# One thread per sample: the draws of a sample run one after the other, samples side by side.
+OMP_NUM_THREADS=1 exec "$mufric" dataset run --plan "$plan" --db "$db" --jobs "$jobs" --threads 1 --sample-timeout 900
