@@ -176,9 +176,18 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
     std::printf("mu = %.5f  (seed 000 protocol: one draw, eq. 17 time-averaged over [%.1f, %.1f] ns, %d steps; no "
                 "error bar)\n", m.mu, sc.average_from * 1e9, sc.duration * 1e9, r.averaged_steps);
   } else if (m.completed) {
-    std::printf("mu = %.5f +- %.5f (standard error, %s)  press-slide protocol: mean of %s (%s x %s), each pressed %.0f + %.0f ns, then averaged over %.3f um of sliding after a %.3f um "
+    // One draw has no standard error: saying +- 0 would claim an exact μ.
+    const std::string error_bar =
+        m.std_error ? [&] {
+          char text[96];
+          std::snprintf(text, sizeof text, "+- %.5f (standard error, %s)", *m.std_error,
+                        relative_percent(*m.std_error, m.mu).c_str());
+          return std::string(text);
+        }()
+                    : std::string("(one draw: no standard error; protocol.realisations >= 2 gives one)");
+    std::printf("mu = %.5f %s  press-slide protocol: mean of %s (%s x %s), each pressed %.0f + %.0f ns, then averaged over %.3f um of sliding after a %.3f um "
                 "run-in; largest drift over a window %s\n",
-                m.mu, m.std_error.value_or(0.0), relative_percent(m.std_error.value_or(0.0), m.mu).c_str(),
+                m.mu, error_bar.c_str(),
                 count_of(static_cast<long long>(m.draws.size()), "draw", "draws").c_str(),
                 count_of(q.phases, "tool phase", "tool phases").c_str(),
                 count_of(q.realisations, "realisation", "realisations").c_str(), sc.ramp * 1e9, q.press_hold * 1e9, q.window * 1e6, q.run_in * 1e6,
