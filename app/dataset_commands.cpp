@@ -213,6 +213,13 @@ void refine_command(const RefineCommandOptions& c) {
     std::fflush(stdout);
   };
   o.on_pick = [](const RefinePick& k) {
+    if (k.imse_reduction > 0.0) {  // independent draws: picked by the integrated variance it removes
+      const std::string what = k.replicates_row >= 0 ? "more draws at plan row " + std::to_string(k.replicates_row) + "'s point"
+                                                     : std::string("a new point");
+      std::printf("  pick %zu: plan row %lld, %s, std of the mean there %.4f, removes %.3g of the mean variance over "
+                  "the box\n", k.number, k.plan_row, what.c_str(), k.std_at_pick, k.imse_reduction);
+      return;
+    }
     std::printf("  pick %zu: plan row %lld, predicted std %.4f\n", k.number, k.plan_row, k.std_at_pick);
   };
   o.on_sample = [](const GenerationProgress& p, const InputSpace& inputs, const Eigen::VectorXd& x) {
@@ -375,7 +382,11 @@ void add_dataset_commands(CLI::App& app) {
   refine->add_option("--seed", f->refine.seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
   refine->footer("Each round trains a GP on the converged samples, picks --batch candidates by the largest posterior\n"
                  "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"
-                 "scene, and reports the leave-one-out error (and the held-out error with --test).");
+                 "scene, and reports the leave-one-out error (and the held-out error with --test).\n"
+                 "A database of independent draws (dataset plan's default) is trained by stochastic kriging, and each\n"
+                 "pick is the candidate that removes the most variance of the mean over the box (IMSE): a new point,\n"
+                 "or more draws at a point already run (a new plan row there, with its own surfaces), whichever the\n"
+                 "patch scatter there and the data around it make worth more.");
   refine->callback([f] { refine_command(*f); });
 
   auto s = std::make_shared<std::string>();

@@ -12,6 +12,7 @@
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 #include "surrogate/sampling.hpp"
+#include "surrogate/stochastic_kriging.hpp"
 
 namespace mufric {
 namespace {
@@ -94,6 +95,41 @@ Eigen::MatrixXd unconverged_points(const Dataset& db) {
   return failed;
 }
 
+// The converged samples' points, each once, with the plan row of its first sample: the candidates
+// for more draws at a point already run.
+struct ReplicationCandidates {
+  Eigen::MatrixXd points;
+  std::vector<long long> plan_rows;
+};
+ReplicationCandidates converged_design_points(const Dataset& db) {
+  ReplicationCandidates r;
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    if (!db.converged(i)) continue;
+    bool seen = false;
+    for (const Eigen::Index k : rows) seen = seen || db.x.row(k) == db.x.row(i);
+    if (!seen) rows.push_back(i);
+  }
+  r.points.resize(static_cast<Eigen::Index>(rows.size()), db.x.cols());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    r.points.row(static_cast<Eigen::Index>(k)) = db.x.row(rows[k]);
+    r.plan_rows.push_back(db.plan_index[static_cast<size_t>(rows[k])]);
+  }
+  return r;
+}
+
+// The draws one new sample makes: the training samples' median count.
+double draws_per_sample(const TrainingSet& data) {
+  std::vector<double> counts;
+  for (Eigen::Index i = 0; i < data.draw_mu.rows(); ++i) counts.push_back(static_cast<double>(data.draw_mu.row(i).array().isFinite().count()));
+  if (counts.empty()) return 1.0;
+  std::nth_element(counts.begin(), counts.begin() + static_cast<std::ptrdiff_t>(counts.size() / 2), counts.end());
+  return std::max(counts[counts.size() / 2], 1.0);
+}
+
+// The reference set of a round is another Sobol' shift than its candidates'.
+constexpr unsigned long long kReferenceSeedOffset = 0x5eedULL;
+
 }  // namespace
 
 RefineReport refine_dataset(const RefineOptions& o) {
@@ -115,7 +151,8 @@ RefineReport refine_dataset(const RefineOptions& o) {
   RefineReport report;
   for (int round = 1;; ++round) {
     const TrainingSet data = training_set(db, o.db);
-    const GaussianProcess gp = train_gaussian_process(data, training);
+    const bool kriging = suits_stochastic_kriging(data);
+    const GaussianProcess gp = kriging ? train_stochastic_kriging(data, training) : train_gaussian_process(data, training);
     if (o.on_round) {
       const auto& sum = gp.state().summary;
       RefineRound r;
@@ -134,14 +171,43 @@ RefineReport refine_dataset(const RefineOptions& o) {
     if (!o.model_out.empty()) save_model(o.model_out, gp);
     if (report.spent >= o.budget) break;
     const int batch = static_cast<int>(std::min<long long>(o.batch, o.budget - report.spent));
-    const Eigen::MatrixXd candidates = refine_candidates(o, db.inputs, round);
-    const auto picks = pick_by_posterior_variance(gp, candidates, batch, unconverged_points(db));
-    // The picks become plan rows, so the database accounts for them like any planned point.
+    const Eigen::MatrixXd sobol = refine_candidates(o, db.inputs, round);
+    std::vector<RefinePick> chosen;
+    Eigen::MatrixXd candidates;
+    if (kriging && gp.has_patch_scatter()) {
+      const ReplicationCandidates replicates = converged_design_points(db);
+      candidates.resize(sobol.rows() + replicates.points.rows(), sobol.cols());
+      candidates << sobol, replicates.points;
+      // One sample's noise at a candidate: the patch scatter there over the draws a sample makes.
+      const Eigen::VectorXd noise = gp.patch_std(candidates).array().square() / draws_per_sample(data);
+      const Eigen::MatrixXd reference =
+          plan_in_box(PlanDesign::sobol, o.reference_count, db.inputs, o.seed + kReferenceSeedOffset + static_cast<unsigned long long>(round));
+      for (const auto& p : pick_by_imse_reduction(gp, candidates, noise, reference, batch, unconverged_points(db))) {
+        RefinePick pick;
+        pick.std_at_pick = p.std_at_pick;
+        pick.imse_reduction = p.imse_reduction;
+        pick.plan_row = p.candidate;  // the candidate's row until it becomes a plan row below
+        if (p.candidate >= sobol.rows()) pick.replicates_row = replicates.plan_rows[static_cast<size_t>(p.candidate - sobol.rows())];
+        chosen.push_back(pick);
+      }
+    } else {
+      candidates = sobol;
+      for (const auto& p : pick_by_posterior_variance(gp, candidates, batch, unconverged_points(db))) {
+        RefinePick pick;
+        pick.std_at_pick = p.std_at_pick;
+        pick.plan_row = p.candidate;
+        chosen.push_back(pick);
+      }
+    }
+    // The picks become plan rows, so the database accounts for them like any planned point; a
+    // replicate is a new row at an existing row's point, with its own draws.
     const Eigen::Index first = db.plan.rows();
-    db.plan.conservativeResize(first + static_cast<Eigen::Index>(picks.size()), Eigen::NoChange);
-    for (size_t k = 0; k < picks.size(); ++k) {
-      db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(picks[k].candidate);
-      if (o.on_pick) o.on_pick({k + 1, static_cast<long long>(first) + static_cast<long long>(k), picks[k].std_at_pick});
+    db.plan.conservativeResize(first + static_cast<Eigen::Index>(chosen.size()), Eigen::NoChange);
+    for (size_t k = 0; k < chosen.size(); ++k) {
+      db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(chosen[k].plan_row);
+      chosen[k].number = k + 1;
+      chosen[k].plan_row = static_cast<long long>(first) + static_cast<long long>(k);
+      if (o.on_pick) o.on_pick(chosen[k]);
     }
     if (db.plan_design.find("active") == std::string::npos) {
       db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";

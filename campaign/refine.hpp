@@ -1,7 +1,9 @@
 #pragma once
 // Active learning on a plan-based database (`mufric dataset refine`): each round trains a GP on the
 // converged samples, picks a batch of candidates by the largest posterior variance (each pick
-// conditioning the next, away from failed points), appends them to the plan, runs them through
+// conditioning the next, away from failed points) — or, for a database of independent draws, trains
+// by stochastic kriging and picks by the integrated variance of the mean each pick removes, among new
+// points and more draws at the existing ones (replicates; surrogate/active_learning.hpp) — appends them to the plan, runs them through
 // generate_dataset and reads the database back, until the budget of runs is spent or nothing new
 // could be run. Candidates are a Sobol' set in the plan box (shifted per round) plus the rows of a
 // CSV (e.g. the server's --log-uncertain file) inside the box; with `grow` the box first grows toward
@@ -41,6 +43,10 @@ struct RefinePick {
   std::size_t number = 0;  // from 1 within the round
   long long plan_row = 0;  // the plan row it became
   double std_at_pick = 0.0;
+  // Independent draws: the mean posterior variance over the box the pick removes (μ units²), and
+  // the plan row whose point it repeats with new draws (−1: a new point).
+  double imse_reduction = 0.0;
+  long long replicates_row = -1;
 };
 
 struct RefineOptions {
@@ -53,6 +59,7 @@ struct RefineOptions {
   long long budget = 0;        // runs to spend
   int batch = 8, jobs = 1, restarts = 2;
   long long candidate_count = 4096;  // Sobol' candidates per round
+  long long reference_count = 512;   // Sobol' points over which the integrated variance is averaged
   unsigned long long seed = 1;       // of the candidate sets and GP restarts
   // The evaluator of the samples, made once after the box growth from the database as it then is
   // (the mufric executable: the micro-model with the database's scene). Required.

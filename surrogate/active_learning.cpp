@@ -60,4 +60,63 @@ std::vector<VariancePick> pick_by_posterior_variance(const GaussianProcess& gp, 
   return picks;
 }
 
+std::vector<ImsePick> pick_by_imse_reduction(const GaussianProcess& gp, const Eigen::MatrixXd& given,
+                                             const Eigen::VectorXd& candidate_noise, const Eigen::MatrixXd& reference,
+                                             int batch, const Eigen::MatrixXd& tried) {
+  const auto& s = gp.state();
+  const auto d = static_cast<Eigen::Index>(s.inputs.size());
+  if (given.cols() != d || reference.cols() != d || (tried.size() > 0 && tried.cols() != d)) {
+    throw Error("active learning: candidates, reference or tried points have the wrong number of inputs (the model has " +
+                std::to_string(d) + ")");
+  }
+  if (candidate_noise.size() != given.rows() || !(candidate_noise.array() >= 0.0).all()) {
+    throw Error("active learning: one noise variance >= 0 per candidate");
+  }
+  if (reference.rows() == 0) throw Error("active learning: no reference points");
+  // Columns: the reference points, the candidates, the tried points. Σ(ref, cand) is kept whole and
+  // updated by the rank-one term of each point conditioned on; a conditioned point's whole column is
+  // formed on demand from V = L⁻¹ K(X, ·) and the earlier updates.
+  const Eigen::Index m_ref = reference.rows(), m_cand = given.rows();
+  Eigen::MatrixXd points(m_ref + m_cand + tried.rows(), d);
+  points << reference, given, tried;
+  const Eigen::MatrixXd xp = to_unit_box(points, s.inputs), xt = to_unit_box(s.x_train, s.inputs);
+  const Eigen::MatrixXd v = s.cholesky.triangularView<Eigen::Lower>().solve(rbf(xt, xp, s.hyper));
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(points.rows(), s.hyper.signal_variance) - v.colwise().squaredNorm().transpose();
+  Eigen::MatrixXd cross = rbf(xp.topRows(m_ref), xp.middleRows(m_ref, m_cand), s.hyper);
+  cross.noalias() -= v.leftCols(m_ref).transpose() * v.middleCols(m_ref, m_cand);
+  std::vector<Eigen::VectorXd> updates;  // Σ(·, k) / √(Σ(k, k) + τ²_k) of each point conditioned on
+  const auto condition_on = [&](Eigen::Index j, double noise) {
+    Eigen::VectorXd c = rbf(xp, xp.row(j), s.hyper) - v.transpose() * v.col(j);
+    for (const auto& u : updates) c -= u * u(j);
+    updates.push_back(c / std::sqrt(std::max(c(j) + noise, 1e-300)));
+    const Eigen::VectorXd& u = updates.back();
+    diagonal -= u.cwiseAbs2();
+    cross.noalias() -= u.head(m_ref) * u.segment(m_ref, m_cand).transpose();
+  };
+  const double scale2 = s.y_scale * s.y_scale;
+  const double tried_noise = s.hyper.noise_variance + s.jitter;
+  for (Eigen::Index t = 0; t < tried.rows(); ++t) condition_on(m_ref + m_cand + t, std::max(tried_noise, 1e-12));
+  std::vector<ImsePick> picks;
+  std::vector<bool> taken(static_cast<size_t>(m_cand), false);
+  for (int b = 0; b < batch && static_cast<Eigen::Index>(picks.size()) < m_cand; ++b) {
+    const Eigen::RowVectorXd removed = cross.colwise().squaredNorm();
+    Eigen::Index best = -1;
+    double best_gain = -1.0;
+    for (Eigen::Index i = 0; i < m_cand; ++i) {
+      if (taken[static_cast<size_t>(i)]) continue;
+      const double gain = removed(i) / (std::max(diagonal(m_ref + i), 0.0) + candidate_noise(i) / scale2) /
+                          static_cast<double>(m_ref);
+      if (gain > best_gain) {
+        best_gain = gain;
+        best = i;
+      }
+    }
+    if (best < 0) break;
+    taken[static_cast<size_t>(best)] = true;
+    picks.push_back({best, best_gain * scale2, s.y_scale * std::sqrt(std::max(diagonal(m_ref + best), 0.0))});
+    condition_on(m_ref + best, candidate_noise(best) / scale2);
+  }
+  return picks;
+}
+
 }  // namespace mufric

@@ -24,4 +24,23 @@ struct VariancePick {
 std::vector<VariancePick> pick_by_posterior_variance(const GaussianProcess& gp, const Eigen::MatrixXd& candidates,
                                                      int batch, const Eigen::MatrixXd& tried = {});
 
+// For stochastic simulators (a GP of the mean over draws, its samples' noise on the diagonal): greedy
+// picks by the integrated variance of the mean each would remove, IMSE reduction (Ankenman, Nelson &
+// Staum 2010, §5; Binois, Huang, Gramacy & Ludkovski 2019, Technometrics 61(1):7, "replication or
+// exploration"). A candidate c observed with noise τ²_c removes, from the posterior variance at every
+// reference point r, Σ(r, c)² / (Σ(c, c) + τ²_c) (R&W eq. 2.24 for one point), averaged over the
+// reference points (a uniform set in the box: the integral over it). A candidate at an existing design
+// point is a replicate (more draws there); elsewhere, a new point: the same formula chooses between
+// them. Each pick conditions the next.
+struct ImsePick {
+  Eigen::Index candidate = 0;   // row of the candidate matrix
+  double imse_reduction = 0.0;  // μ units², the mean posterior variance removed over the reference set
+  double std_at_pick = 0.0;     // posterior std of the mean there, given the earlier picks
+};
+// candidate_noise: τ²_c of one sample at each candidate, μ units² (its per-draw variance / draws).
+// reference: SI points spanning the box. tried: as for pick_by_posterior_variance.
+std::vector<ImsePick> pick_by_imse_reduction(const GaussianProcess& gp, const Eigen::MatrixXd& candidates,
+                                             const Eigen::VectorXd& candidate_noise, const Eigen::MatrixXd& reference,
+                                             int batch, const Eigen::MatrixXd& tried = {});
+
 }  // namespace mufric

@@ -89,5 +89,87 @@ TEST(ActiveLearning, FailedRunsAreConditionedOnAndNeverPicked) {
   expect_brute_force_picks(gp, candidates, picks, tried);
 }
 
+// Posterior variance with a per-point noise vector (normalised units, without noise at q).
+double brute_force_variance(const Eigen::MatrixXd& x, const Eigen::RowVectorXd& q, const GpHyperParameters& h,
+                            const Eigen::VectorXd& noise) {
+  const Eigen::Index n = x.rows();
+  Eigen::MatrixXd k(n, n);
+  Eigen::VectorXd kq(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    kq(i) = kernel(x.row(i), q, h);
+    for (Eigen::Index j = 0; j < n; ++j) k(i, j) = kernel(x.row(i), x.row(j), h) + (i == j ? noise(i) : 0.0);
+  }
+  return kernel(q, q, h) - kq.dot(k.fullPivLu().solve(kq));
+}
+
+// The IMSE reduction of each pick against brute force: the mean posterior variance over the
+// reference points with the earlier picks, less that with this pick too (dense LU with the picks
+// appended as noisy observations); each pick the brute-force argmax over the candidates. A GP with
+// known per-sample noise (stochastic kriging), candidates of very different noise, two of them at
+// training points (replicates).
+TEST(ActiveLearning, ImseReductionMatchesBruteForceAndPicksItsArgmax) {
+  TrainingSet t = test::smooth_training_set(30, 4);
+  t.mu_std.resize(30);
+  for (Eigen::Index i = 0; i < 30; ++i) t.mu_std(i) = 0.002 + 0.004 * static_cast<double>(i % 5);
+  GpTrainingOptions o;
+  o.optimise = false;
+  o.sample_noise = true;
+  o.interval_of_mean = true;
+  o.initial.signal_variance = 1.5;
+  o.initial.length_scales = Eigen::Vector3d(0.4, 0.6, 0.5);
+  o.initial.noise_variance = 1e-4;
+  const GaussianProcess gp = train_gaussian_process(t, o);
+  const auto& s = gp.state();
+  Eigen::MatrixXd candidates = plan_in_box(PlanDesign::sobol, 40, s.inputs, 3);
+  candidates.row(0) = s.x_train.row(2);  // replicates
+  candidates.row(1) = s.x_train.row(7);
+  Eigen::VectorXd noise(40);
+  for (Eigen::Index i = 0; i < 40; ++i) noise(i) = std::pow(0.001 + 0.01 * static_cast<double>(i % 4), 2);
+  const Eigen::MatrixXd reference = plan_in_box(PlanDesign::sobol, 64, s.inputs, 9);
+  const auto picks = pick_by_imse_reduction(gp, candidates, noise, reference, 4);
+  ASSERT_EQ(picks.size(), 4u);
+
+  // The training rows in the unit box with their total diagonal noise, normalised.
+  Eigen::MatrixXd x = to_unit_box(s.x_train, s.inputs);
+  Eigen::VectorXd diagonal = s.known_noise.array() + s.hyper.noise_variance + s.jitter;
+  const double scale2 = s.y_scale * s.y_scale;
+  auto mean_variance = [&](const Eigen::MatrixXd& rows, const Eigen::VectorXd& d) {
+    double sum = 0.0;
+    for (Eigen::Index r = 0; r < reference.rows(); ++r) {
+      sum += brute_force_variance(rows, unit_row(s.inputs, reference.row(r)), s.hyper, d);
+    }
+    return sum / static_cast<double>(reference.rows());
+  };
+  auto with = [](const Eigen::MatrixXd& rows, const Eigen::RowVectorXd& row) {
+    Eigen::MatrixXd out(rows.rows() + 1, rows.cols());
+    out << rows, row;
+    return out;
+  };
+  auto with_value = [](const Eigen::VectorXd& v, double value) {
+    Eigen::VectorXd out(v.size() + 1);
+    out << v, value;
+    return out;
+  };
+  std::vector<bool> taken(40, false);
+  for (const auto& pick : picks) {
+    const double before = mean_variance(x, diagonal);
+    double best = -1.0;
+    Eigen::Index argmax = -1;
+    for (Eigen::Index c = 0; c < 40; ++c) {
+      if (taken[static_cast<size_t>(c)]) continue;
+      const double gain = before - mean_variance(with(x, unit_row(s.inputs, candidates.row(c))), with_value(diagonal, noise(c) / scale2));
+      if (gain > best) {
+        best = gain;
+        argmax = c;
+      }
+    }
+    EXPECT_EQ(pick.candidate, argmax);
+    EXPECT_NEAR(pick.imse_reduction, best * scale2, 1e-8 * best * scale2);
+    taken[static_cast<size_t>(pick.candidate)] = true;
+    x = with(x, unit_row(s.inputs, candidates.row(pick.candidate)));
+    diagonal = with_value(diagonal, noise(pick.candidate) / scale2);
+  }
+}
+
 }  // namespace
 }  // namespace mufric

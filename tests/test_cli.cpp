@@ -732,6 +732,8 @@ TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
   EXPECT_NE(r.output.find("round 3: "), std::string::npos) << r.output;  // 2 + 1 runs, a GP after each round
   EXPECT_NE(r.output.find("3 micro-model runs spent of a budget of 3"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("pick 2: plan row 7"), std::string::npos) << r.output;  // picks extend the plan
+  // Independent draws: picked by the variance of the mean each removes over the box.
+  EXPECT_NE(r.output.find("of the mean variance over the box"), std::string::npos) << r.output;
   r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
   EXPECT_NE(r.output.find(": 1 file, "), std::string::npos) << r.output;  // not "1 files" (issue 30)
   EXPECT_NE(r.output.find("-> 9 samples"), std::string::npos) << r.output;

@@ -4,9 +4,11 @@
 
 #include <atomic>
 #include <filesystem>
+#include <random>
 #include <set>
 
 #include "campaign/dataset_generation.hpp"
+#include "campaign/refine.hpp"
 #include "common/error.hpp"
 
 namespace mufric {
@@ -310,6 +312,56 @@ TEST(DatasetGeneration, IndependentDrawsGiveEachRowItsOwnReproducibleSeeds) {
   EXPECT_EQ(c.draws, DrawDesign::common);
   for (long long seed : c.tool_seed) EXPECT_EQ(seed, -1);
   EXPECT_EQ(c.draw_mu.cols(), 0);
+}
+
+// dataset refine on independent draws: stochastic kriging, picks by IMSE among new points and more
+// draws at existing ones. With one Sobol' candidate per round, a batch of three must repeat existing
+// points: each repeat is a new plan row at that row's point, run with its own seeds.
+TEST(DatasetGeneration, RefineOnIndependentDrawsRepeatsPointsWithNewDraws) {
+  Dataset plan = small_plan(12);
+  for (Eigen::Index i = 0; i < 12; ++i) {
+    plan.plan.row(i) << 300e6 + 1e9 * static_cast<double>(i % 4) / 3.0, 0.5 + 2.0 * static_cast<double>((i / 4) % 3) / 2.0, 400.0 + 40.0 * static_cast<double>(i % 3);
+  }
+  plan.draws = DrawDesign::independent;
+  plan.plan_seed = 5;
+  const std::string db = temp_path("refine.h5");
+  std::filesystem::remove(db);
+  // Four draws whose scatter (0.02) dwarfs the trend: repeats are worth as much as new points.
+  const SampleEvaluator noisy = [](const SampleRequest& r) {
+    SampleOutcome o;
+    o.converged = true;
+    std::mt19937_64 rng(r.seeds->tool ^ (r.seeds->chip << 1));
+    std::normal_distribution<double> normal(0.0, 0.02);
+    for (int k = 0; k < 4; ++k) o.draw_mu.push_back(exact_mu(r.x) + normal(rng));
+    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2] + o.draw_mu[3]) / 4.0;
+    return o;
+  };
+  generate_dataset(plan, db, noisy, {});
+  RefineOptions o;
+  o.db = db;
+  o.budget = 3;
+  o.batch = 3;
+  o.restarts = 0;
+  o.candidate_count = 1;
+  o.make_evaluator = [&](const Dataset&) { return noisy; };
+  std::vector<RefinePick> picks;
+  o.on_pick = [&](const RefinePick& p) { picks.push_back(p); };
+  EXPECT_EQ(refine_dataset(o).spent, 3);
+  ASSERT_EQ(picks.size(), 3u);
+  const Dataset d = read_dataset(db);
+  long long repeats = 0;
+  for (const RefinePick& p : picks) {
+    EXPECT_GT(p.imse_reduction, 0.0);
+    if (p.replicates_row < 0) continue;
+    ++repeats;
+    EXPECT_EQ(d.plan.row(p.plan_row), d.plan.row(p.replicates_row));
+    const DrawSeeds original = row_draw_seeds(5, p.replicates_row), repeat = row_draw_seeds(5, p.plan_row);
+    EXPECT_NE(original.tool, repeat.tool);
+    EXPECT_NE(original.chip, repeat.chip);
+  }
+  EXPECT_GE(repeats, 2);  // at most one new point was on offer
+  EXPECT_EQ(d.size(), 15);
+  EXPECT_EQ(d.draws, DrawDesign::independent);
 }
 
 // A run that completes with a warning (a molten chip) is kept with its μ and standard error, as
