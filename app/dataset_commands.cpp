@@ -274,6 +274,28 @@ void status_command(const std::string& path) {
     }
     std::printf("  mu: %.5f .. %.5f; %lld of %lld converged samples carry their standard error\n", lo, hi, with_std, converged);
   }
+  if (d.draw_mu.cols() > 0 && converged > 0) {
+    // The per-draw spread (the patch scatter a model trained on these data will serve), from the
+    // converged samples' own draws.
+    std::vector<double> spreads;
+    long long draws = 0;
+    for (Eigen::Index i = 0; i < d.size(); ++i) {
+      if (!d.converged(i)) continue;
+      const Eigen::ArrayXd row = d.draw_mu.row(i).transpose().array();
+      const Eigen::Index r = row.isFinite().count();
+      draws += r;
+      if (r < 2) continue;
+      const double mean = row.isFinite().select(row, 0.0).sum() / static_cast<double>(r);
+      const double squares = row.isFinite().select((row - mean).square(), 0.0).sum();
+      spreads.push_back(std::sqrt(squares / static_cast<double>(r - 1)) / std::max(std::abs(mean), 1e-300));
+    }
+    std::printf("  draws: %lld in %lld converged samples", draws, converged);
+    if (!spreads.empty()) {
+      std::nth_element(spreads.begin(), spreads.begin() + static_cast<std::ptrdiff_t>(spreads.size() / 2), spreads.end());
+      std::printf("; per-draw standard deviation of mu, median over the samples %.1f %% of their mu", 100.0 * spreads[spreads.size() / 2]);
+    }
+    std::printf("\n");
+  }
   if (!d.note.empty()) std::printf("  note: %s\n", d.note.c_str());
   if (const auto it = d.diagnostics.find("wall_seconds"); it != d.diagnostics.end() && d.size() > 0) {
     const double total = it->second.array().isNaN().select(0.0, it->second.array()).sum();
@@ -324,7 +346,7 @@ void add_dataset_commands(CLI::App& app) {
   plan->add_flag("--common-tools", p->common_tools,
                  "Every row on the scene's own tool and chip surfaces (common random numbers), as before issue 33: "
                  "for a trend or a difference between scenes, where shared surfaces cancel. Default: every row its "
-                 "own surfaces, drawn from seeds derived from --seed and the row, so that their error averages out "
+                 "own surfaces, drawn from seeds derived from --seed and the row, so that their scatter averages out "
                  "over the campaign and the model's interval shrinks with it");
   plan->footer("Every planned point is kept in the file, so a database made from it accounts for each one.");
   plan->callback([p] { plan_command(*p); });

@@ -77,6 +77,7 @@ Dataset empty_dataset(const Dataset& plan) {
   d.source = plan.source;
   d.scene_json = plan.scene_json;
   d.code_version = code_version();
+  d.created_utc = utc_timestamp();  // once: every later write keeps it
   return d;
 }
 

@@ -687,6 +687,8 @@ TEST_F(Cli, DryAndLubricatedModelsAreServedSideBySide) {
     EXPECT_NE(r.output.find("physics " + physics + ")"), std::string::npos) << r.output;
     r = run("train --data " + path(physics + ".h5") + " --out " + path("models/" + physics + ".h5"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
+    // Common draws: the model says its interval keeps the shared scatter.
+    EXPECT_NE(r.output.find("only a dataset of independent draws"), std::string::npos) << r.output;
   }
   ServeProcess server(path("models"), path("serve.log"), path("address"));
   ASSERT_FALSE(server.address().empty()) << "server did not start";

@@ -95,8 +95,11 @@ TEST(StochasticKriging, AKnownDiagonalGivesTheDensePosterior) {
 }
 
 // A heteroscedastic stochastic simulator with a known mean and a known per-draw spread.
-double true_mean(const Eigen::RowVectorXd& x) { return 0.2 + 0.04 * std::sin(3.0 * x(0)) - 0.03 * x(2); }
-double true_spread(const Eigen::RowVectorXd& x) { return 0.01 + 0.04 * x(0); }
+// Of a point's row i of a matrix of points (unit cube).
+double true_mean(const Eigen::MatrixXd& points, Eigen::Index i) {
+  return 0.2 + 0.04 * std::sin(3.0 * points(i, 0)) - 0.03 * points(i, 2);
+}
+double true_spread(const Eigen::MatrixXd& points, Eigen::Index i) { return 0.01 + 0.04 * points(i, 0); }
 constexpr double kConstantSpread = 0.03;
 
 TrainingSet independent_draws(Eigen::Index samples, int draws, std::uint64_t seed, bool heteroscedastic = true) {
@@ -112,8 +115,8 @@ TrainingSet independent_draws(Eigen::Index samples, int draws, std::uint64_t see
   t.draw_mu.resize(samples, draws);
   for (Eigen::Index i = 0; i < samples; ++i) {
     for (Eigen::Index j = 0; j < 3; ++j) t.x(i, j) = unit(rng);
-    const double spread = heteroscedastic ? true_spread(t.x.row(i)) : kConstantSpread;
-    for (int k = 0; k < draws; ++k) t.draw_mu(i, k) = true_mean(t.x.row(i)) + spread * normal(rng);
+    const double spread = heteroscedastic ? true_spread(t.x, i) : kConstantSpread;
+    for (int k = 0; k < draws; ++k) t.draw_mu(i, k) = true_mean(t.x, i) + spread * normal(rng);
     t.mu(i) = t.draw_mu.row(i).mean();
     const double variance = (t.draw_mu.row(i).array() - t.mu(i)).square().sum() / (draws - 1);
     t.mu_std(i) = std::sqrt(variance / draws);
@@ -149,11 +152,11 @@ TEST(StochasticKriging, LearnsTheMeanAndThePatchScatterOfIndependentDraws) {
   const Eigen::VectorXd patch = gp_large.patch_std(q);
   double patch_log_error = 0.0;
   for (Eigen::Index i = 0; i < kQueries; ++i) {
-    const double truth = true_mean(q.row(i));
+    const double truth = true_mean(q, i);
     covered += truth >= e.lo(i) && truth <= e.hi(i);
     width_small += small_e.hi(i) - small_e.lo(i);
     width_large += e.hi(i) - e.lo(i);
-    patch_log_error += std::abs(std::log(patch(i) / true_spread(q.row(i))));
+    patch_log_error += std::abs(std::log(patch(i) / true_spread(q, i)));
   }
   // The interval is the mean's: it covers the true mean (not the draws) at about its level...
   EXPECT_GE(covered, static_cast<long long>(0.85 * kQueries)) << covered;
@@ -175,6 +178,20 @@ TEST(StochasticKriging, LearnsTheMeanAndThePatchScatterOfIndependentDraws) {
   EXPECT_EQ(again.hi, e.hi);
   EXPECT_EQ(back->patch_std(q), patch);
   std::filesystem::remove(path);
+}
+
+// Only a dataset of independent draws with per-draw μ is trained by stochastic kriging: a file from
+// before draws were recorded (unknown), or of common draws, is trained as before.
+TEST(StochasticKriging, OnlyIndependentDrawsWithTheirMuSuitIt) {
+  TrainingSet t = independent_draws(10, 4, 5);
+  EXPECT_TRUE(suits_stochastic_kriging(t));
+  t.draws = DrawDesign::common;
+  EXPECT_FALSE(suits_stochastic_kriging(t));
+  t.draws = DrawDesign::unknown;
+  EXPECT_FALSE(suits_stochastic_kriging(t));
+  t.draws = DrawDesign::independent;
+  t.draw_mu.resize(10, 0);
+  EXPECT_FALSE(suits_stochastic_kriging(t));
 }
 
 TEST(StochasticKriging, RefusesSamplesWithoutDraws) {
@@ -217,7 +234,7 @@ TEST(StochasticKriging, OneDrawPerSampleServesTheMeanWithoutAPatchScatter) {
   what.mu_tolerance = 0.0;
   const Evaluation e = gp.evaluate(q, what);
   long long covered = 0;
-  for (Eigen::Index i = 0; i < q.rows(); ++i) covered += true_mean(q.row(i)) >= e.lo(i) && true_mean(q.row(i)) <= e.hi(i);
+  for (Eigen::Index i = 0; i < q.rows(); ++i) covered += true_mean(q, i) >= e.lo(i) && true_mean(q, i) <= e.hi(i);
   EXPECT_GE(covered, 170) << covered;
   std::vector<double> stds(e.std.data(), e.std.data() + e.std.size());
   std::nth_element(stds.begin(), stds.begin() + 100, stds.end());
