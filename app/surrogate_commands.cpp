@@ -271,6 +271,7 @@ void add_train(CLI::App& app) {
                     "(%.1f %% of mean mu); a sample's mean's smoothed standard error, median %.4g\n",
                     sk.scatter_samples, sk.draws, sk.median_patch_std,
                     100.0 * sk.median_patch_std / std::max(std::abs(data.mu.mean()), 1e-300), sk.median_sample_std_error);
+        for (const auto& w : sk.scatter.warnings) std::printf("warning (patch scatter): %s\n", w.c_str());
       }
     } else {
       if (data.draws == DrawDesign::independent && !o->no_stochastic_kriging) {

@@ -443,7 +443,9 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
   const InputSpace inputs_of_model = s.inputs;
   GaussianProcess gp(std::move(s));
   if (in.has(fast_group)) gp.attach_fast_evaluator(read_fast_evaluator(in, gp, fast_group));
-  if (in.has(group + "/patch_scatter")) {
+  // Only the model's own GP has a patch scatter (a scatter of the scatter is not a thing, and a file
+  // nesting them deeply would recurse here).
+  if (group == "/gp" && in.has(group + "/patch_scatter")) {
     gp.attach_patch_scatter(std::make_shared<const GaussianProcess>(read_group(in, inputs_of_model, group + "/patch_scatter")));
   }
   return gp;
