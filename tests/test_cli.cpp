@@ -168,7 +168,7 @@ TEST_F(Cli, LawPredictTrainEvalChain) {
   EXPECT_NE(r.output.find("mu = 0.221001"), std::string::npos) << r.output;
   ASSERT_EQ(run("dataset from-model --model " + path("law.h5") + " --samples 120 --out " + path("db.h5")).exit_code, 0);
   ASSERT_EQ(run("dataset from-model --model " + path("law.h5") + " --samples 50 --seed 5 --out " + path("t.h5")).exit_code, 0);
-  r = run("train --data " + path("db.h5") + " --out " + path("gp.h5") + " --restarts 1");
+  r = run("train --data " + path("db.h5") + " --out " + path("gp.h5") + " --restarts 1 --fast-max-seconds 300");  // a sanitizer build is several times slower than the default budget assumes
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("log marginal likelihood"), std::string::npos);
   EXPECT_NE(r.output.find("leave-one-out"), std::string::npos);
@@ -191,7 +191,7 @@ TEST_F(Cli, UpgradeAddsAFastEvaluator) {
   EXPECT_NE(r.output.find("fast evaluator: none"), std::string::npos) << r.output;
   r = run("predict --model " + path("gp.h5") + " --p 80MPa --v 10m/min --angle 90deg");
   EXPECT_NE(r.output.find("(exact model)"), std::string::npos) << r.output;
-  r = run("upgrade " + path("gp.h5"));
+  r = run("upgrade " + path("gp.h5") + " --fast-max-seconds 300");  // as above: not the budget under test
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("meets the tolerances"), std::string::npos) << r.output;
   r = run("describe " + path("gp.h5"));
