@@ -41,10 +41,6 @@ bool same_plan(const h5::RowMatrix& a, const h5::RowMatrix& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
 }
 
-}  // namespace
-
-namespace {
-
 // SplitMix64's output function (Steele, Lea & Flood 2014; Vigna's reference constants).
 std::uint64_t splitmix64(std::uint64_t z) {
   z += 0x9e3779b97f4a7c15ULL;
@@ -337,8 +333,7 @@ Dataset merge_datasets(const std::vector<std::string>& paths, bool allow_mixed, 
     if (d.failed(i)) o.failure_reason = d.failure_reason[static_cast<size_t>(i)];
     if (d.outside_model(i)) o.warnings = {d.failure_reason[static_cast<size_t>(i)]};
     for (const auto& [name, values] : d.diagnostics) o.diagnostics[name] = values(i);
-    for (Eigen::Index k = 0; k < d.draw_mu.cols(); ++k) o.draw_mu.push_back(d.draw_mu(i, k));
-    while (!o.draw_mu.empty() && std::isnan(o.draw_mu.back())) o.draw_mu.pop_back();  // the padding
+    for (Eigen::Index k = 0; k < d.draw_mu.cols(); ++k) o.draw_mu.push_back(d.draw_mu(i, k));  // padding included
     std::optional<DrawSeeds> seeds;
     if (!d.tool_seed.empty() && d.tool_seed[static_cast<size_t>(i)] >= 0) {
       seeds = DrawSeeds{static_cast<std::uint64_t>(d.tool_seed[static_cast<size_t>(i)]),

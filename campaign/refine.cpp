@@ -120,8 +120,8 @@ ReplicationCandidates converged_design_points(const Dataset& db) {
 
 // The draws one new sample makes: the training samples' median count.
 double draws_per_sample(const TrainingSet& data) {
-  std::vector<double> counts;
-  for (Eigen::Index i = 0; i < data.draw_mu.rows(); ++i) counts.push_back(static_cast<double>(data.draw_mu.row(i).array().isFinite().count()));
+  const Eigen::VectorXi draws = finite_draws(data);
+  std::vector<double> counts(draws.data(), draws.data() + draws.size());
   if (counts.empty()) return 1.0;
   std::nth_element(counts.begin(), counts.begin() + static_cast<std::ptrdiff_t>(counts.size() / 2), counts.end());
   return std::max(counts[counts.size() / 2], 1.0);

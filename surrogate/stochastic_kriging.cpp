@@ -28,6 +28,14 @@ constexpr double kSingleDrawNoiseBound = 10.0;
 
 }  // namespace
 
+Eigen::VectorXi finite_draws(const TrainingSet& data) {
+  Eigen::VectorXi counts = Eigen::VectorXi::Zero(data.x.rows());
+  for (Eigen::Index i = 0; i < std::min(data.draw_mu.rows(), counts.size()); ++i) {
+    counts(i) = static_cast<int>(data.draw_mu.row(i).array().isFinite().count());
+  }
+  return counts;
+}
+
 DrawVariances draw_variances(const TrainingSet& data) {
   DrawVariances v;
   std::vector<double> logs, variances;
@@ -70,9 +78,8 @@ GaussianProcess train_stochastic_kriging(const TrainingSet& data, const GpTraini
   StochasticKrigingReport report;
   const Eigen::Index n = data.x.rows();
   if (data.draw_mu.rows() != n) throw Error("stochastic kriging: the training set carries no per-draw mu");
-  Eigen::VectorXi draws(n);
+  const Eigen::VectorXi draws = finite_draws(data);
   for (Eigen::Index i = 0; i < n; ++i) {
-    draws(i) = static_cast<int>(data.draw_mu.row(i).array().isFinite().count());
     if (draws(i) == 0) {
       throw Error(data.source_path + ": training sample " + std::to_string(i) + " has no finite per-draw mu (/samples/draw_mu)");
     }

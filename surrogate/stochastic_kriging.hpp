@@ -18,6 +18,9 @@
 
 namespace mufric {
 
+// Each training sample's count of finite draws (its row of draw_mu; 0 without per-draw μ).
+Eigen::VectorXi finite_draws(const TrainingSet& data);
+
 // Per-sample log variances of the draws, for samples with at least two finite draws.
 struct DrawVariances {
   std::vector<Eigen::Index> rows;          // rows of the training set

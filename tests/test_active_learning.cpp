@@ -23,16 +23,23 @@ double kernel(const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b, const Gp
   return h.signal_variance * std::exp(-0.5 * ((a - b).array() / h.length_scales.transpose().array()).square().sum());
 }
 
-// Posterior variance (normalised units, without noise) at q given training rows `x` (unit box).
-double brute_force_variance(const Eigen::MatrixXd& x, const Eigen::RowVectorXd& q, const GpHyperParameters& h, double noise) {
+// Posterior variance (normalised units, without noise at q) given training rows `x` (unit box) observed
+// with per-point noise variances.
+double brute_force_variance(const Eigen::MatrixXd& x, const Eigen::RowVectorXd& q, const GpHyperParameters& h,
+                            const Eigen::VectorXd& noise) {
   const Eigen::Index n = x.rows();
   Eigen::MatrixXd k(n, n);
   Eigen::VectorXd kq(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     kq(i) = kernel(x.row(i), q, h);
-    for (Eigen::Index j = 0; j < n; ++j) k(i, j) = kernel(x.row(i), x.row(j), h) + (i == j ? noise : 0.0);
+    for (Eigen::Index j = 0; j < n; ++j) k(i, j) = kernel(x.row(i), x.row(j), h) + (i == j ? noise(i) : 0.0);
   }
-  return kernel(q, q, h) - kq.dot(k.partialPivLu().solve(kq));
+  return kernel(q, q, h) - kq.dot(k.fullPivLu().solve(kq));
+}
+
+// The same with one noise variance for every point.
+double brute_force_variance(const Eigen::MatrixXd& x, const Eigen::RowVectorXd& q, const GpHyperParameters& h, double noise) {
+  return brute_force_variance(x, q, h, Eigen::VectorXd::Constant(x.rows(), noise));
 }
 
 // Each pick must be the brute-force argmax of the posterior variance given the training inputs,
@@ -87,19 +94,6 @@ TEST(ActiveLearning, FailedRunsAreConditionedOnAndNeverPicked) {
   const auto picks = pick_by_posterior_variance(gp, candidates, 3, tried);
   ASSERT_EQ(picks.size(), 3u);
   expect_brute_force_picks(gp, candidates, picks, tried);
-}
-
-// Posterior variance with a per-point noise vector (normalised units, without noise at q).
-double brute_force_variance(const Eigen::MatrixXd& x, const Eigen::RowVectorXd& q, const GpHyperParameters& h,
-                            const Eigen::VectorXd& noise) {
-  const Eigen::Index n = x.rows();
-  Eigen::MatrixXd k(n, n);
-  Eigen::VectorXd kq(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    kq(i) = kernel(x.row(i), q, h);
-    for (Eigen::Index j = 0; j < n; ++j) k(i, j) = kernel(x.row(i), x.row(j), h) + (i == j ? noise(i) : 0.0);
-  }
-  return kernel(q, q, h) - kq.dot(k.fullPivLu().solve(kq));
 }
 
 // The IMSE reduction of each pick against brute force: the mean posterior variance over the

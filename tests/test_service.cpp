@@ -789,7 +789,7 @@ TEST_F(Service, ThePatchScatterReachesEveryInterface) {
   const client::Answer plain = client::connect("grpc://" + server.address() + "/gp")->evaluate(pts.block(), what);
   EXPECT_TRUE(plain.patch_std.empty());
   EXPECT_FALSE(client::connect("grpc://" + server.address() + "/gp")->describe().has_patch_scatter);
-  for (const std::string uri : {"grpc://" + server.address() + "/sk", "file://" + (dir_ / "sk.h5").string()}) {
+  for (const std::string& uri : {"grpc://" + server.address() + "/sk", "file://" + (dir_ / "sk.h5").string()}) {
     mufric_client* c = nullptr;
     ASSERT_EQ(mufric_open_with_options(uri.c_str(), "fill=-1", &c), MUFRIC_OK) << mufric_last_error();
     EXPECT_EQ(mufric_has_patch_scatter(c), 1);

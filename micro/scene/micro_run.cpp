@@ -689,7 +689,7 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
          {"run_in_m", q.run_in},
          {"window_m", q.window},
          {"window_in_tool_correlation_lengths",
-          scene.tool_surface.csv.empty() && !scene.tool_surface.flat
+          scene.tool_surface.is_synthetic()
               ? nlohmann::json(q.window / scene.tool_surface.synthetic.correlation_length)
               : nlohmann::json(nullptr)},
          {"step_distance_m", q.step_distance},
@@ -713,10 +713,9 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
     one["realisation"] = d.realisation;
     one["tool_shift_fraction"] = d.shift_fraction;
     one["tool_seed"] = d.seed;
-    const bool synthetic_chip = scene.chip_surface.csv.empty() && !scene.chip_surface.flat;
-    one["chip_seed"] = d.chip_seed        ? nlohmann::json(*d.chip_seed)
-                       : synthetic_chip ? nlohmann::json(scene.chip_surface.synthetic.seed)
-                                        : nlohmann::json(nullptr);
+    one["chip_seed"] = d.chip_seed                        ? nlohmann::json(*d.chip_seed)
+                       : scene.chip_surface.is_synthetic() ? nlohmann::json(scene.chip_surface.synthetic.seed)
+                                                           : nlohmann::json(nullptr);
     if (!d.result.block_means.empty()) {
       one["block_means"] = d.result.block_means;
       one["drift"] = d.result.drift;

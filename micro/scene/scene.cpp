@@ -271,13 +271,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
         p.fail("name", "press-slide under a pressure presses dynamically (the chip's inertia holds it until the contact "
                        "closes): time.scheme must be generalized-alpha, or load the chip by vertical_displacement");
       }
-      if (q.realisations > 1 && (!s.tool_surface.csv.empty() || s.tool_surface.flat)) {
+      if (q.realisations > 1 && !s.tool_surface.is_synthetic()) {
         p.fail("realisations", "realisations redraw a synthetic tool with other seeds; this tool is " +
                                    std::string(s.tool_surface.flat ? "flat" : "a measured profile") +
                                    " (use phases to average over its positions)");
       }
       if (q.step_distance > q.window) p.fail("step_distance", "is longer than the window");
-      const bool chip_drawable = s.chip_surface.csv.empty() && !s.chip_surface.flat;
+      const bool chip_drawable = s.chip_surface.is_synthetic();
       q.draws = p.text("draws", chip_drawable ? "tools-and-chip" : "tools", {"tools", "tools-and-chip"}) == "tools"
                     ? DrawnSurfaces::tools
                     : DrawnSurfaces::tools_and_chip;

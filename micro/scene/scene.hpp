@@ -23,6 +23,8 @@ struct SurfaceSpec {
   int control_points = 64;
   double shift_fraction = 0.0;     // moves the profile along x by this fraction of the interval
   bool mirror = false;             // x → −x (a reflected profile, for symmetry studies)
+  // Drawn from `synthetic` (a seed draws another of the same statistics), not measured or flat.
+  bool is_synthetic() const { return csv.empty() && !flat; }
 };
 
 // How μ is measured (README "What μ means"). Seed 000's protocol ramps the pressure while the chip
