@@ -35,4 +35,4 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMUFRIC_SAN
   -DMUFRIC_BUILD_BENCH=OFF -DMUFRIC_BUILD_TESTS=ON
 cmake --build build-asan -j "$jobs" --target mufric mufric_unit_tests mufric_micro_tests mufric_service_tests mufric_cli_tests
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan -j "$jobs" -L "unit|service|cli" --output-on-failure --timeout 600
+  ctest --test-dir build-asan -j "$jobs" -L "^(unit|service|cli)$" --output-on-failure --timeout 600
