@@ -133,6 +133,7 @@ void add_bench_command(CLI::App& app) {
     int clients = 1;
     double seconds = 1.0;
     bool with_std = false;
+    bool patch_std = false;
     bool streaming = false;
     bool json = false;
     bool exact = false;
@@ -149,6 +150,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--seconds", o->seconds, "Measuring time per batch size")->capture_default_str()
       ->check(FiniteRange(0.01, 3600.0));
   cmd->add_flag("--std", o->with_std, "Also the standard deviation and a 95 % interval");
+  cmd->add_flag("--patch-std", o->patch_std, "Also the patch scatter (a model trained on independent draws)");
   cmd->add_flag("--stream", o->streaming, "grpc://: send blocks over one EvaluateStream per client");
   cmd->add_flag("--json", o->json, "One JSON object per batch size instead of a table");
   cmd->add_flag("--exact", o->exact, "Ask for the exact model only (no certified fast evaluator)");
@@ -159,7 +161,8 @@ void add_bench_command(CLI::App& app) {
                   "increments, one call per increment")
       ->delimiter(',')->expected(2)->check(CLI::Range(1LL, 1'000'000'000LL));
   cmd->callback([o] {
-    EvaluationRequest what{.std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false};
+    EvaluationRequest what{
+        .std = o->with_std, .ci_level = o->with_std ? 0.95 : 0.0, .gradient = false, .patch_std = o->patch_std};
     if (o->exact) what.mu_tolerance = what.std_relative_tolerance = 0.0;
     client::Options options = client::parse_options(o->client_options);
     options.streaming = options.streaming || o->streaming;
@@ -183,7 +186,9 @@ void add_bench_command(CLI::App& app) {
     }
     if (!o->json) {
       std::printf("%10s %10s %14s %12s %12s %8s   (%s, %s, %d client%s)\n", "batch", "calls", "points/s", "p50 [us]",
-                  "p99 [us]", "errors", o->model.c_str(), o->with_std ? "mean+std" : "mean only", o->clients,
+                  "p99 [us]", "errors", o->model.c_str(),
+                  o->with_std ? (o->patch_std ? "mean+std+patch_std" : "mean+std") : (o->patch_std ? "mean+patch_std" : "mean only"),
+                  o->clients,
                   o->clients == 1 ? "" : "s");
     }
     long long failed_calls = 0;
@@ -200,9 +205,9 @@ void add_bench_command(CLI::App& app) {
       const double points_per_second = static_cast<double>(batch) * answered_calls / m.wall_seconds;
       if (o->json) {
         std::printf("{\"batch\": %lld, \"clients\": %d, \"calls\": %zu, \"points_per_second\": %.6g, \"p50_us\": %.4g, "
-                    "\"p99_us\": %.4g, \"errors\": %lld, \"std\": %s}\n",
+                    "\"p99_us\": %.4g, \"errors\": %lld, \"std\": %s, \"patch_std\": %s}\n",
                     batch, o->clients, m.latencies.size(), points_per_second, 1e6 * p50, 1e6 * p99, m.errors,
-                    o->with_std ? "true" : "false");
+                    o->with_std ? "true" : "false", o->patch_std ? "true" : "false");
       } else {
         std::printf("%10lld %10zu %14.4g %12.4g %12.4g %8lld\n", batch, m.latencies.size(), points_per_second, 1e6 * p50,
                     1e6 * p99, m.errors);

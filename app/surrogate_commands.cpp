@@ -156,33 +156,49 @@ void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
   cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
 }
 
-// Builds, reports and attaches a fast evaluator. A grid that cannot reach the tolerances within the
-// budgets is not stored: no default request could use it, and it would only weigh on the file (issue
-// 30: 57.7 MB for a 2-point model). The message says what stopped it and how to build it later.
-void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o, double fit_seconds) {
-  gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
-  if (o.skip) return;
-  FastEvaluatorOptions build = o.build;
-  build.max_seconds = fast_evaluator_budget(o, fit_seconds);
-  build.progress = [](const std::string& line) {
-    std::printf("  fast evaluator: %s\n", line.c_str());
+// Builds and reports a fast evaluator of `gp` ("model" or "patch scatter" in the messages); null when
+// it cannot reach the tolerances within the budgets. Such a grid is not stored: no default request
+// could use it, and it would only weigh on the file (issue 30: 57.7 MB for a 2-point model). The
+// message says what stopped it and how to build it later.
+std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess& gp, FastEvaluatorOptions build,
+                                                          const std::string& label) {
+  build.progress = [label](const std::string& line) {
+    std::printf("  fast evaluator (%s): %s\n", label.c_str(), line.c_str());
     std::fflush(stdout);
   };
-  std::printf("fast evaluator: building within %.1f s and %.0f MB (--fast-max-seconds, --fast-max-mb)\n",
-              build.max_seconds, build.max_megabytes);
+  std::printf("fast evaluator (%s): building within %.1f s and %.0f MB (--fast-max-seconds, --fast-max-mb)\n",
+              label.c_str(), build.max_seconds, build.max_megabytes);
   const auto start = std::chrono::steady_clock::now();
   auto fast = std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, build));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!fast->meets(o.build.mu_tolerance, o.build.std_relative_tolerance)) {
-    std::printf("fast evaluator: not stored, built in %.1f s: %s before the tolerances were met; the exact model answers "
-                "every request (a larger --fast-max-seconds / --fast-max-mb, or looser --fast-*-tolerance, with "
-                "`mufric upgrade --rebuild`)\n",
-                seconds, fast->stop_reason().c_str());
-    return;
+  if (!fast->meets(build.mu_tolerance, build.std_relative_tolerance)) {
+    std::printf("fast evaluator (%s): not stored, built in %.1f s: %s before the tolerances were met; the exact model "
+                "answers every request (a larger --fast-max-seconds / --fast-max-mb, or looser --fast-*-tolerance, "
+                "with `mufric upgrade --rebuild`)\n",
+                label.c_str(), seconds, fast->stop_reason().c_str());
+    return nullptr;
   }
-  std::printf("fast evaluator: %.1f MB, built in %.1f s; meets the tolerances: it answers default requests inside the box\n",
-              static_cast<double>(fast->grid().bytes()) / 1e6, seconds);
-  gp.attach_fast_evaluator(std::move(fast));
+  std::printf("fast evaluator (%s): %.1f MB, built in %.1f s; meets the tolerances: it answers default requests inside "
+              "the box\n",
+              label.c_str(), static_cast<double>(fast->grid().bytes()) / 1e6, seconds);
+  return fast;
+}
+
+// The model's fast evaluator and, for a model with a patch scatter, the scatter's: its log variance
+// tabulated to the tolerance that holds patch_std to --fast-std-tolerance (relative), its own σ unused.
+void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o, double fit_seconds) {
+  gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
+  if (gp.patch_scatter()) gp.attach_patch_scatter_fast_evaluator(nullptr);
+  if (o.skip) return;
+  FastEvaluatorOptions build = o.build;
+  build.max_seconds = fast_evaluator_budget(o, fit_seconds);
+  gp.attach_fast_evaluator(build_fast_evaluator(gp, build, "model"));
+  if (gp.patch_scatter()) {
+    FastEvaluatorOptions scatter = build;
+    scatter.mu_tolerance = patch_scatter_log_variance_tolerance(o.build.std_relative_tolerance);
+    scatter.std_relative_tolerance = 1.0;
+    gp.attach_patch_scatter_fast_evaluator(build_fast_evaluator(*gp.patch_scatter(), scatter, "patch scatter"));
+  }
 }
 
 void add_train(CLI::App& app) {

@@ -35,8 +35,8 @@ for n in $sizes; do
   mean=$(sed -n 's/^mean relative error *\([0-9.]*\) %/\1/p' "eval$n.log")
   max=$(sed -n 's/^max relative error *\([0-9.]*\) %/\1/p' "eval$n.log")
   coverage=$(sed -n 's/^95 % interval coverage *\([0-9.]*\) %/\1/p' "eval$n.log")
-  fast_mb=$(sed -n 's/^fast evaluator: \([0-9.]*\) MB, built in .*/\1/p' "train$n.log")
-  fast_s=$(sed -n 's/^fast evaluator: .* built in \([0-9.]*\) s.*/\1/p' "train$n.log")
+  fast_mb=$(sed -n 's/^fast evaluator (model): \([0-9.]*\) MB, built in .*/\1/p' "train$n.log")
+  fast_s=$(sed -n 's/^fast evaluator (model): .* built in \([0-9.]*\) s.*/\1/p' "train$n.log")
   certified=$(grep -q "does NOT meet" "train$n.log" && echo no || echo yes)
   echo "$n,$train_s,$mean,$max,$coverage,$fast_mb,$fast_s,$certified,$(cost "g$n.h5" 10000 --exact),$(cost "g$n.h5" 10000 ""),$(cost "g$n.h5" 1 --exact),$(cost "g$n.h5" 1 "")" >>"$csv"
   tail -1 "$csv" >&2

@@ -67,10 +67,10 @@ def mufric_train(args, csv, model, extra):
     out = r.stdout
     m = re.search(r"training points\) in (\S+) s", out)
     row["fit_s"] = float(m.group(1)) if m else None
-    m = re.search(r"^fast evaluator: (\S+) MB, built in (\S+) s", out, re.M)
+    m = re.search(r"^fast evaluator \(model\): (\S+) MB, built in (\S+) s", out, re.M)
     if m:
         row.update(grid="stored", grid_mb=float(m.group(1)), grid_s=float(m.group(2)))
-    m = re.search(r"^fast evaluator: not stored, built in (\S+) s: (.*?) before", out, re.M)
+    m = re.search(r"^fast evaluator \(model\): not stored, built in (\S+) s: (.*?) before", out, re.M)
     if m:
         row.update(grid="not stored", grid_s=float(m.group(1)), why=m.group(2))
     if row["finished"]:

@@ -101,7 +101,7 @@ void FrictionModel::widen_clamped_intervals(const QueryBatch& x, const std::vect
   clamped.clamped_variances += raw.clamped_variances;
 }
 
-Eigen::VectorXd FrictionModel::patch_std_valid(const QueryBatch& x) const {
+Eigen::VectorXd FrictionModel::patch_std_valid(const QueryBatch& x, const EvaluationRequest&) const {
   return Eigen::VectorXd::Constant(x.rows(), std::numeric_limits<double>::quiet_NaN());
 }
 
@@ -141,7 +141,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
   const bool patch = what.patch_std && has_patch_scatter();
   if (n_valid == m && !clamp) {
     evaluate_valid(x, what, inner);
-    if (patch) inner.patch_std = patch_std_valid(x);
+    if (patch) inner.patch_std = patch_std_valid(x, what);
   } else if (n_valid > 0) {
     QueryBatch compact(n_valid, d);
     for (Eigen::Index k = 0; k < n_valid; ++k) compact.row(k) = x.row(valid[static_cast<size_t>(k)]);
@@ -152,7 +152,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
       }
     }
     evaluate_valid(compact, what, inner);
-    if (patch) inner.patch_std = patch_std_valid(compact);  // the face's, for a clamped point
+    if (patch) inner.patch_std = patch_std_valid(compact, what);  // the face's, for a clamped point
     if (clamp && need_std && has_uncertainty()) widen_clamped_intervals(x, valid, what, inner);
     if (clamp && what.gradient) {
       // μ is constant along a clamped input beyond the box.

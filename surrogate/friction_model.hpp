@@ -105,7 +105,7 @@ class FrictionModel {
   // std is filled when what.std or what.ci_level > 0.
   virtual void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const = 0;
   // The patch scatter at valid points (only called when has_patch_scatter()).
-  virtual Eigen::VectorXd patch_std_valid(const QueryBatch& x) const;
+  virtual Eigen::VectorXd patch_std_valid(const QueryBatch& x, const EvaluationRequest& what) const;
 
  private:
   // σ of the clamped answers (rows of `clamped`, evaluated at the box face) of points outside the box.

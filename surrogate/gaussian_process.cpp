@@ -396,15 +396,41 @@ void GaussianProcess::attach_patch_scatter(std::shared_ptr<const GaussianProcess
   if (scatter && !same_input_space(scatter->inputs(), inputs())) {
     throw Error("Gaussian process: the patch scatter's inputs or box differ from the model's");
   }
+  if (!scatter || scatter->mu_min() == std::numeric_limits<double>::lowest()) {
+    patch_scatter_ = std::move(scatter);
+    return;
+  }
+  // Its output is a log variance, not a μ: FrictionModel::evaluate (what its fast evaluator is built
+  // and checked from) must not clamp it to μ's range.
+  auto log_variance = std::make_shared<GaussianProcess>(*scatter);
+  log_variance->set_unbounded_output();
+  patch_scatter_ = std::move(log_variance);
+}
+
+void GaussianProcess::set_unbounded_output() {
+  set_mu_range(std::numeric_limits<double>::lowest(), std::numeric_limits<double>::max());
+}
+
+void GaussianProcess::attach_patch_scatter_fast_evaluator(std::shared_ptr<const FastEvaluator> fast) {
+  if (!patch_scatter_) throw Error("Gaussian process: a fast evaluator of the patch scatter needs a patch scatter");
+  auto scatter = std::make_shared<GaussianProcess>(*patch_scatter_);
+  scatter->attach_fast_evaluator(std::move(fast));
   patch_scatter_ = std::move(scatter);
 }
 
-Eigen::VectorXd GaussianProcess::patch_std(const QueryBatch& x) const {
+Eigen::VectorXd GaussianProcess::patch_std(const QueryBatch& x, double std_relative_tolerance) const {
   if (!patch_scatter_) return {};
-  return std_from_log_variance(*patch_scatter_, x);
+  return std_from_log_variance(*patch_scatter_, x, std_relative_tolerance);
 }
 
-Eigen::VectorXd GaussianProcess::std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x) {
+Eigen::VectorXd GaussianProcess::patch_std_valid(const QueryBatch& x, const EvaluationRequest& what) const {
+  // The request's "0 (either): exact" convention of EvaluationRequest, and σ's relative tolerance.
+  const bool exact = what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0;
+  return patch_std(x, exact ? 0.0 : what.std_relative_tolerance);
+}
+
+Eigen::VectorXd GaussianProcess::std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x,
+                                                       double std_relative_tolerance) {
   // The scatter GP's output is a log variance: not a μ, so not FrictionModel::evaluate's μ range or
   // policies. A point outside the box takes its nearest face's value; a non-finite one none.
   QueryBatch clamped = x;
@@ -422,7 +448,8 @@ Eigen::VectorXd GaussianProcess::std_from_log_variance(const GaussianProcess& lo
   Evaluation e;
   e.mu.resize(finite.rows());
   EvaluationRequest mean_only;
-  mean_only.mu_tolerance = 0.0;  // the exact model: the scatter GP carries no grid
+  mean_only.mu_tolerance = patch_scatter_log_variance_tolerance(std_relative_tolerance);  // 0: exact
+  mean_only.std_relative_tolerance = 1.0;  // the scatter's own σ is never served
   if (finite.rows() > 0) log_variance.evaluate_valid(finite, mean_only, e);
   Eigen::VectorXd out = Eigen::VectorXd::Constant(x.rows(), std::numeric_limits<double>::quiet_NaN());
   for (size_t k = 0; k < finite_rows.size(); ++k) out(finite_rows[k]) = std::exp(0.5 * e.mu(static_cast<Eigen::Index>(k)));
@@ -437,8 +464,9 @@ std::string GaussianProcess::summary() const {
     << (h.noise_term ? "" : " (no noise term)") << ", jitter " << state_.jitter << "\n";
   if (state_.known_noise.size() != 0) {
     s << "  known per-sample noise (micro-model standard errors): mean variance " << state_.known_noise.mean()
-      << ", max " << state_.known_noise.maxCoeff() << " (normalised); RMS standard error of mu "
-      << state_.micro_std_error << "\n";
+      << ", max " << state_.known_noise.maxCoeff() << " (normalised); RMS standard error of a sample's mu "
+      << std::sqrt(state_.known_noise.mean()) * state_.y_scale
+      << (state_.micro_std_error > 0.0 ? ", added to every interval as the shared scatter" : "") << "\n";
   }
   s << "  interval: " << gp_interval_meaning(interval_meaning()) << "\n";
   if (patch_scatter_) {
@@ -447,6 +475,12 @@ std::string GaussianProcess::summary() const {
       << " samples; per-draw std from the samples' own draws " << std::exp(0.5 * p.y_train.minCoeff()) << " .. "
       << std::exp(0.5 * p.y_train.maxCoeff()) << " (bias-corrected logs), length scales";
     for (Eigen::Index j = 0; j < p.hyper.length_scales.size(); ++j) s << " " << p.hyper.length_scales(j);
+    if (const FastEvaluator* f = patch_scatter_->fast_evaluator()) {
+      s << "; fast evaluator of its log variance within " << f->bounds().mu_absolute << " (patch_std within "
+        << 0.5 * f->bounds().mu_absolute << " relative)";
+    } else {
+      s << "; no fast evaluator (the exact scatter GP answers)";
+    }
     s << "\n";
   }
   for (size_t j = 0; j < state_.inputs.size(); ++j) {

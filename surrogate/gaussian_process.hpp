@@ -62,6 +62,12 @@ struct GpTrainingSummary {
   std::string created_utc;
 };
 
+// patch_std = exp(½ m) of the scatter GP's log variance m: an absolute error δ in m is a relative
+// error δ/2 in patch_std (to first order), so a fast evaluator of m within 2R holds patch_std to R.
+inline constexpr double patch_scatter_log_variance_tolerance(double std_relative_tolerance) {
+  return 2.0 * std_relative_tolerance;
+}
+
 class GaussianProcess final : public FrictionModel {
  public:
   struct State {
@@ -112,14 +118,23 @@ class GaussianProcess final : public FrictionModel {
 
   // The patch scatter (issue 33): a GP of the log per-draw variance of μ over the same inputs
   // (surrogate/stochastic_kriging.hpp), served as its own output, never mixed into the interval.
+  // (The scatter's output range is made unbounded: a log variance, not a μ.)
   void attach_patch_scatter(std::shared_ptr<const GaussianProcess> scatter);
+  // For a GP whose output is not a μ: FrictionModel::evaluate (and so a fast evaluator's build and
+  // its load-time check) no longer clamps it to μ's range.
+  void set_unbounded_output();
   const GaussianProcess* patch_scatter() const { return patch_scatter_.get(); }
+  // The scatter GP's own fast evaluator (of its log variance, built to
+  // patch_scatter_log_variance_tolerance); the scatter must be attached first.
+  void attach_patch_scatter_fast_evaluator(std::shared_ptr<const FastEvaluator> fast);
   // The per-draw standard deviation of μ at SI points (rows), exp(½ m(x)) of the scatter GP's mean;
-  // empty when the model has none. Outside the box, m at the nearest face (clamped).
-  Eigen::VectorXd patch_std(const QueryBatch& x) const;
+  // empty when the model has none. Outside the box, m at the nearest face (clamped). With a relative
+  // tolerance R > 0 the scatter's fast evaluator answers when its bound holds patch_std to R; 0: exact.
+  Eigen::VectorXd patch_std(const QueryBatch& x, double std_relative_tolerance = 0.0) const;
   // exp(½ m(x)) of a GP `log_variance` of a log variance, each point clamped to its box (NaN for a
   // non-finite point): what patch_std serves, and what stochastic kriging puts on its diagonal.
-  static Eigen::VectorXd std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x);
+  static Eigen::VectorXd std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x,
+                                               double std_relative_tolerance = 0.0);
 
   // The model file's groups under `group` ("/gp"; the patch scatter's under "/gp/patch_scatter").
   void write_group(h5::Writer& out, const std::string& group) const;
@@ -131,7 +146,7 @@ class GaussianProcess final : public FrictionModel {
 
  protected:
   void evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const override;
-  Eigen::VectorXd patch_std_valid(const QueryBatch& x) const override { return patch_std(x); }
+  Eigen::VectorXd patch_std_valid(const QueryBatch& x, const EvaluationRequest& what) const override;
 
  private:
   void evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const;

@@ -442,6 +442,7 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
   }
   const InputSpace inputs_of_model = s.inputs;
   GaussianProcess gp(std::move(s));
+  if (group.ends_with("/patch_scatter")) gp.set_unbounded_output();  // before its grid's load check
   if (in.has(fast_group)) gp.attach_fast_evaluator(read_fast_evaluator(in, gp, fast_group));
   // Only the model's own GP has a patch scatter (a scatter of the scatter is not a thing, and a file
   // nesting them deeply would recurse here).

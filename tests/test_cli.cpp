@@ -652,6 +652,7 @@ TEST_F(Cli, DatasetPlanRunResumeMergeAndTrain) {
   EXPECT_NE(r.output.find("patch scatter "), std::string::npos) << r.output;
   r = run("describe " + path("gp.h5"));
   EXPECT_NE(r.output.find("patch scatter: a GP of the log per-draw variance"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fast evaluator of its log variance within"), std::string::npos) << r.output;  // train built it
   // The same data trained as common draws (as every dataset from before issue 33 is): one GP, the
   // samples' scatter added to the interval, no patch scatter.
   r = run("train --data " + path("all.h5") + " --out " + path("gp-common.h5") + " --restarts 1 --no-stochastic-kriging");

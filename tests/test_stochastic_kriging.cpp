@@ -9,6 +9,7 @@
 #include <random>
 
 #include "common/error.hpp"
+#include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 #include "surrogate/stochastic_kriging.hpp"
@@ -177,6 +178,54 @@ TEST(StochasticKriging, LearnsTheMeanAndThePatchScatterOfIndependentDraws) {
   EXPECT_EQ(again.mu, e.mu);
   EXPECT_EQ(again.hi, e.hi);
   EXPECT_EQ(back->patch_std(q), patch);
+  std::filesystem::remove(path);
+}
+
+// The patch scatter's own fast evaluator: its log variance tabulated to 2R holds patch_std to R of
+// the exact scatter GP's (the independent answer) wherever a request allows R, also at clamped points
+// outside the box; a request for the exact model gets the exact scatter bit for bit; the grid and its
+// bound survive the model file.
+TEST(StochasticKriging, ThePatchScatterFastEvaluatorHoldsItsTolerance) {
+  GpTrainingOptions options;
+  options.restarts = 1;
+  GaussianProcess gp = train_stochastic_kriging(independent_draws(120, 4, 8), options);
+  ASSERT_NE(gp.patch_scatter(), nullptr);
+  constexpr double kRelative = 1e-3;
+  FastEvaluatorOptions build;
+  build.mu_tolerance = patch_scatter_log_variance_tolerance(kRelative);
+  build.std_relative_tolerance = 1.0;
+  build.check_points = 2000;
+  gp.attach_patch_scatter_fast_evaluator(
+      std::make_shared<const FastEvaluator>(FastEvaluator::build(*gp.patch_scatter(), build)));
+  ASSERT_NE(gp.patch_scatter()->fast_evaluator(), nullptr);
+  ASSERT_TRUE(gp.patch_scatter()->fast_evaluator()->meets(build.mu_tolerance, 1.0));
+
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> wide(0.01, 1.3);  // half the points outside the box (high side)
+  constexpr Eigen::Index kQueries = 4000;
+  Eigen::MatrixXd q(kQueries, 3);
+  for (Eigen::Index i = 0; i < kQueries; ++i) {
+    for (Eigen::Index j = 0; j < 3; ++j) q(i, j) = wide(rng);
+  }
+  const Eigen::VectorXd exact = gp.patch_std(q), fast = gp.patch_std(q, kRelative);
+  const double worst = ((fast - exact).array() / exact.array()).abs().maxCoeff();
+  EXPECT_LE(worst, kRelative);
+  EXPECT_GT(worst, 0.0);  // the grid answered, not the exact GP
+
+  EXPECT_EQ(gp.evaluate(q, {.patch_std = true, .mu_tolerance = 0.0}).patch_std, exact);
+  const Evaluation served = gp.evaluate(q, {.patch_std = true, .std_relative_tolerance = kRelative});
+  EXPECT_EQ(served.patch_std, fast);
+
+  const auto path = (std::filesystem::temp_directory_path() / ("mufric_sk_fast_" + std::to_string(::getpid()) + ".h5")).string();
+  save_model(path, gp);
+  const auto loaded = load_model(path);
+  const auto* back = dynamic_cast<const GaussianProcess*>(loaded.get());
+  ASSERT_NE(back, nullptr);
+  ASSERT_NE(back->patch_scatter(), nullptr);
+  ASSERT_NE(back->patch_scatter()->fast_evaluator(), nullptr);
+  EXPECT_EQ(back->patch_std(q, kRelative), fast);
+  EXPECT_EQ(back->patch_std(q), exact);
+  EXPECT_NE(back->summary().find("fast evaluator of its log variance"), std::string::npos);
   std::filesystem::remove(path);
 }
 

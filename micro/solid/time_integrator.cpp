@@ -18,6 +18,13 @@ bool trace_newton() {
   return on;
 }
 
+// A micro run lasts nanoseconds: "t = 0.000000 s" (std::to_string) hid where a step failed.
+std::string time_label(double t_s) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "t = %.6g ns", t_s * 1e9);
+  return buffer;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -333,12 +340,12 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
       report_.cutbacks.push_back({t, this_dt, at.reason});
       if (std::string stop_reason; options_.should_stop && options_.should_stop(stop_reason)) {
         record_solver_counts();
-        report_.reason = "stopped after a failed step at t = " + std::to_string(t) + " s: " + stop_reason;
+        report_.reason = "stopped after a failed step at " + time_label(t) + ": " + stop_reason;
         return report_;
       }
       if (++consecutive_cuts > options_.max_cutbacks) {
         record_solver_counts();
-        report_.reason = "step at t = " + std::to_string(t) + " s failed after " + std::to_string(options_.max_cutbacks) +
+        report_.reason = "step at " + time_label(t) + " failed after " + std::to_string(options_.max_cutbacks) +
                          " cut-backs: " + at.reason;
         return report_;
       }
@@ -357,7 +364,7 @@ IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>
       report_.seconds_after_step += seconds_since(start);
       if (!ok) {
         record_solver_counts();
-        report_.reason = "after the step to t = " + std::to_string(t) + " s: " + reason;
+        report_.reason = "after the step to " + time_label(t) + ": " + reason;
         return report_;
       }
     }
