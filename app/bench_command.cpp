@@ -142,7 +142,7 @@ void add_bench_command(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "Throughput and latency of a model: in-process (file://) or a server (grpc://)");
-  cmd->add_option("--model", o->model, "file:///path/model.h5 (or a path), grpc://host:port/model")->required();
+  cmd->add_option("--model", o->model, "file:///path/model.h5 (or a path), a shipped model's name (dry_default), grpc://host:port/model")->required();
   cmd->add_option("--batch", o->batches, "Batch sizes (points per call)")->capture_default_str()->expected(1, 16)
       ->check(CLI::Range(1LL, 100'000'000LL));
   cmd->add_option("--clients", o->clients, "Concurrent clients, each with its own connection")

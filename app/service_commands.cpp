@@ -4,8 +4,10 @@
 
 #include "app/commands.hpp"
 #include "client/friction_client.hpp"
+#include "common/error.hpp"
 #include "common/wording.hpp"
 #include "server/server.hpp"
+#include "surrogate/model_file.hpp"
 
 namespace mufric::app {
 
@@ -38,8 +40,9 @@ void add_service_commands(CLI::App& app) {
   add_status_command(app);
   auto o = std::make_shared<server::ServerOptions>();
   auto* cmd = app.add_subcommand("serve", "Serve every model file (*.h5) of a directory over gRPC");
-  cmd->add_option("--models", o->models_directory, "Directory of model files; the name of a model is its file stem")
-      ->required();
+  cmd->add_option("--models", o->models_directory,
+                  "Directory of model files; the name of a model is its file stem (default: the shipped models, " +
+                      (shipped_models_directory().empty() ? std::string("none found") : shipped_models_directory()) + ")");
   cmd->add_option("--listen", o->listen, "Address to listen on (port 0: any free port)")->capture_default_str();
   cmd->add_option("--poll", o->poll_seconds, "Seconds between rescans of the directory for new or changed files")
       ->capture_default_str()->check(FiniteRange(0.05, 3600.0));
@@ -73,7 +76,17 @@ void add_service_commands(CLI::App& app) {
               "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
               "server reflection are on. Logs go to stderr, one line per event. A call whose deadline passes (or that\n"
               "the client cancels) stops within a few thousand points and answers DEADLINE_EXCEEDED (CANCELLED).");
-  cmd->callback([o] { server::run_server(*o); });
+  cmd->callback([o] {
+    if (o->models_directory.empty()) {
+      o->models_directory = shipped_models_directory();
+      if (o->models_directory.empty()) {
+        throw Error("serve: no --models directory given and no shipped models found (set MUFRIC_MODELS_DIR)");
+      }
+      std::fprintf(stderr, "serving the shipped models in %s (--models DIR serves another directory)\n",
+                   o->models_directory.c_str());
+    }
+    server::run_server(*o);
+  });
 }
 
 }  // namespace mufric::app

@@ -313,7 +313,7 @@ void add_eval(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("eval", "Held-out accuracy of a model on a test dataset");
-  cmd->add_option("--model", o->model, "Model file or file:// URI")->required();
+  cmd->add_option("--model", o->model, "Model file or file:// URI, or a shipped model's name (dry_default)")->required();
   cmd->add_option("--test", o->test, "Test dataset (HDF5 or CSV), not used in training")->required();
   cmd->add_option("--level", o->level, "Confidence level of the interval whose coverage is reported")
       ->capture_default_str()->check(FiniteRange(0.5, 0.9999));
@@ -378,7 +378,7 @@ void add_predict(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("predict", "Friction coefficients with their confidence intervals, human units");
-  cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), or grpc://host:port/model")->required();
+  cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), a shipped model's name (dry_default), or grpc://host:port/model")->required();
   for (const auto& [input, flag] : kInputFlags) {
     cmd->add_option(flag, o->values[flag],
                     "The " + input + " with its unit, e.g. " + std::string(example_quantity(kind_of_input(input))));
@@ -492,7 +492,7 @@ void add_predict(CLI::App& app) {
 void add_describe(CLI::App& app) {
   auto model_uri = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand("describe", "Inputs, units, training box and accuracy figures of a model");
-  cmd->add_option("model", *model_uri, "Model file or file:// URI, or a served model: grpc://host:port/model")->required();
+  cmd->add_option("model", *model_uri, "Model file or file:// URI, a shipped model's name (dry_default), or a served model: grpc://host:port/model")->required();
   cmd->callback([model_uri] {
     auto print_inputs = [](const InputSpace& inputs) {
       for (const auto& input : inputs) {
@@ -568,7 +568,7 @@ void add_dataset_from_model(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* from_model = dataset->add_subcommand(
       "from-model", "Sample a model (e.g. an empirical law) on a Latin hypercube of its box into a dataset file");
-  from_model->add_option("--model", o->model, "Model file or file:// URI")->required();
+  from_model->add_option("--model", o->model, "Model file or file:// URI, or a shipped model's name (dry_default)")->required();
   from_model->add_option("--samples", o->sampling.samples, "Number of samples")->capture_default_str()
       ->check(CLI::Range(1, 10000000));
   from_model->add_option("--seed", o->sampling.seed, "Random seed")->capture_default_str();

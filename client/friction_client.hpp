@@ -3,7 +3,8 @@
 //   grpc://host:port/model   a mufric server (channel reuse, deadlines, retry with backoff on
 //                            UNAVAILABLE, automatic chunking under the message limit)
 //   grpcs://host:port/model  the same over TLS (mutual TLS with a client certificate)
-//   file:///path/model.h5    the same model evaluated in-process, no server (or a plain path)
+//   file:///path/model.h5    the same model evaluated in-process, no server (or a plain path, or a
+//                            shipped model's name: "dry_default")
 #include <memory>
 #include <optional>
 #include <string>

@@ -44,7 +44,8 @@ enum mufric_point_status {
   MUFRIC_POINT_OUT_OF_BOX = 3
 };
 
-/* uri: "grpc://host:port/model", "file:///path/model.h5" or a path. */
+/* uri: "grpc://host:port/model", "file:///path/model.h5", a path, or the name of a model shipped with
+   mufric ("dry_default": <prefix>/share/mufric/models/dry_default.h5, or $MUFRIC_MODELS_DIR). */
 int mufric_open(const char* uri, mufric_client** client);
 
 /* The same with options, "key=value" pairs separated by commas, semicolons or blanks (NULL or ""

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <memory>
 
@@ -175,15 +177,65 @@ std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, cons
   return load_model(copy.path());
 }
 
+std::string shipped_models_directory() {
+  namespace fs = std::filesystem;
+  if (const char* set = std::getenv("MUFRIC_MODELS_DIR"); set != nullptr && *set != '\0') return set;
+  std::error_code ignored;
+  // Beside the running executable's prefix first (an install moved elsewhere, a container), then the
+  // prefix configured at build time, then the source tree (a build that is not installed).
+  const fs::path executable = fs::read_symlink("/proc/self/exe", ignored);
+  const std::string beside = executable.empty() ? std::string()
+                                                : (executable.parent_path().parent_path() / "share/mufric/models").string();
+  for (const std::string& candidate : {beside, std::string(MUFRIC_INSTALLED_MODELS_DIR), std::string(MUFRIC_SOURCE_MODELS_DIR)}) {
+    if (!candidate.empty() && fs::is_directory(candidate, ignored)) return candidate;
+  }
+  return {};
+}
+
+std::vector<std::string> shipped_model_names() {
+  namespace fs = std::filesystem;
+  std::vector<std::string> names;
+  const std::string dir = shipped_models_directory();
+  std::error_code error;
+  if (dir.empty() || !fs::is_directory(dir, error)) return names;
+  for (const auto& entry : fs::directory_iterator(dir, error)) {
+    if (entry.path().extension() == ".h5") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+namespace {
+
+// A bare name that is not a file here: the shipped model of that name, if there is one.
+std::string shipped_model_path(const std::string& name) {
+  namespace fs = std::filesystem;
+  std::error_code ignored;
+  if (name.empty() || name.find('/') != std::string::npos || fs::exists(name, ignored)) return name;
+  const bool has_extension = name.ends_with(".h5");
+  const std::string stem = has_extension ? name.substr(0, name.size() - 3) : name;
+  const std::string dir = shipped_models_directory();
+  if (!dir.empty() && fs::is_regular_file(fs::path(dir) / (stem + ".h5"), ignored)) return (fs::path(dir) / (stem + ".h5")).string();
+  if (has_extension) return name;  // a file name: opening it says it is missing
+  std::string shipped;
+  for (const auto& n : shipped_model_names()) shipped += (shipped.empty() ? "" : ", ") + n;
+  throw Error("model '" + name + "': no such file here, and no shipped model of that name (" +
+              (dir.empty() ? std::string("no shipped models found; set MUFRIC_MODELS_DIR")
+                           : "shipped, in " + dir + ": " + (shipped.empty() ? std::string("none") : shipped)) +
+              ")");
+}
+
+}  // namespace
+
 std::string model_path_from_uri(const std::string& uri) {
   const std::string file_scheme = "file://";
-  if (uri.rfind(file_scheme, 0) == 0) return uri.substr(file_scheme.size());
+  if (uri.rfind(file_scheme, 0) == 0) return shipped_model_path(uri.substr(file_scheme.size()));
   const auto scheme_end = uri.find("://");
   if (scheme_end != std::string::npos) {
     throw Error("model URI '" + uri + "': scheme '" + uri.substr(0, scheme_end) +
-                "' is not handled here; use file:///path/model.h5 or a plain path");
+                "' is not handled here; use file:///path/model.h5, a plain path or a shipped model's name");
   }
-  return uri;
+  return shipped_model_path(uri);
 }
 
 // ---- Coulomb -------------------------------------------------------------------------------

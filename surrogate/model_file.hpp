@@ -5,6 +5,7 @@
 // Loading validates everything and refuses a corrupt or incompatible file naming the field.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/isolation.hpp"
 #include "surrogate/friction_model.hpp"
@@ -30,7 +31,18 @@ std::unique_ptr<FrictionModel> load_model(const std::string& path);
 // the HDF5 library becomes an Error naming it. For the CLI and the server, not for a meso code.
 std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, const IsolationLimits& limits = {});
 
+// The models shipped with mufric (models/*.h5 of the source tree, installed to
+// <prefix>/share/mufric/models): $MUFRIC_MODELS_DIR if set, else the first that exists of
+// share/mufric/models beside the running executable's prefix, the configured install prefix's, and
+// the source tree's; "" when there is none.
+std::string shipped_models_directory();
+// The stems of the shipped models ("dry_default", ...), sorted; empty without a directory.
+std::vector<std::string> shipped_model_names();
+
 // "file:///abs/model.h5", "file://rel/model.h5" or a plain path → the path; other schemes throw.
+// A bare name (no '/') that is not a file here names a shipped model: "dry_default" (or
+// "dry_default.h5") → <shipped directory>/dry_default.h5; a bare name without ".h5" that is neither
+// throws, listing the shipped models.
 std::string model_path_from_uri(const std::string& uri);
 
 }  // namespace mufric

@@ -74,7 +74,7 @@ class Cli : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
-// `mufric serve --models DIR` in a child process on a free loopback port, its stderr in LOG;
+// `mufric serve --models DIR` (DIR "": no --models) in a child process on a free loopback port, its stderr in LOG;
 // `launcher` goes before the executable ({"taskset", "-c", "0"}).
 class ServeProcess {
  public:
@@ -86,7 +86,8 @@ class ServeProcess {
       unsetenv("GOMP_SPINCOUNT");  // as a user who chose no wait policy
       unsetenv("OMP_WAIT_POLICY");
       std::vector<std::string> words = launcher;
-      words.insert(words.end(), {MUFRIC_EXE, "serve", "--models", models, "--listen", "127.0.0.1:0", "--ready-file", ready_file});
+      words.insert(words.end(), {MUFRIC_EXE, "serve", "--listen", "127.0.0.1:0", "--ready-file", ready_file});
+      if (!models.empty()) words.insert(words.end(), {"--models", models});  // none: the shipped models
       std::vector<char*> argv;
       for (std::string& word : words) argv.push_back(word.data());
       argv.push_back(nullptr);
@@ -286,6 +287,47 @@ TEST_F(Cli, PredictSaysWhyAPointHasNoAnswerAndAnswersACsv) {
   EXPECT_NE(answers.find("mu,std,lo,hi,status,reason"), std::string::npos) << answers;
   EXPECT_NE(answers.find("80,10,90,0.221001"), std::string::npos) << answers;  // Table 4 at 90°, as above
   EXPECT_NE(answers.find("INVALID_INPUT,\"contact_pressure: -5MPa"), std::string::npos) << answers;
+}
+
+// The shipped model (models/dry_default.h5) is what `train` makes of the committed campaign database
+// with its defaults (campaigns/dry_default/train.sh): retrained, it gives the same answers, interval and
+// patch scatter, inside and outside the box. A bare name finds it in every command; a wrong one is
+// named with the shipped models.
+TEST_F(Cli, TheShippedModelIsTheCampaignsFit) {
+  ::setenv("MUFRIC_MODELS_DIR", MUFRIC_SOURCE_DIR "/models", 1);
+  CommandResult r = run(std::string("train --data ") + MUFRIC_SOURCE_DIR "/campaigns/dry_default/db.h5 --out " +
+                        path("refit.h5") + " --fast-max-seconds 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ofstream points(path("q.csv"));
+  points << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C]\n";
+  for (int i = 0; i < 40; ++i) {  // a lattice over the box and beyond it on every side
+    points << 100 + 90 * i << "," << 0.5 + 55 * i << "," << 10 + 25 * (i % 40) << "\n";
+  }
+  points.close();
+  r = run("predict --model dry_default --csv " + path("q.csv") + " --out " + path("shipped.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run("predict --model " + path("refit.h5") + " --csv " + path("q.csv") + " --out " + path("refit.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string shipped = read_text(path("shipped.csv"));
+  EXPECT_NE(shipped.find("patch_std"), std::string::npos) << shipped;
+  EXPECT_EQ(shipped, read_text(path("refit.csv")));
+  r = run("describe dry_default");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("averaged over all draws"), std::string::npos) << r.output;
+  {  // `serve` without --models serves it
+    ServeProcess server("", path("serve.log"), path("ready"));
+    ASSERT_FALSE(server.address().empty()) << read_text(path("serve.log"));
+    r = run("predict --model grpc://" + server.address() + "/dry_default --p 800MPa --v 100m/min --T 500C");
+    const CommandResult local = run("predict --model dry_default --p 800MPa --v 100m/min --T 500C");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output, local.output);
+    EXPECT_NE(read_text(path("serve.log")).find("serving the shipped models in"), std::string::npos);
+  }
+  r = run("describe dry_defualt");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("no shipped model of that name"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(": dry_default)"), std::string::npos) << r.output;
+  ::unsetenv("MUFRIC_MODELS_DIR");
 }
 
 TEST_F(Cli, NumberWithoutUnitNamesTheFlag) {

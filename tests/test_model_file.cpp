@@ -279,6 +279,33 @@ TEST(ModelFile, UriSchemes) {
   EXPECT_THROW(model_path_from_uri("s3://bucket/m.h5"), Error);
 }
 
+// A bare name that is not a file here is a shipped model's (MUFRIC_MODELS_DIR first); a path, a file
+// here or a missing "*.h5" stays what it is; an unknown bare name is an error listing the shipped ones.
+TEST(ModelFile, ABareNameIsAShippedModel) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("mufric_shipped_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "dry_default.h5") << "x";
+  std::ofstream(dir / "wet.h5") << "x";
+  ::setenv("MUFRIC_MODELS_DIR", dir.c_str(), 1);
+  EXPECT_EQ(shipped_models_directory(), dir.string());
+  EXPECT_EQ(shipped_model_names(), (std::vector<std::string>{"dry_default", "wet"}));
+  const std::string shipped = (dir / "dry_default.h5").string();
+  EXPECT_EQ(model_path_from_uri("dry_default"), shipped);
+  EXPECT_EQ(model_path_from_uri("dry_default.h5"), shipped);
+  EXPECT_EQ(model_path_from_uri("file://dry_default"), shipped);
+  EXPECT_EQ(model_path_from_uri("elsewhere/dry_default"), "elsewhere/dry_default");
+  EXPECT_EQ(model_path_from_uri("missing.h5"), "missing.h5");
+  try {
+    model_path_from_uri("dry_defualt");
+    ADD_FAILURE() << "an unknown name was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(": dry_default, wet)"), std::string::npos) << e.what();
+  }
+  ::unsetenv("MUFRIC_MODELS_DIR");
+  fs::remove_all(dir);
+}
+
 
 GaussianProcess gp_with_fast_evaluator(unsigned data_seed) {
   GaussianProcess gp = test::fixed_hyper_gp(80, data_seed, 1.0, {0.5, 0.6, 0.7}, 1e-3);
