@@ -47,4 +47,13 @@ PYTHONPATH=build/python /usr/bin/python3 examples/python/meso_trace.py "$(cat "$
   --points 2000 --increments 50 --dataset "$out/db.h5" --plot "$out/mu-over-box.png"
 kill -TERM $server && wait $server || true
 trap - EXIT
+
+echo; echo "== 3. The shipped model (dry_default: the default 64 x 12 scene's campaign, stochastic kriging)"
+$mufric describe dry_default | grep -E "training points|leave-one-out"
+for state in "300MPa 22.5m/min 25C" "800MPa 100m/min 500C" "1300MPa 200m/min 900C" "2500MPa 1000m/min 700C"; do
+  read -r p v t <<<"$state"
+  printf '%-8s %-10s %-6s ' "$p" "$v" "$t"
+  $mufric predict --model dry_default --p "$p" --v "$v" --T "$t" | sed -n -e '2s/ *status.*//p' -e '3s/:.*//p' | paste -sd ' ' 
+done
+/usr/bin/python3 bench/plot_model.py "$mufric" dry_default "$out/dry_default.png"
 echo; echo "files: $(ls "$out" | tr '\n' ' ')in $out/"
