@@ -1,5 +1,6 @@
-// `mufric micro …`: the micro-model's user-facing steps. So far: surface profiles (measured or
-// synthetic), their roughness and their periodic spline fit.
+// `mufric micro profile / run / check / converge / fluid-check`: the micro-model's user-facing steps
+// (surface profiles and their fit, one run dry or lubricated, its cost before it runs, mesh and
+// protocol convergence, the flow solver's benchmark). The work is micro/'s; here flags are parsed.
 #include <chrono>
 #include <cmath>
 #include <functional>

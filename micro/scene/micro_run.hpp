@@ -1,9 +1,10 @@
 #pragma once
-// One high-fidelity dry run (seed 000 sections 3.1 and 4): the chip interval, pressed with p on Γ_B
-// against the rigid rough tool and dragged at v, at initial temperature T; μ by eq. (17) from the
-// contact tractions at every step, averaged over a window (scene.protocol: seed 000's time window
-// while the load ramps, or press-slide's sliding-distance window after pressing). measure_mu repeats
-// the run over tool phases and realisations and reports the mean with its standard error.
+// One high-fidelity run, dry or lubricated (seed 000 sections 3.1 and 4): the chip interval,
+// pressed with p on Γ_B against the rigid rough tool and dragged at v, at initial temperature T; μ
+// by eq. (17) from the contact tractions at every step, averaged over a window (scene.protocol:
+// seed 000's time window while the load ramps, or press-slide's sliding-distance window after
+// pressing). measure_mu repeats the run over tool phases and realisations and reports the mean with
+// its standard error.
 #include <chrono>
 #include <cstdint>
 #include <functional>

@@ -51,8 +51,9 @@ struct SideLoad {
   TimeFunction scale;     // empty: 1
 };
 
-// Forces on the boundary that depend on the displacement (contact, later fluid loads): added to the
-// internal forces and the tangent by SolidProblem::assemble. Implemented beneath in contact/.
+// Forces on the boundary that depend on the displacement: added to the internal forces and the
+// tangent by SolidProblem::assemble. Implemented above solid/: contact/MortarContact (the rough
+// tool) and coupling/NodalLoad (the lubricant's tractions on the chip).
 class BoundaryInteraction {
  public:
   virtual ~BoundaryInteraction() = default;
