@@ -15,7 +15,9 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/units.hpp"
 #include "mufric/v1/friction.grpc.pb.h"
+#include "proto/wire_codec.hpp"
 #include "surrogate/gaussian_process.hpp"
 #include "surrogate/model_file.hpp"
 
@@ -255,25 +257,13 @@ class GrpcClient final : public FrictionClient {
                                            const EvaluationRequest& what) const {
     mufric::v1::EvaluateRequest request;
     request.set_model(model_);
-    auto add = [&](const double* values, google::protobuf::RepeatedField<double>* field) {
-      if (values) field->Assign(values + first, values + first + count);
-    };
-    add(block.contact_pressure, request.mutable_contact_pressure());
-    add(block.sliding_velocity, request.mutable_sliding_velocity());
-    add(block.temperature, request.mutable_temperature());
-    add(block.fibre_angle, request.mutable_fibre_angle());
-    request.set_std(what.std);
-    request.set_ci_level(what.ci_level);
-    request.set_gradient(what.gradient);
-    request.set_patch_std(what.patch_std);
-    request.set_extrapolation(static_cast<mufric::v1::Extrapolation>(what.extrapolation));
-    if (what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0) {
-      request.set_mu_tolerance(-1.0);  // the exact model only
-      request.set_std_tolerance(-1.0);
-    } else {
-      request.set_mu_tolerance(what.mu_tolerance);
-      request.set_std_tolerance(what.std_relative_tolerance);
+    for (const std::string& name : known_input_names()) {
+      const auto field = Block::field_for(name);
+      const double* values = field ? block.*field : nullptr;
+      auto* array = wire::mutable_input_array(request, name);
+      if (values && array) array->Assign(values + first, values + first + count);
     }
+    wire::encode_options(what, request);
     return request;
   }
 

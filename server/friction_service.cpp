@@ -6,29 +6,20 @@
 
 #include <omp.h>
 
+#include "common/units.hpp"
 #include "common/version.hpp"
+#include "proto/wire_codec.hpp"
 #include "surrogate/gaussian_process.hpp"
 
 // The wire's enums are the model's, value for value.
 static_assert(static_cast<int>(mufric::Extrapolation::raw) == mufric::v1::EXTRAPOLATION_RAW);
 static_assert(static_cast<int>(mufric::Extrapolation::clamp) == mufric::v1::EXTRAPOLATION_CLAMP);
-static_assert(static_cast<int>(mufric::Extrapolation::refuse) == mufric::v1::EXTRAPOLATION_REFUSE);
-static_assert(static_cast<int>(mufric::PointStatus::out_of_box) == mufric::v1::POINT_STATUS_OUT_OF_BOX);
-
 namespace mufric::server {
 namespace {
 
 using mufric::v1::EvaluateRequest;
 
-const google::protobuf::RepeatedField<double>* input_array(const EvaluateRequest& request, const std::string& name) {
-  if (name == "contact_pressure") return &request.contact_pressure();
-  if (name == "sliding_velocity") return &request.sliding_velocity();
-  if (name == "temperature") return &request.temperature();
-  if (name == "fibre_angle") return &request.fibre_angle();
-  return nullptr;
-}
-
-constexpr const char* kWireInputs[] = {"contact_pressure", "sliding_velocity", "temperature", "fibre_angle"};
+using wire::input_array;
 
 void add_model_summaries(const ModelRegistry& registry,
                          google::protobuf::RepeatedPtrField<mufric::v1::ModelSummary>& summaries) {
@@ -83,9 +74,10 @@ grpc::Status batch_from_request(const EvaluateRequest& request, const InputSpace
     const auto* array = input_array(request, inputs[j].name);
     batch.col(static_cast<Eigen::Index>(j)) = Eigen::Map<const Eigen::VectorXd>(array->data(), points);
   }
-  for (const char* name : kWireInputs) {
+  for (const std::string& name : known_input_names()) {
     const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == name; });
-    if (!used && !input_array(request, name)->empty()) ignored.emplace_back(name);
+    const auto* array = input_array(request, name);
+    if (!used && array != nullptr && !array->empty()) ignored.emplace_back(name);
   }
   return grpc::Status::OK;
 }
@@ -106,15 +98,14 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
   out.set_extrapolation(static_cast<mufric::v1::Extrapolation>(model.default_extrapolation()));
   out.set_mu_min(model.mu_min());
   out.set_mu_max(model.mu_max());
-  if (const auto* gp = dynamic_cast<const GaussianProcess*>(&model)) {
-    const auto& state = gp->state();
-    out.set_training_points(static_cast<uint64_t>(state.x_train.rows()));
-    out.set_loo_mean_relative_error(state.summary.loo_mean_relative_error);
-    out.set_loo_max_relative_error(state.summary.loo_max_relative_error);
-    out.set_loo_coverage_95(state.summary.loo_coverage_95);
-    out.set_interval_meaning(gp_interval_meaning(gp->interval_meaning()));
-    out.set_interval(std::string(to_string(gp->interval_meaning())));
-    out.set_micro_std_error(state.micro_std_error);
+  if (const auto training = model.training_description()) {
+    out.set_training_points(static_cast<uint64_t>(training->training_points));
+    out.set_loo_mean_relative_error(training->loo_mean_relative_error);
+    out.set_loo_max_relative_error(training->loo_max_relative_error);
+    out.set_loo_coverage_95(training->loo_coverage_95);
+    out.set_interval_meaning(training->interval_meaning);
+    out.set_interval(training->interval);
+    out.set_micro_std_error(training->micro_std_error);
   }
   out.set_has_patch_scatter(model.has_patch_scatter());
   out.set_summary(model.summary());
@@ -134,9 +125,9 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
     return {grpc::StatusCode::NOT_FOUND, "model '" + request.model() + "' version " + request.version() +
                                              " is not served; the current version is " + served->version};
   }
-  if (request.ci_level() != 0.0 && !(request.ci_level() > 0.0 && request.ci_level() < 1.0)) {
-    return {grpc::StatusCode::INVALID_ARGUMENT, "field ci_level must lie in (0, 1) or be 0, got " +
-                                                    std::to_string(request.ci_level())};
+  EvaluationRequest what;
+  if (const std::string why = wire::decode_options(request, what); !why.empty()) {
+    return {grpc::StatusCode::INVALID_ARGUMENT, why};
   }
   const FrictionModel& model = *served->model;
   QueryBatch batch;
@@ -146,23 +137,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   const auto n = static_cast<int>(batch.rows());
   response.set_model(served->name);
   response.set_version(served->version);
-  if (!std::isfinite(request.mu_tolerance()) || !std::isfinite(request.std_tolerance())) {
-    return {grpc::StatusCode::INVALID_ARGUMENT, "fields mu_tolerance and std_tolerance must be finite"};
-  }
-  EvaluationRequest what{
-      .std = request.std(), .ci_level = request.ci_level(), .gradient = request.gradient(), .patch_std = request.patch_std()};
   const bool patch = what.patch_std && model.has_patch_scatter();
-  if (!mufric::v1::Extrapolation_IsValid(request.extrapolation())) {
-    return {grpc::StatusCode::INVALID_ARGUMENT,
-            "field extrapolation: unknown value " + std::to_string(static_cast<int>(request.extrapolation()))};
-  }
-  what.extrapolation = static_cast<Extrapolation>(request.extrapolation());
-  if (request.mu_tolerance() < 0.0 || request.std_tolerance() < 0.0) {
-    what.mu_tolerance = what.std_relative_tolerance = 0.0;  // the exact model only
-  } else {
-    if (request.mu_tolerance() > 0.0) what.mu_tolerance = request.mu_tolerance();
-    if (request.std_tolerance() > 0.0) what.std_relative_tolerance = request.std_tolerance();
-  }
   UncertainQueryLog* const log = model.has_uncertainty() ? limits_.uncertain_log : nullptr;
   EvaluationRequest computed = what;
   computed.std = what.std || log != nullptr;

@@ -3,6 +3,7 @@
 // the client and the CLI never care which kind of model answers.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,6 +69,16 @@ struct Evaluation {
   long long range_clipped = 0;      // points whose μ (or interval) was clipped to the model's μ range
 };
 
+// What a trained model knows of its training, for `describe` and the service's DescribeModel; a law
+// has none (FrictionModel::training_description).
+struct TrainingDescription {
+  long long training_points = 0;
+  double loo_mean_relative_error = 0.0, loo_max_relative_error = 0.0, loo_coverage_95 = 0.0;
+  std::string interval;          // what the interval means, by name: new-run, shared-scatter, mean-over-draws
+  std::string interval_meaning;  // the same in words
+  double micro_std_error = 0.0;  // the shared scatter added to every interval (0: none)
+};
+
 class FrictionModel {
  public:
   virtual ~FrictionModel() = default;
@@ -98,6 +109,8 @@ class FrictionModel {
 
   // Free text: provenance, accuracy figures (shown by describe/train).
   virtual std::string summary() const = 0;
+  // Its training, for a model that was trained; nothing for a law.
+  virtual std::optional<TrainingDescription> training_description() const { return std::nullopt; }
 
  protected:
   explicit FrictionModel(InputSpace inputs) : inputs_(std::move(inputs)) {}

@@ -1,0 +1,30 @@
+#pragma once
+// The one translation between the in-process evaluation types (surrogate/friction_model.hpp) and the
+// wire (proto/mufric/v1/friction.proto), shared by the C++ client and the server: which request
+// array carries which model input, and what to compute with which tolerances. Each side used to
+// spell these itself, and "use the exact model" had three encodings.
+#include <string>
+#include <string_view>
+
+#include "mufric/v1/friction.pb.h"
+#include "surrogate/friction_model.hpp"
+
+namespace mufric::wire {
+
+// The request's array that carries a named model input (common/units.hpp known_input_names());
+// nullptr for a name the wire does not carry.
+const google::protobuf::RepeatedField<double>* input_array(const v1::EvaluateRequest& request, std::string_view name);
+google::protobuf::RepeatedField<double>* mutable_input_array(v1::EvaluateRequest& request, std::string_view name);
+
+// On the wire a negative tolerance asks for the exact model only (EvaluationRequest: either
+// tolerance 0), and 0 (a field a client did not set) leaves the server's default.
+inline constexpr double kExactModelOnly = -1.0;
+
+// What to compute (std, interval, gradient, patch scatter), the tolerances and the extrapolation
+// policy, onto the wire.
+void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out);
+// The wire's options as an EvaluationRequest (its defaults where the wire leaves them); "" or the
+// reason a request is invalid, naming the field.
+std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& what);
+
+}  // namespace mufric::wire
