@@ -40,9 +40,10 @@ void add_service_commands(CLI::App& app) {
   add_status_command(app);
   auto o = std::make_shared<server::ServerOptions>();
   auto* cmd = app.add_subcommand("serve", "Serve every model file (*.h5) of a directory over gRPC");
+  const std::string shipped = shipped_models_directory();
   cmd->add_option("--models", o->models_directory,
                   "Directory of model files; the name of a model is its file stem (default: the shipped models, " +
-                      (shipped_models_directory().empty() ? std::string("none found") : shipped_models_directory()) + ")");
+                      (shipped.empty() ? std::string("none found") : shipped) + ")");
   cmd->add_option("--listen", o->listen, "Address to listen on (port 0: any free port)")->capture_default_str();
   cmd->add_option("--poll", o->poll_seconds, "Seconds between rescans of the directory for new or changed files")
       ->capture_default_str()->check(FiniteRange(0.05, 3600.0));
@@ -76,9 +77,9 @@ void add_service_commands(CLI::App& app) {
               "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
               "server reflection are on. Logs go to stderr, one line per event. A call whose deadline passes (or that\n"
               "the client cancels) stops within a few thousand points and answers DEADLINE_EXCEEDED (CANCELLED).");
-  cmd->callback([o] {
+  cmd->callback([o, shipped] {
     if (o->models_directory.empty()) {
-      o->models_directory = shipped_models_directory();
+      o->models_directory = shipped;
       if (o->models_directory.empty()) {
         throw Error("serve: no --models directory given and no shipped models found (set MUFRIC_MODELS_DIR)");
       }

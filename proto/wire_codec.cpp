@@ -4,6 +4,9 @@
 
 namespace mufric::wire {
 
+// The wire's enums are the model's, value for value: the codec and the server cast between them.
+static_assert(static_cast<int>(Extrapolation::raw) == v1::EXTRAPOLATION_RAW);
+static_assert(static_cast<int>(Extrapolation::clamp) == v1::EXTRAPOLATION_CLAMP);
 static_assert(static_cast<int>(Extrapolation::refuse) == v1::EXTRAPOLATION_REFUSE);
 static_assert(static_cast<int>(PointStatus::out_of_box) == v1::POINT_STATUS_OUT_OF_BOX);
 
@@ -16,11 +19,9 @@ const google::protobuf::RepeatedField<double>* input_array(const v1::EvaluateReq
 }
 
 google::protobuf::RepeatedField<double>* mutable_input_array(v1::EvaluateRequest& request, std::string_view name) {
-  if (name == "contact_pressure") return request.mutable_contact_pressure();
-  if (name == "sliding_velocity") return request.mutable_sliding_velocity();
-  if (name == "temperature") return request.mutable_temperature();
-  if (name == "fibre_angle") return request.mutable_fibre_angle();
-  return nullptr;
+  // One table of names: a repeated scalar field has no presence bit, so its const accessor's field
+  // is the very one mutable_x() returns.
+  return const_cast<google::protobuf::RepeatedField<double>*>(input_array(request, name));
 }
 
 void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out) {
@@ -29,9 +30,8 @@ void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out) {
   out.set_gradient(what.gradient);
   out.set_patch_std(what.patch_std);
   out.set_extrapolation(static_cast<v1::Extrapolation>(what.extrapolation));
-  const bool exact = what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0;
-  out.set_mu_tolerance(exact ? kExactModelOnly : what.mu_tolerance);
-  out.set_std_tolerance(exact ? kExactModelOnly : what.std_relative_tolerance);
+  out.set_mu_tolerance(what.exact_only() ? kExactModelOnly : what.mu_tolerance);
+  out.set_std_tolerance(what.exact_only() ? kExactModelOnly : what.std_relative_tolerance);
 }
 
 std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& what) {

@@ -11,9 +11,6 @@
 #include "proto/wire_codec.hpp"
 #include "surrogate/gaussian_process.hpp"
 
-// The wire's enums are the model's, value for value.
-static_assert(static_cast<int>(mufric::Extrapolation::raw) == mufric::v1::EXTRAPOLATION_RAW);
-static_assert(static_cast<int>(mufric::Extrapolation::clamp) == mufric::v1::EXTRAPOLATION_CLAMP);
 namespace mufric::server {
 namespace {
 

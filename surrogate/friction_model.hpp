@@ -49,6 +49,9 @@ struct EvaluationRequest {
   double std_relative_tolerance = 1e-3;   // of σ, i.e. of the interval's half-width
   // Points outside the training box: model_default is the policy the model file declares.
   Extrapolation extrapolation = Extrapolation::model_default;
+
+  // Either tolerance 0: the exact model only, no fast evaluator anywhere.
+  bool exact_only() const { return mu_tolerance <= 0.0 || std_relative_tolerance <= 0.0; }
 };
 
 // A batch of query points, structure-of-arrays: column j of an m × d column-major matrix is the

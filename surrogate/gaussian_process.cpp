@@ -424,9 +424,8 @@ Eigen::VectorXd GaussianProcess::patch_std(const QueryBatch& x, double std_relat
 }
 
 Eigen::VectorXd GaussianProcess::patch_std_valid(const QueryBatch& x, const EvaluationRequest& what) const {
-  // The request's "0 (either): exact" convention of EvaluationRequest, and σ's relative tolerance.
-  const bool exact = what.mu_tolerance <= 0.0 || what.std_relative_tolerance <= 0.0;
-  return patch_std(x, exact ? 0.0 : what.std_relative_tolerance);
+  // patch_std is a standard deviation: held to σ's relative tolerance.
+  return patch_std(x, what.exact_only() ? 0.0 : what.std_relative_tolerance);
 }
 
 Eigen::VectorXd GaussianProcess::std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x,

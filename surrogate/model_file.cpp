@@ -215,7 +215,9 @@ std::string shipped_model_path(const std::string& name) {
   const bool has_extension = name.ends_with(".h5");
   const std::string stem = has_extension ? name.substr(0, name.size() - 3) : name;
   const std::string dir = shipped_models_directory();
-  if (!dir.empty() && fs::is_regular_file(fs::path(dir) / (stem + ".h5"), ignored)) return (fs::path(dir) / (stem + ".h5")).string();
+  if (const fs::path shipped = fs::path(dir) / (stem + ".h5"); !dir.empty() && fs::is_regular_file(shipped, ignored)) {
+    return shipped.string();
+  }
   if (has_extension) return name;  // a file name: opening it says it is missing
   std::string shipped;
   for (const auto& n : shipped_model_names()) shipped += (shipped.empty() ? "" : ", ") + n;
