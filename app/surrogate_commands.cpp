@@ -48,7 +48,9 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
                 theta_text(start.initial_log).c_str(),
                 theta_text(start.final_log).c_str());
   }
-  std::printf("best: start %d, log marginal likelihood %.6f\n", report.best_start, s.summary.log_marginal_likelihood);
+  std::printf("best: start %d, %s %.6f\n", report.best_start,
+              s.mean_estimated ? "log restricted likelihood (REML, the mean estimated)" : "log marginal likelihood",
+              s.summary.log_marginal_likelihood);
   std::printf("hyper-parameters:\n  signal variance %.6g (normalised mu units)\n", s.hyper.signal_variance);
   for (size_t j = 0; j < s.inputs.size(); ++j) {
     const auto& input = s.inputs[j];

@@ -126,6 +126,26 @@ GaussianProcess::GaussianProcess(State state) : FrictionModel(state.inputs), sta
   inverse_factor_ = inverse;
   row_split_ = static_cast<Eigen::Index>(static_cast<double>(n) / std::sqrt(2.0));
   weights_by_input_ = scaled_train_.array().colwise() * weights_.array();
+  if (state_.mean_estimated) {
+    trend_direction_ = inverse_factor_.triangularView<Eigen::Lower>() * Eigen::VectorXd::Ones(n);
+    trend_precision_ = trend_direction_.squaredNorm();
+    require(std::isfinite(trend_precision_) && trend_precision_ > 0.0, "the estimated mean's precision 1ᵀK⁻¹1 is not positive");
+  }
+}
+
+double GaussianProcess::normalised_variance(double squared_norm, double trend_dot) const {
+  // σ² + σn² − σ⁴ |L⁻¹ k̂|²  (R&W Algorithm 2.1, lines 5–6), plus the micro-model's own scatter
+  // (State::micro_std_error), or σ² alone for the mean over draws; plus an estimated mean's variance
+  // (1 − σ² 1ᵀK⁻¹k̂)² / 1ᵀK⁻¹1 (State::mean_estimated).
+  const double s2 = state_.hyper.signal_variance;
+  const double scatter = state_.micro_std_error / state_.y_scale;
+  const double prior = state_.interval_of_mean ? s2 : s2 + state_.hyper.noise_variance + scatter * scatter;
+  double variance = prior - s2 * s2 * squared_norm;
+  if (state_.mean_estimated) {
+    const double unexplained = 1.0 - s2 * trend_dot;
+    variance += unexplained * unexplained / trend_precision_;
+  }
+  return variance;
 }
 
 void GaussianProcess::correlations_with_training(const Eigen::RowVectorXd& scaled_query,
@@ -183,11 +203,9 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
   }
 
   if (need_std) {
-    // var_b = σ² + σn² − σ⁴ |L⁻¹ k̂_b|²  (R&W Algorithm 2.1, lines 5–6), in normalised units, plus
-    // the micro-model's own scatter (GaussianProcess::State::micro_std_error).
-    Eigen::RowVectorXd norms2;
+    Eigen::Matrix<double, 2, Eigen::Dynamic> norms;
     if (count <= kRowByRowMaxQueries) {
-      norms2 = squared_norms_row_by_row(k_block, what.max_threads);
+      norms = norms_row_by_row(k_block, what.max_threads);
     } else {
 #if defined(__AVX2__)
       // A build for a vector ISA (MUFRIC_NATIVE): Eigen's product, compiled for it, is the faster one
@@ -208,13 +226,16 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
       dtrmm_(&side, &upper, &transpose, &non_unit, &rows, &columns, &one, inverse_factor_.data(), &rows, v_block.data(),
              &rows);
 #endif
-      norms2 = v_block.leftCols(count).colwise().squaredNorm();
+      norms.resize(2, count);
+      norms.row(0) = v_block.leftCols(count).colwise().squaredNorm();
+      if (state_.mean_estimated) {
+        norms.row(1) = trend_direction_.transpose() * v_block.leftCols(count);
+      } else {
+        norms.row(1).setZero();
+      }
     }
-    const double s2 = state_.hyper.signal_variance;
-    const double scatter = state_.micro_std_error / state_.y_scale;
-    const double prior = state_.interval_of_mean ? s2 : s2 + state_.hyper.noise_variance + scatter * scatter;
     for (Eigen::Index b = 0; b < count; ++b) {
-      double variance = prior - s2 * s2 * norms2(b);
+      double variance = normalised_variance(norms(0, b), norms(1, b));
       if (variance < 0.0) {
         variance = 0.0;
         ++clamped;
@@ -237,11 +258,13 @@ int evaluation_team_size(int max_threads) {
   return max_threads > 0 ? std::min(max_threads, available) : available;
 }
 
-Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::MatrixXd& kernels, int max_threads) const {
+Eigen::Matrix<double, 2, Eigen::Dynamic> GaussianProcess::norms_row_by_row(const Eigen::MatrixXd& kernels,
+                                                                            int max_threads) const {
   const Eigen::Index n = scaled_train_.rows();
   const Eigen::Index count = kernels.cols();
+  const bool trend = state_.mean_estimated;
   auto rows = [&](Eigen::Index begin, Eigen::Index end) {
-    Eigen::RowVectorXd sums = Eigen::RowVectorXd::Zero(count);
+    Eigen::Matrix<double, 2, Eigen::Dynamic> sums = Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, count);
     if (count == 1) {  // a plain dot product per row: no matrix–vector call overhead
       for (Eigen::Index i = begin; i < end; ++i) {
 #if defined(__AVX2__)
@@ -251,20 +274,22 @@ Eigen::RowVectorXd GaussianProcess::squared_norms_row_by_row(const Eigen::Matrix
         // A portable build: the run-time-dispatched kernel (1.4× Eigen's SSE2 dot on AVX-512).
         const double v = gp_kernels::lane_dot(inverse_factor_.row(i).data(), kernels.col(0).data(), i + 1);
 #endif
-        sums(0) += v * v;
+        sums(0, 0) += v * v;
+        if (trend) sums(1, 0) += trend_direction_(i) * v;
       }
       return sums;
     }
     Eigen::RowVectorXd v(count);
     for (Eigen::Index i = begin; i < end; ++i) {
       v.noalias() = inverse_factor_.row(i).head(i + 1) * kernels.topRows(i + 1);
-      sums += v.cwiseAbs2();
+      sums.row(0) += v.cwiseAbs2();
+      if (trend) sums.row(1) += trend_direction_(i) * v;
     }
     return sums;
   };
   const double bytes = 4.0 * static_cast<double>(n) * static_cast<double>(n);
   if (bytes <= kSplitRowsAboveBytes || evaluation_team_size(max_threads) < 2) return rows(0, n);
-  Eigen::RowVectorXd halves[2];
+  Eigen::Matrix<double, 2, Eigen::Dynamic> halves[2];
 #pragma omp parallel num_threads(2)
   {
     const int t = omp_get_thread_num();
@@ -479,6 +504,10 @@ std::string GaussianProcess::summary() const {
       << (state_.micro_std_error > 0.0 ? ", added to every interval as the shared scatter" : "") << "\n";
   }
   s << "  interval: " << gp_interval_meaning(interval_meaning()) << "\n";
+  s << "  constant mean " << state_.y_mean
+    << (state_.mean_estimated ? ": estimated by generalised least squares, its variance part of the interval (ordinary kriging)"
+                              : ": the samples' average, taken as known (simple kriging)")
+    << "\n";
   if (patch_scatter_) {
     const auto& p = patch_scatter_->state();
     s << "  patch scatter: a GP of the log per-draw variance of mu on " << p.x_train.rows()
@@ -498,7 +527,8 @@ std::string GaussianProcess::summary() const {
       << " (box widths)\n";
   }
   const auto& t = state_.summary;
-  s << "  log marginal likelihood " << t.log_marginal_likelihood << "\n";
+  s << (state_.mean_estimated ? "  log restricted likelihood (REML) " : "  log marginal likelihood ") << t.log_marginal_likelihood
+    << "\n";
   s << "  leave-one-out: mean relative error " << 100.0 * t.loo_mean_relative_error << " %, max "
     << 100.0 * t.loo_max_relative_error << " %, RMSE " << t.loo_rmse << ", 95 % coverage "
     << 100.0 * t.loo_coverage_95 << " %";

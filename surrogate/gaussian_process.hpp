@@ -90,6 +90,13 @@ class GaussianProcess final : public FrictionModel {
     // eq. 7's MSE), without the learned noise or micro_std_error: both belong to a sample, not to
     // the mean. Otherwise new_run or shared_scatter, by micro_std_error.
     bool interval_of_mean = false;
+    // Ordinary kriging: y_mean is the constant mean estimated by generalised least squares from the
+    // data, β̂ = 1ᵀK⁻¹y / 1ᵀK⁻¹1, and every served variance adds that estimate's own, (1 − 1ᵀK⁻¹k)² /
+    // 1ᵀK⁻¹1 (Ankenman, Nelson & Staum 2010, eqs. 7–8; the BLUP's MSE of Sacks, Welch, Mitchell &
+    // Wynn 1989, Stat. Sci. 4(4):409, with a constant regressor). false: y_mean is the samples' plain average, taken as known (simple kriging,
+    // scikit-learn's normalize_y), which a few samples whose signal variance sits at its lower bound
+    // make far too narrow (bench/RESULTS.md, "calibration").
+    bool mean_estimated = false;
     Eigen::VectorXd alpha;     // K⁻¹ (y − mean)/scale
     Eigen::MatrixXd cholesky;  // lower factor of K, n × n
     GpTrainingSummary summary;
@@ -160,8 +167,11 @@ class GaussianProcess final : public FrictionModel {
   // for the interval or the gradient must not change μ by a single bit (an explicit meso run and its
   // twin would part ways). Not inlined, so that every caller runs the same instructions.
   [[gnu::noinline]] double mean_from_correlations(const double* correlation) const;
-  // |L⁻¹ k_b|² for each column k_b of a few kernel vectors, reading each row of L⁻¹ once.
-  Eigen::RowVectorXd squared_norms_row_by_row(const Eigen::MatrixXd& kernels, int max_threads) const;
+  // For each column k_b of a few kernel vectors, reading each row of L⁻¹ once: |L⁻¹ k_b|² (row 0)
+  // and, with an estimated mean, uᵀ L⁻¹ k_b = 1ᵀK⁻¹k_b (row 1; 0 otherwise).
+  Eigen::Matrix<double, 2, Eigen::Dynamic> norms_row_by_row(const Eigen::MatrixXd& kernels, int max_threads) const;
+  // The normalised variance of a query from σ², |L⁻¹k̂|² and uᵀL⁻¹k̂ (k̂: its correlations).
+  double normalised_variance(double squared_norm, double trend_dot) const;
 
   State state_;
   // L⁻¹, row-major. The same n²/2 multiply-adds per query as a triangular solve with L, but without
@@ -169,6 +179,10 @@ class GaussianProcess final : public FrictionModel {
   // is a streaming matrix–vector product whose rows two cores split between their own L2 caches.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse_factor_;
   Eigen::Index row_split_ = 0;  // rows [0, split) and [split, n) hold equal halves of the entries
+  // An estimated mean's variance: u = L⁻¹1 and 1ᵀK⁻¹1 = uᵀu (normalised units), once per model, so
+  // that a query's 1ᵀK⁻¹k is one more dot product with the L⁻¹k its variance forms anyway.
+  Eigen::VectorXd trend_direction_;
+  double trend_precision_ = 0.0;
   std::shared_ptr<const FastEvaluator> fast_;
   std::shared_ptr<const GaussianProcess> patch_scatter_;
   Eigen::RowVectorXd box_lo_;

@@ -197,8 +197,8 @@ void for_each_parallel(size_t count, int threads, Work work) {
 }  // namespace
 
 LogMarginalLikelihood::LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term,
-                                             Eigen::VectorXd known_noise)
-    : x_unit_(x_unit), y_(y), noise_term_(noise_term), known_noise_(std::move(known_noise)) {}
+                                             Eigen::VectorXd known_noise, bool restricted)
+    : x_unit_(x_unit), y_(y), noise_term_(noise_term), known_noise_(std::move(known_noise)), restricted_(restricted) {}
 
 LogMarginalLikelihood::Value LogMarginalLikelihood::operator()(const Eigen::VectorXd& theta, bool with_gradient) {
   const Eigen::Index n = x_unit_.rows();
@@ -213,10 +213,24 @@ LogMarginalLikelihood::Value LogMarginalLikelihood::operator()(const Eigen::Vect
     return value;
   }
   Eigen::VectorXd alpha = factor_.triangularView<Eigen::Lower>().solve(y_);
-  const double data_fit = alpha.squaredNorm();
+  double data_fit = alpha.squaredNorm();
   factor_.triangularView<Eigen::Lower>().transpose().solveInPlace(alpha);
   const double log_det_half = factor_.diagonal().array().log().sum();
-  value.lml = -0.5 * data_fit - log_det_half - 0.5 * static_cast<double>(n) * std::log(2.0 * std::numbers::pi);
+  double contrasts = static_cast<double>(n);
+  // REML: yᵀPy with P = K⁻¹ − ggᵀ/c, g = K⁻¹1, c = 1ᵀg; −½ log c; n − 1 contrasts; α becomes Py.
+  Eigen::VectorXd g;
+  double precision = 0.0;
+  if (restricted_) {
+    g = factor_.triangularView<Eigen::Lower>().solve(Eigen::VectorXd::Ones(n));
+    precision = g.squaredNorm();
+    factor_.triangularView<Eigen::Lower>().transpose().solveInPlace(g);
+    const double beta = alpha.sum() / precision;
+    data_fit -= beta * beta * precision;
+    alpha -= beta * g;
+    contrasts -= 1.0;
+  }
+  value.lml = -0.5 * data_fit - log_det_half - 0.5 * contrasts * std::log(2.0 * std::numbers::pi);
+  if (restricted_) value.lml -= 0.5 * std::log(precision);
   if (!std::isfinite(value.lml)) {
     value.reason = "log marginal likelihood is not finite";
     return value;
@@ -224,11 +238,14 @@ LogMarginalLikelihood::Value LogMarginalLikelihood::operator()(const Eigen::Vect
   value.ok = true;
   if (!with_gradient) return value;
 
-  // ∂L/∂θ_j = ½ tr((ααᵀ − K⁻¹) ∂K/∂θ_j), summed over the lower triangle (R&W eq. 5.9).
+  // ∂L/∂θ_j = ½ tr((ααᵀ − K⁻¹) ∂K/∂θ_j), summed over the lower triangle (R&W eq. 5.9); REML: K⁻¹ → P.
   if (!inverse_from_cholesky(factor_)) {
     value.ok = false;
     value.reason = "dpotri failed on a successful Cholesky factor";
     return value;
+  }
+  if (restricted_) {
+    for (Eigen::Index j = 0; j < n; ++j) factor_.col(j).tail(n - j) -= g.tail(n - j) * (g(j) / precision);
   }
   scaled_ = x_unit_ * hyper.length_scales.cwiseInverse().asDiagonal();
   double signal_sum = 0.0;
@@ -254,10 +271,31 @@ LogMarginalLikelihood::Value LogMarginalLikelihood::operator()(const Eigen::Vect
   return value;
 }
 
+namespace {
+
+// Ordinary kriging's constant (Ankenman, Nelson & Staum 2010, eq. 7): β̂ = 1ᵀK⁻¹y / 1ᵀK⁻¹1 in
+// normalised units, folded into y_mean, and α = K⁻¹(y − β̂1); α = K⁻¹y on entry.
+void estimate_constant_mean(GaussianProcess::State& state) {
+  const Eigen::Index n = state.alpha.size();
+  Eigen::VectorXd k_inv_ones = state.cholesky.triangularView<Eigen::Lower>().solve(Eigen::VectorXd::Ones(n));
+  state.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(k_inv_ones);
+  const double beta = state.alpha.sum() / k_inv_ones.sum();
+  state.alpha -= beta * k_inv_ones;
+  state.y_mean += state.y_scale * beta;
+  state.mean_estimated = true;
+}
+
+}  // namespace
+
 void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summary) {
   const Eigen::Index n = state.x_train.rows();
   Eigen::MatrixXd inverse = state.cholesky;
   if (n < 2 || !inverse_from_cholesky(inverse)) return;
+  inverse.triangularView<Eigen::StrictlyUpper>() = inverse.transpose().eval();
+  if (state.mean_estimated) {
+    const Eigen::VectorXd k_inv_ones = inverse.rowwise().sum();
+    inverse -= k_inv_ones * k_inv_ones.transpose() / k_inv_ones.sum();
+  }
   double sum_rel = 0.0, max_rel = 0.0, sum_sq = 0.0;
   Eigen::Index covered = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -379,7 +417,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     }
     for_each_parallel(starts.size(), threads, [&](size_t s) {
       const auto t_start = std::chrono::steady_clock::now();
-      LogMarginalLikelihood coarse(x_subset, y_subset, options.noise_term, noise_subset);
+      LogMarginalLikelihood coarse(x_subset, y_subset, options.noise_term, noise_subset, options.estimate_mean);
       const LocalOptimum optimum = maximise(coarse, starts[s], options, bounds);
       report.starts[s].subset_evaluations = optimum.evaluations;
       subset_lml[s] = optimum.lml;
@@ -420,7 +458,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     const size_t s = leaders[i];
     const auto t_start = std::chrono::steady_clock::now();
     GpStartReport& r = report.starts[s];
-    LogMarginalLikelihood lml(x_unit, y, options.noise_term, state.known_noise);
+    LogMarginalLikelihood lml(x_unit, y, options.noise_term, state.known_noise, options.estimate_mean);
     if (!options.optimise || !refine[s]) {
       const auto value = lml(polish_from[s], false);
       r.final_log = polish_from[s];
@@ -481,6 +519,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   report.jitter = chol.jitter;
   state.alpha = state.cholesky.triangularView<Eigen::Lower>().solve(y);
   state.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(state.alpha);
+  if (options.estimate_mean) estimate_constant_mean(state);
 
   auto& summary = state.summary;
   summary.log_marginal_likelihood = best.log_marginal_likelihood;

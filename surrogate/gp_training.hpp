@@ -46,6 +46,10 @@ struct GpTrainingOptions {
   // whose errors are independent, on the diagonal (stochastic kriging) or in the learned noise (one
   // draw per sample). micro_std_error is then 0.
   bool interval_of_mean = false;
+  // Estimate the constant mean by generalised least squares and charge its variance to every
+  // interval (ordinary kriging, GaussianProcess::State::mean_estimated); false: the samples' average
+  // is the known mean (simple kriging, as scikit-learn's normalize_y).
+  bool estimate_mean = false;
   // Progress lines for long fits (thread-safe calls): when each stage starts, and during a start's
   // full-data climb at most every kTrainingProgressSeconds. May be empty.
   std::function<void(const std::string&)> progress;
@@ -79,9 +83,12 @@ struct GpTrainingReport {
 // Log marginal likelihood of normalised outputs y at unit-box inputs, and its gradient w.r.t. θ.
 class LogMarginalLikelihood {
  public:
-  // known_noise: per-point variance on the diagonal (normalised), or empty.
+  // known_noise: per-point variance on the diagonal (normalised), or empty. restricted: the
+  // likelihood of the data's contrasts, free of an unknown constant mean (REML, Patterson & Thompson
+  // 1971; Santner, Williams & Notz 2003, section 3.3): what an estimated mean is fitted with, since
+  // plain ML with the mean estimated biases σ² low by the mean's own variance, worst at a few samples.
   LogMarginalLikelihood(const Eigen::MatrixXd& x_unit, const Eigen::VectorXd& y, bool noise_term,
-                        Eigen::VectorXd known_noise = Eigen::VectorXd());
+                        Eigen::VectorXd known_noise = Eigen::VectorXd(), bool restricted = false);
 
   struct Value {
     bool ok = false;
@@ -100,6 +107,7 @@ class LogMarginalLikelihood {
   const Eigen::VectorXd& y_;
   bool noise_term_;
   Eigen::VectorXd known_noise_;
+  bool restricted_;
   Eigen::MatrixXd kf_;      // σ² R, lower triangle
   Eigen::MatrixXd factor_;  // L, then (LLᵀ)⁻¹
   Eigen::MatrixXd scaled_;  // x_unit / l
@@ -109,7 +117,9 @@ class LogMarginalLikelihood {
 GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTrainingOptions& options,
                                        GpTrainingReport* report = nullptr);
 
-// Leave-one-out figures in closed form from K⁻¹ (R&W eq. 5.12): μ₋ᵢ = yᵢ − αᵢ/[K⁻¹]ᵢᵢ, σ²₋ᵢ = 1/[K⁻¹]ᵢᵢ.
+// Leave-one-out figures in closed form from K⁻¹ (R&W eq. 5.12): μ₋ᵢ = yᵢ − αᵢ/[K⁻¹]ᵢᵢ, σ²₋ᵢ = 1/[K⁻¹]ᵢᵢ;
+// with an estimated mean, re-estimated without the point: K⁻¹ becomes P = K⁻¹ − K⁻¹11ᵀK⁻¹/1ᵀK⁻¹1 and
+// α = Py (Dubrule 1983, Math. Geol. 15(6):687, for universal kriging).
 void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summary);
 
 }  // namespace mufric

@@ -376,6 +376,7 @@ void GaussianProcess::write_group(h5::Writer& out, const std::string& group) con
   if (s.known_noise.size() != 0) out.doubles(group + "/known_noise", s.known_noise);
   out.double_attribute(group, "micro_std_error", s.micro_std_error);
   out.string_attribute(group, "interval", std::string(to_string(interval_meaning())));
+  out.string_attribute(group, "constant_mean", s.mean_estimated ? "estimated" : "average");
   out.group(summary_group);
   for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(summary_group, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryCounts) out.int_attribute(summary_group, name, s.summary.*field);
@@ -452,6 +453,13 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
     s.interval_of_mean = meaning == "mean-over-draws";
   }
 
+  // Absent (files before the trend term): the average, as known (simple kriging).
+  if (in.has_attribute(group, "constant_mean")) {
+    const std::string mean = in.string_attribute(group, "constant_mean");
+    if (mean != "estimated" && mean != "average") in.fail(group, "attribute constant_mean '" + mean + "' is not estimated or average");
+    s.mean_estimated = mean == "estimated";
+  }
+
   Eigen::MatrixXd kf;
   rbf_signal_covariance(to_unit_box(s.x_train, s.inputs), s.hyper, kf);
   // Known per-point noise belongs to the covariance the factor was made of.
@@ -488,6 +496,10 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
   const double scale = (kf.lpNorm<Eigen::Infinity>() + diagonal) * n_alpha + y.lpNorm<Eigen::Infinity>();
   if ((k_alpha - y).lpNorm<Eigen::Infinity>() > kLoadBackwardErrorTolerance * scale) {
     in.fail(group + "/alpha", "is inconsistent with x_train, y_train and the hyper-parameters (K·alpha != y)");
+  }
+  // The generalised-least-squares constant makes the residuals K-orthogonal to it: 1ᵀK⁻¹(y − β̂1) = 1ᵀα = 0.
+  if (s.mean_estimated && std::abs(s.alpha.sum()) > kAlphaRecomputeTolerance * n_alpha) {
+    in.fail(group, "attribute y_mean is not the estimated constant mean of constant_mean = estimated (sum of alpha != 0)");
   }
   if (in.has(summary_group)) {
     for (const auto& [name, field] : kSummaryNumbers) s.summary.*field = in.double_attribute(summary_group, name);

@@ -72,6 +72,51 @@ TEST(GpVerification, LogMarginalLikelihoodMatchesDenseLuFormula) {
   }
 }
 
+// The restricted likelihood against its definition: the density of n − 1 orthonormal contrasts Ay
+// (A1 = 0, AAᵀ = I), which is REML's up to −½ log n (Harville 1974, Biometrika 61(2):383).
+TEST(GpVerification, RestrictedLikelihoodIsTheDensityOfTheContrasts) {
+  const TrainingSet data = test::smooth_training_set(30, 6);
+  const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
+  const Eigen::VectorXd y = (data.mu.array() - 0.3) / 0.05;  // any offset: REML does not see it
+  const Eigen::Index n = y.size();
+  const Eigen::VectorXd known = Eigen::VectorXd::LinSpaced(n, 1e-3, 5e-2);
+  LogMarginalLikelihood reml(u, y, true, known, true);
+  GpHyperParameters h;
+  h.signal_variance = 1.8;
+  h.length_scales = Eigen::Vector3d(0.6, 0.5, 1.1);
+  h.noise_variance = 2e-3;
+  h.noise_term = true;
+  const auto value = reml(h.to_log(), false);
+  ASSERT_TRUE(value.ok) << value.reason;
+  // A: the last n − 1 columns of the Q of [1 | I], transposed.
+  Eigen::MatrixXd ones_first(n, n);
+  ones_first.col(0).setOnes();
+  ones_first.rightCols(n - 1) = Eigen::MatrixXd::Identity(n, n).leftCols(n - 1);
+  const Eigen::MatrixXd q = Eigen::HouseholderQR<Eigen::MatrixXd>(ones_first).householderQ();
+  const Eigen::MatrixXd a = q.rightCols(n - 1).transpose();
+  ASSERT_LT((a * Eigen::VectorXd::Ones(n)).norm(), 1e-12);
+  Eigen::MatrixXd k = dense_covariance(u, h, h.noise_variance);
+  k.diagonal() += known;
+  const Eigen::MatrixXd contrast_covariance = a * k * a.transpose();
+  const Eigen::VectorXd contrasts = a * y;
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(contrast_covariance);
+  const double log_det = lu.matrixLU().diagonal().array().abs().log().sum();
+  const double density = -0.5 * contrasts.dot(lu.solve(contrasts)) - 0.5 * log_det -
+                         0.5 * static_cast<double>(n - 1) * std::log(2 * std::numbers::pi);
+  EXPECT_NEAR(value.lml, density - 0.5 * std::log(static_cast<double>(n)), 1e-9 * std::abs(value.lml));
+  // Its gradient against central differences.
+  const auto with_gradient = reml(h.to_log(), true);
+  const Eigen::VectorXd theta = h.to_log();
+  constexpr double step = 1e-5;
+  for (Eigen::Index i = 0; i < theta.size(); ++i) {
+    Eigen::VectorXd plus = theta, minus = theta;
+    plus(i) += step;
+    minus(i) -= step;
+    const double fd = (reml(plus, false).lml - reml(minus, false).lml) / (2 * step);
+    EXPECT_NEAR(with_gradient.gradient(i), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "parameter " << i;
+  }
+}
+
 TEST(GpVerification, GradientMatchesCentralFiniteDifferences) {
   const TrainingSet data = test::smooth_training_set(35, 5);
   const Eigen::MatrixXd u = to_unit_box(data.x, data.inputs);
