@@ -18,7 +18,6 @@
 #include "common/units.hpp"
 #include "mufric/v1/friction.grpc.pb.h"
 #include "proto/wire_codec.hpp"
-#include "surrogate/gaussian_process.hpp"
 #include "surrogate/model_file.hpp"
 
 namespace mufric::client {
@@ -157,13 +156,6 @@ std::shared_ptr<grpc::ChannelCredentials> channel_credentials(bool tls, const Op
   return grpc::SslCredentials(ssl);
 }
 
-// Points per call: chunk_points, cut down to a multiple of the GP's query block when it is at
-// least one block, so that a point's σ has the same bits as in-process however a block is split.
-long long chunk_size(long long chunk_points) {
-  if (chunk_points < kGpQueryBlock) return std::max(1LL, chunk_points);
-  return chunk_points - chunk_points % kGpQueryBlock;
-}
-
 class GrpcClient final : public FrictionClient {
  public:
   GrpcClient(const std::string& target, std::string model, bool tls, const Options& options)
@@ -183,7 +175,7 @@ class GrpcClient final : public FrictionClient {
 
   Answer evaluate(const Block& block, const EvaluationRequest& what) override {
     Answer answer;
-    const auto chunk = static_cast<size_t>(chunk_size(options_.chunk_points));
+    const auto chunk = static_cast<size_t>(wire::bit_stable_piece(options_.chunk_points));
     for (size_t first = 0; first < block.points || first == 0; first += chunk) {
       const size_t count = std::min(chunk, block.points - first);
       const mufric::v1::EvaluateRequest request = make_request(block, first, count, what);

@@ -1,6 +1,9 @@
 #include "proto/wire_codec.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include "surrogate/gaussian_process.hpp"
 
 namespace mufric::wire {
 
@@ -57,6 +60,11 @@ std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& wha
     if (in.std_tolerance() > 0.0) what.std_relative_tolerance = in.std_tolerance();
   }
   return {};
+}
+
+long long bit_stable_piece(long long wanted) {
+  if (wanted < kGpQueryBlock) return std::max(1LL, wanted);
+  return wanted - wanted % kGpQueryBlock;
 }
 
 }  // namespace mufric::wire

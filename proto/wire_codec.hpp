@@ -27,4 +27,9 @@ void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out);
 // reason a request is invalid, naming the field.
 std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& what);
 
+// Points per piece when a batch is cut into pieces (the client's calls, the server's looks at the
+// deadline): `wanted` (at least 1), cut down to a multiple of the GP's query block when it is at
+// least one block, so that a point's σ keeps its bits however a batch is cut (kGpQueryBlock).
+long long bit_stable_piece(long long wanted);
+
 }  // namespace mufric::wire

@@ -9,7 +9,6 @@
 #include "common/units.hpp"
 #include "common/version.hpp"
 #include "proto/wire_codec.hpp"
-#include "surrogate/gaussian_process.hpp"
 
 namespace mufric::server {
 namespace {
@@ -154,12 +153,13 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   uint64_t extrapolated = 0, invalid = 0, fast = 0, out_of_box = 0, clipped = 0;
   // Chunks, so that a call whose caller has given up (deadline passed, cancelled) stops within a
   // few milliseconds instead of computing an answer nobody reads.
-  for (int first = 0; first < n; first += static_cast<int>(kPointsBetweenDeadlineChecks)) {
+  const int piece = static_cast<int>(wire::bit_stable_piece(kPointsBetweenDeadlineChecks));
+  for (int first = 0; first < n; first += piece) {
     if (grpc::Status gone = gone_check ? gone_check(first, n) : grpc::Status::OK; !gone.ok()) {
       ++counters_.abandoned;
       return gone;
     }
-    const int count = std::min(n - first, static_cast<int>(kPointsBetweenDeadlineChecks));
+    const int count = std::min(n - first, piece);
     const Evaluation e = count == n ? model.evaluate(batch, computed)
                                     : model.evaluate(QueryBatch(batch.middleRows(first, count)), computed);
     if (log != nullptr) log->record(served->name, model.inputs(), batch.middleRows(first, count), e.std);

@@ -10,7 +10,6 @@
 #include "mufric/v1/friction.grpc.pb.h"
 #include "server/model_registry.hpp"
 #include "server/uncertain_log.hpp"
-#include "surrogate/gaussian_process.hpp"
 
 namespace mufric::server {
 
@@ -27,9 +26,9 @@ struct ServiceLimits {
   UncertainQueryLog* uncertain_log = nullptr;
 };
 
-// Points evaluated between two looks at the caller's deadline and cancellation: a few ms of work.
+// Points evaluated between two looks at the caller's deadline and cancellation: a few ms of work
+// (cut to wire::bit_stable_piece).
 inline constexpr long long kPointsBetweenDeadlineChecks = 8192;
-static_assert(kPointsBetweenDeadlineChecks % kGpQueryBlock == 0, "a chunk must end on a GP query block");
 
 // Threads for one evaluation when `in_flight` evaluations (this one included) are running.
 int threads_per_evaluation(int evaluation_threads, int in_flight);
