@@ -371,6 +371,32 @@ TEST(ClosestPoint, DivergedPointsFailWithAReasonInsteadOfExhaustingMemory) {
   EXPECT_NE(p.reason.find("periods"), std::string::npos) << p.reason;
 }
 
+// Points on or a picometre off a profile 20 µm from the origin, in SI units (the seam of a 20 µm
+// contact cell): f = C′·(C − x) is known there only to eps × 20 µm × |C′|, above the relative
+// tolerance alone, and the projection never converged (15 of 16 draws of a 20 µm cell stopped).
+TEST(ClosestPoint, ConvergesOnTheCurveFarFromTheOrigin) {
+  RoughnessSpec spec;
+  spec.length = 20e-6;
+  spec.ra = 0.3e-6;
+  spec.correlation_length = 1e-6;
+  spec.samples = 1024;
+  spec.seed = 3;
+  const SplineCurve c = fit_periodic_profile(synthetic_rough_profile(spec), 3, 128).curve;
+  long long not_converged = 0;
+  for (int i = 0; i <= 200; ++i) {
+    const double u = 0.9 + 0.2 * i / 200.0;  // across the seam at u = 1 (x = 20 µm)
+    const Points2 d = c.derivatives(u, 1);
+    const Eigen::Vector2d normal = Eigen::Vector2d(-d(1, 1), d(1, 0)).normalized();
+    for (const double offset : {0.0, 1e-12, -1e-12}) {
+      const Eigen::Vector2d x = d.row(0).transpose() + offset * normal;
+      const Projection p = project(c, x);
+      not_converged += !p.converged;
+      EXPECT_LE(p.distance, std::abs(offset) + 1e-15) << u << ": " << p.reason;
+    }
+  }
+  EXPECT_EQ(not_converged, 0);
+}
+
 TEST(ClosestPoint, AdversarialProfiles) {
   // Sharp peaks: a cubic through a spiky control polygon.
   Points2 spikes(12, 2);

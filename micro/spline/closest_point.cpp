@@ -33,6 +33,20 @@ Stationarity stationarity(const SplineCurve& curve, const Eigen::Vector2d& x, do
   return {c1.dot(r), c2.dot(r) + c1.squaredNorm(), r.squaredNorm(), c1.norm()};
 }
 
+// f = C′·(C − x) is known only to the rounding of C − x, about eps (|C| + |x|) ≤ eps (2|x| + |C − x|)
+// per coordinate, times |C′|: no iteration gets |f| below that. The relative tolerance alone, 1e-13 of
+// |C′| (d + length scale), asked for less than that once the coordinates are ~20 µm from the origin
+// and the point sits on the curve (d ≈ 0, a short length scale): a 20 µm cell's periodic seam never
+// converged there (bench/RESULTS.md, "The cell width as a lever"). 8 ulps leaves room for the sums in C.
+constexpr double kStationarityRoundingUlps = 8.0;
+
+double stationarity_tolerance(const Stationarity& s, const Eigen::Vector2d& x, double length_scale) {
+  const double distance = std::sqrt(s.distance_squared);
+  const double rounding = kStationarityRoundingUlps * std::numeric_limits<double>::epsilon() *
+                          (2.0 * x.lpNorm<Eigen::Infinity>() + distance);
+  return s.speed * std::max(kProjectionRelativeTolerance * (distance + length_scale), rounding);
+}
+
 // Golden-section search for the minimum of |C(u) − x|² on [a, b] (Numerical Recipes §10.2): the
 // last resort when the derivative-based iteration lands on a stationary point that is no minimum.
 LocalResult golden_section(const SplineCurve& curve, const Eigen::Vector2d& x, double a, double b) {
@@ -72,7 +86,7 @@ LocalResult refine(const SplineCurve& curve, const Eigen::Vector2d& x, double a,
   LocalResult result{u, s.distance_squared, 0, false};
   for (int it = 1; it <= kProjectionMaxIterations && !result.converged; ++it) {
     result.iterations = it;
-    const double tolerance = kProjectionRelativeTolerance * s.speed * (std::sqrt(s.distance_squared) + length_scale);
+    const double tolerance = stationarity_tolerance(s, x, length_scale);
     const bool at_end = (u - a <= width_tolerance && s.f > 0.0) || (b - u <= width_tolerance && s.f < 0.0);
     if (std::abs(s.f) <= tolerance || b - a <= width_tolerance || at_end) {
       result.converged = true;
