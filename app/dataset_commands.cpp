@@ -63,7 +63,8 @@ void print_box(const InputSpace& box) {
 }
 
 struct PlanOptions {
-  std::string out, design = "sobol", scene_path, p, v, t;
+  std::string out, design = "sobol", scene_path;
+  std::map<std::string, std::string> ranges;  // flag (--p, --v, --T) → range text
   std::vector<std::string> overrides;
   long long samples = 64;
   unsigned long long seed = 0;
@@ -72,12 +73,10 @@ struct PlanOptions {
 
 void plan_command(const PlanOptions& o) {
   InputSpace box = default_friction_box();
-  const std::map<std::string, const std::string*> ranges{
-      {"contact_pressure", &o.p}, {"sliding_velocity", &o.v}, {"temperature", &o.t}};
-  const std::map<std::string, std::string> flags{{"contact_pressure", "--p"}, {"sliding_velocity", "--v"}, {"temperature", "--T"}};
   for (auto& input : box) {
-    const std::string& text = *ranges.at(input.name);
-    if (!text.empty()) std::tie(input.lo, input.hi) = parse_range(text, input.kind(), flags.at(input.name));
+    const std::string flag(find_known_input(input.name)->flag);
+    const auto text = o.ranges.find(flag);
+    if (text != o.ranges.end() && !text->second.empty()) std::tie(input.lo, input.hi) = parse_range(text->second, input.kind(), flag);
   }
   const scene::Scene sc = scene::load_scene(o.scene_path, o.overrides);
   scene::micro_evaluator(sc, box, 1);  // refuses a scene the dataset cannot drive, before anything is written
@@ -337,9 +336,12 @@ void add_dataset_commands(CLI::App& app) {
   plan->add_option("--samples", p->samples, "Number of points")->capture_default_str()->check(CLI::Range(1LL, 10000000LL));
   plan->add_option("--design", p->design, "sobol, lhs (Latin hypercube) or random")->capture_default_str();
   plan->add_option("--seed", p->seed, "Seed (Sobol: 0 = unshifted, else a random digital shift)")->capture_default_str();
-  plan->add_option("--p", p->p, "Contact pressure range, e.g. 300MPa:1300MPa (default: seed 000's box)");
-  plan->add_option("--v", p->v, "Sliding velocity range, e.g. 22.5m/min:200m/min");
-  plan->add_option("--T", p->t, "Temperature range, e.g. 25C:900C");
+  for (const InputSpec& input : default_friction_box()) {  // --p, --v, --T
+    const std::string flag(find_known_input(input.name)->flag);
+    plan->add_option(flag, p->ranges[flag],
+                     "Range of " + input.name + ", e.g. " + format_human(input.lo, input.kind()) + ":" +
+                         format_human(input.hi, input.kind()) + " (default: that, seed 000's box)");
+  }
   plan->add_option("--scene", p->scene_path, "Scene file (JSON) stored with the plan; default: the default dry scene")
       ->check(CLI::ExistingFile);
   plan->add_option("--set", p->overrides, "Override a scene value, e.g. --set time.duration=100ns (repeatable)");

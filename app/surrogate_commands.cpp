@@ -334,11 +334,6 @@ void add_eval(CLI::App& app) {
   });
 }
 
-// --p/--v/--T/--angle map onto the model's named inputs.
-const std::map<std::string, std::string> kInputFlags{{"contact_pressure", "--p"},
-                                                     {"sliding_velocity", "--v"},
-                                                     {"temperature", "--T"},
-                                                     {"fibre_angle", "--angle"}};
 
 // The points to ask: one from the flags, or every row of --csv (columns named like the model's
 // inputs, with units).
@@ -381,9 +376,10 @@ void add_predict(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("predict", "Friction coefficients with their confidence intervals, human units");
   cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), a shipped model's name (dry_default), or grpc://host:port/model")->required();
-  for (const auto& [input, flag] : kInputFlags) {
+  for (const KnownInput& input : known_inputs()) {  // --p, --v, --T, --angle
+    const std::string flag(input.flag);
     cmd->add_option(flag, o->values[flag],
-                    "The " + input + " with its unit, e.g. " + std::string(example_quantity(kind_of_input(input))));
+                    "The " + std::string(input.name) + " with its unit, e.g. " + std::string(example_quantity(input.kind)));
   }
   cmd->add_option("--csv", o->csv,
                   "Many points: a CSV whose columns are the model's inputs with units, e.g.\n"
@@ -408,23 +404,26 @@ void add_predict(CLI::App& app) {
     const bool from_csv = !o->csv.empty();
     PredictPoints points;
     if (from_csv) {
-      for (const auto& [input, flag] : kInputFlags) {
-        if (!o->values[flag].empty()) throw Error(flag + " and --csv exclude each other");
+      for (const KnownInput& input : known_inputs()) {
+        if (!o->values[std::string(input.flag)].empty()) throw Error(std::string(input.flag) + " and --csv exclude each other");
       }
       points = points_from_csv(o->csv, inputs);
     } else {
       if (!o->out.empty()) throw Error("--out goes with --csv");
       for (const auto& input : inputs) {
-        const auto flag_it = kInputFlags.find(input.name);
-        if (flag_it == kInputFlags.end()) throw Error("model input '" + input.name + "' has no command-line flag");
-        const std::string& text = o->values[flag_it->second];
-        if (text.empty()) throw Error(flag_it->second + " is required: the model's input " + input.name + " (e.g. " +
-                                      flag_it->second + " " + std::string(example_quantity(input.kind())) + ")");
-        points.columns.push_back({parse_quantity(text, input.kind(), flag_it->second)});
+        const KnownInput* known = find_known_input(input.name);
+        if (known == nullptr) throw Error("model input '" + input.name + "' has no command-line flag (use --csv)");
+        const std::string flag(known->flag);
+        const std::string& text = o->values[flag];
+        if (text.empty()) throw Error(flag + " is required: the model's input " + input.name + " (e.g. " + flag + " " +
+                                      std::string(example_quantity(input.kind())) + ")");
+        points.columns.push_back({parse_quantity(text, input.kind(), flag)});
       }
-      for (const auto& [input, flag] : kInputFlags) {
-        const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == input; });
-        if (!used && !o->values[flag].empty()) throw Error(flag + " was given but the model has no input " + input);
+      for (const KnownInput& known : known_inputs()) {
+        const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == known.name; });
+        if (!used && !o->values[std::string(known.flag)].empty()) {
+          throw Error(std::string(known.flag) + " was given but the model has no input " + std::string(known.name));
+        }
       }
     }
     const size_t n = points.columns.empty() ? 0 : points.columns.front().size();

@@ -165,8 +165,27 @@ std::string format_human(double value_si, QuantityKind kind, int precision) {
   return std::string(text) + std::string(human_unit(kind));
 }
 
+const std::vector<KnownInput>& known_inputs() {
+  static const std::vector<KnownInput> inputs{{"contact_pressure", QuantityKind::pressure, "--p"},
+                                              {"sliding_velocity", QuantityKind::velocity, "--v"},
+                                              {"temperature", QuantityKind::temperature, "--T"},
+                                              {"fibre_angle", QuantityKind::angle, "--angle"}};
+  return inputs;
+}
+
+const KnownInput* find_known_input(std::string_view input_name) {
+  for (const KnownInput& input : known_inputs()) {
+    if (input.name == input_name) return &input;
+  }
+  return nullptr;
+}
+
 const std::vector<std::string>& known_input_names() {
-  static const std::vector<std::string> names{"contact_pressure", "sliding_velocity", "temperature", "fibre_angle"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const KnownInput& input : known_inputs()) n.emplace_back(input.name);
+    return n;
+  }();
   return names;
 }
 
@@ -196,11 +215,8 @@ std::string physical_range_violation(double value_si, QuantityKind kind) {
 }
 
 QuantityKind kind_of_input(std::string_view input_name) {
-  if (input_name == "contact_pressure") return QuantityKind::pressure;
-  if (input_name == "sliding_velocity") return QuantityKind::velocity;
-  if (input_name == "temperature") return QuantityKind::temperature;
-  if (input_name == "fibre_angle") return QuantityKind::angle;
-  return QuantityKind::dimensionless;
+  const KnownInput* input = find_known_input(input_name);
+  return input ? input->kind : QuantityKind::dimensionless;
 }
 
 }  // namespace mufric

@@ -36,10 +36,20 @@ std::string format_human(double value_si, QuantityKind kind, int precision = 4);
 std::string_view human_unit(QuantityKind kind);
 double si_to_human(double value_si, QuantityKind kind);
 
+// The model inputs mufric knows, the one table of them: in their usual order (the C ABI's argument
+// order, a dataset's columns), each with its kind of quantity and the command-line flag that gives
+// its value or range (predict, dataset plan).
+struct KnownInput {
+  std::string_view name;
+  QuantityKind kind;
+  std::string_view flag;
+};
+const std::vector<KnownInput>& known_inputs();
+// The known input of that name; nullptr if mufric does not know it.
+const KnownInput* find_known_input(std::string_view input_name);
 // The kind of a named model input (contact_pressure → pressure, ...); dimensionless if unknown.
 QuantityKind kind_of_input(std::string_view input_name);
-// The model inputs mufric knows, in their usual order: contact_pressure, sliding_velocity,
-// temperature, fibre_angle.
+// known_inputs()' names: contact_pressure, sliding_velocity, temperature, fibre_angle.
 const std::vector<std::string>& known_input_names();
 
 // Where a quantity of a kind can physically lie (SI), the one table every command checks against
