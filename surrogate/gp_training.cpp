@@ -314,10 +314,18 @@ void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summa
   summary.loo_coverage_95 = static_cast<double>(covered) / static_cast<double>(n);
 }
 
-GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTrainingOptions& options,
-                                       GpTrainingReport* report_out) {
-  const auto t0 = std::chrono::steady_clock::now();
-  GpTrainingReport report;
+namespace {
+
+// The training data normalised: unit-box inputs, outputs (μ − mean)/scale.
+struct NormalisedData {
+  Eigen::MatrixXd x_unit;
+  Eigen::VectorXd y;
+};
+
+// Checks the data, normalises them into `state` (training points, mean and scale) and sets the noise
+// model: the samples' own standard errors as the shared scatter or on the diagonal, as asked.
+NormalisedData prepare_training_data(const TrainingSet& data, const GpTrainingOptions& options,
+                                     GaussianProcess::State& state, GpTrainingReport& report) {
   const Eigen::Index n = data.x.rows();
   const auto d = static_cast<Eigen::Index>(data.inputs.size());
   if (n == 0) throw Error("training set is empty");
@@ -330,8 +338,6 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
                   std::to_string(input.hi) + "]; it cannot be scaled (is it constant in the data?)");
     }
   }
-
-  GaussianProcess::State state;
   state.inputs = data.inputs;
   state.x_train = data.x;
   state.y_train = data.mu;
@@ -344,8 +350,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   } else {
     state.y_scale = y_std;
   }
-  const Eigen::MatrixXd x_unit = to_unit_box(data.x, data.inputs);
-  const Eigen::VectorXd y = (data.mu.array() - state.y_mean) / state.y_scale;
+  NormalisedData normalised{to_unit_box(data.x, data.inputs), (data.mu.array() - state.y_mean) / state.y_scale};
   // The samples' own standard errors: their RMS widens the served interval; on request, each one's
   // variance also goes on the diagonal.
   const bool all_std = data.mu_std.size() == n && data.mu_std.allFinite();
@@ -366,8 +371,12 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     state.known_noise = (data.mu_std.array() / state.y_scale).square().matrix();
     report.sample_noise_used = true;
   }
+  return normalised;
+}
 
-  const LogBounds bounds = log_bounds(options.bounds, d, options.noise_term);
+// The first start (options.initial, or σ² = 1, l = 0.5 box widths, σn² = 1e-5) and, when optimising,
+// options.restarts more drawn log-uniformly in the bounds from options.seed; all inside the bounds.
+std::vector<Eigen::VectorXd> starting_points(const GpTrainingOptions& options, const LogBounds& bounds, Eigen::Index d) {
   GpHyperParameters initial = options.initial;
   if (initial.length_scales.size() == 0) {
     initial.signal_variance = 1.0;
@@ -386,66 +395,82 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
       starts.push_back(theta);
     }
   }
+  return starts;
+}
 
-  const int threads = options.threads > 0 ? options.threads : usable_cores();  // affinity and OMP_NUM_THREADS
-  report.starts.resize(starts.size());
-  for (size_t s = 0; s < starts.size(); ++s) {
-    report.starts[s].initial_log = starts[s];
-    report.starts[s].final_log = starts[s];
-  }
+// Stage 1, a subset of the data (Chalupka, Williams & Murray 2013): each start first climbs the
+// likelihood of a fixed random subset, ~(n/m)³ times cheaper per evaluation, when the data are large.
+struct SubsetStage {
+  bool used = false;
+  std::vector<Eigen::VectorXd> optima;  // where each start's full-data stage begins (its start if unused or failed)
+  std::vector<double> lml;              // each start's subset optimum (kFailedLml: none)
+};
 
-  // Stage 1, subset of data (Chalupka, Williams & Murray 2013): each start first climbs the LML of
-  // a fixed random subset, ~(n/m)³ times cheaper per evaluation.
-  std::vector<Eigen::VectorXd> polish_from = starts;
-  std::vector<double> subset_lml(starts.size(), kFailedLml);
-  const bool use_subset =
-      options.optimise && options.subset_size > 0 && n > 2 * static_cast<Eigen::Index>(options.subset_size);
-  TrainingProgress progress(options.progress);
-  if (use_subset) {
-    progress.say(count_of(static_cast<long long>(starts.size()), "start", "starts") + " on a subset of " + std::to_string(options.subset_size) +
-                 " of the " + std::to_string(n) + " points");
-    std::vector<Eigen::Index> order(static_cast<size_t>(n));
-    std::iota(order.begin(), order.end(), Eigen::Index{0});
-    std::shuffle(order.begin(), order.end(), std::mt19937_64(options.seed ^ 0x5eed5eedULL));
-    Eigen::MatrixXd x_subset(options.subset_size, d);
-    Eigen::VectorXd y_subset(options.subset_size);
-    Eigen::VectorXd noise_subset(state.known_noise.size() != 0 ? options.subset_size : 0);
-    for (Eigen::Index k = 0; k < options.subset_size; ++k) {
-      x_subset.row(k) = x_unit.row(order[static_cast<size_t>(k)]);
-      y_subset(k) = y(order[static_cast<size_t>(k)]);
-      if (noise_subset.size() != 0) noise_subset(k) = state.known_noise(order[static_cast<size_t>(k)]);
-    }
-    for_each_parallel(starts.size(), threads, [&](size_t s) {
-      const auto t_start = std::chrono::steady_clock::now();
-      LogMarginalLikelihood coarse(x_subset, y_subset, options.noise_term, noise_subset, options.estimate_mean);
-      const LocalOptimum optimum = maximise(coarse, starts[s], options, bounds);
-      report.starts[s].subset_evaluations = optimum.evaluations;
-      subset_lml[s] = optimum.lml;
-      if (optimum.lml > kFailedLml) polish_from[s] = optimum.theta;
-      report.starts[s].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-    });
+SubsetStage climb_on_a_subset(const NormalisedData& data, const Eigen::VectorXd& known_noise,
+                              const GpTrainingOptions& options, const LogBounds& bounds,
+                              const std::vector<Eigen::VectorXd>& starts, int threads, TrainingProgress& progress,
+                              GpTrainingReport& report) {
+  const Eigen::Index n = data.x_unit.rows(), d = data.x_unit.cols();
+  SubsetStage stage{.used = options.optimise && options.subset_size > 0 && n > 2 * static_cast<Eigen::Index>(options.subset_size),
+                    .optima = starts,
+                    .lml = std::vector<double>(starts.size(), kFailedLml)};
+  if (!stage.used) return stage;
+  progress.say(count_of(static_cast<long long>(starts.size()), "start", "starts") + " on a subset of " +
+               std::to_string(options.subset_size) + " of the " + std::to_string(n) + " points");
+  std::vector<Eigen::Index> order(static_cast<size_t>(n));
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(options.seed ^ 0x5eed5eedULL));
+  Eigen::MatrixXd x_subset(options.subset_size, d);
+  Eigen::VectorXd y_subset(options.subset_size);
+  Eigen::VectorXd noise_subset(known_noise.size() != 0 ? options.subset_size : 0);
+  for (Eigen::Index k = 0; k < options.subset_size; ++k) {
+    x_subset.row(k) = data.x_unit.row(order[static_cast<size_t>(k)]);
+    y_subset(k) = data.y(order[static_cast<size_t>(k)]);
+    if (noise_subset.size() != 0) noise_subset(k) = known_noise(order[static_cast<size_t>(k)]);
   }
+  for_each_parallel(starts.size(), threads, [&](size_t s) {
+    const auto t_start = std::chrono::steady_clock::now();
+    LogMarginalLikelihood coarse(x_subset, y_subset, options.noise_term, noise_subset, options.estimate_mean);
+    const LocalOptimum optimum = maximise(coarse, starts[s], options, bounds);
+    report.starts[s].subset_evaluations = optimum.evaluations;
+    stage.lml[s] = optimum.lml;
+    if (optimum.lml > kFailedLml) stage.optima[s] = optimum.theta;
+    report.starts[s].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  });
+  return stage;
+}
 
-  // Stage 2, all data, as in multi-level single linkage (Rinnooy Kan & Timmer 1987): starts whose
-  // subset optima coincide share one full-data run (a basin is climbed once), and a subset optimum
-  // far worse than the best is evaluated on all data but not refined.
-  const double best_subset_lml = *std::max_element(subset_lml.begin(), subset_lml.end());
-  std::vector<bool> refine(starts.size(), true);
-  if (use_subset) {
-    for (size_t s = 0; s < starts.size(); ++s) refine[s] = best_subset_lml - subset_lml[s] <= kHopelessSubsetGap;
-  }
-  std::vector<size_t> leader(starts.size());
+// Stage 2's grouping, as in multi-level single linkage (Rinnooy Kan & Timmer 1987): starts whose
+// subset optima coincide share one full-data run (a basin is climbed once). leader[s] is the start
+// whose run s shares (s itself for a leader).
+std::vector<size_t> basin_leaders(const SubsetStage& stage) {
+  std::vector<size_t> leader(stage.optima.size());
   std::vector<size_t> leaders;
-  for (size_t s = 0; s < starts.size(); ++s) {
+  for (size_t s = 0; s < stage.optima.size(); ++s) {
     leader[s] = s;
-    if (use_subset) {
+    if (stage.used) {
       for (const size_t l : leaders) {
-        if ((polish_from[s] - polish_from[l]).cwiseAbs().maxCoeff() < kSameBasinLog) {
+        if ((stage.optima[s] - stage.optima[l]).cwiseAbs().maxCoeff() < kSameBasinLog) {
           leader[s] = l;
           break;
         }
       }
     }
+    if (leader[s] == s) leaders.push_back(s);
+  }
+  return leader;
+}
+
+// Stage 2, all data: each basin's leader climbs from its subset optimum; a subset optimum far worse
+// than the best is evaluated on all data but not refined; the other starts share their leader's result.
+void climb_on_all_data(const NormalisedData& data, const Eigen::VectorXd& known_noise, const GpTrainingOptions& options,
+                       const LogBounds& bounds, const SubsetStage& stage, int threads, TrainingProgress& progress,
+                       GpTrainingReport& report) {
+  const Eigen::Index n = data.x_unit.rows();
+  const double best_subset_lml = *std::max_element(stage.lml.begin(), stage.lml.end());
+  const std::vector<size_t> leader = basin_leaders(stage);
+  std::vector<size_t> leaders;
+  for (size_t s = 0; s < leader.size(); ++s) {
     if (leader[s] == s) leaders.push_back(s);
   }
   if (options.optimise) {
@@ -458,10 +483,11 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     const size_t s = leaders[i];
     const auto t_start = std::chrono::steady_clock::now();
     GpStartReport& r = report.starts[s];
-    LogMarginalLikelihood lml(x_unit, y, options.noise_term, state.known_noise, options.estimate_mean);
-    if (!options.optimise || !refine[s]) {
-      const auto value = lml(polish_from[s], false);
-      r.final_log = polish_from[s];
+    LogMarginalLikelihood lml(data.x_unit, data.y, options.noise_term, known_noise, options.estimate_mean);
+    const bool refine = options.optimise && (!stage.used || best_subset_lml - stage.lml[s] <= kHopelessSubsetGap);
+    if (!refine) {
+      const auto value = lml(stage.optima[s], false);
+      r.final_log = stage.optima[s];
       r.evaluations = 1;
       r.ok = value.ok;
       r.log_marginal_likelihood = value.ok ? value.lml : kFailedLml;
@@ -471,13 +497,13 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
         r.outcome = "fixed hyper-parameters";
       } else {
         std::ostringstream why;
-        why << "not refined: its subset LML " << subset_lml[s] << " is " << best_subset_lml - subset_lml[s]
+        why << "not refined: its subset LML " << stage.lml[s] << " is " << best_subset_lml - stage.lml[s]
             << " below the best start's";
         r.outcome = why.str();
       }
     } else {
-      const LocalOptimum optimum =
-          maximise(lml, polish_from[s], options, bounds, progress.enabled() ? &progress : nullptr, "start " + std::to_string(s));
+      const LocalOptimum optimum = maximise(lml, stage.optima[s], options, bounds, progress.enabled() ? &progress : nullptr,
+                                            "start " + std::to_string(s));
       r.final_log = optimum.theta;
       r.log_marginal_likelihood = optimum.lml;
       r.evaluations = optimum.evaluations;
@@ -486,7 +512,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     }
     r.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   });
-  for (size_t s = 0; s < starts.size(); ++s) {
+  for (size_t s = 0; s < leader.size(); ++s) {
     if (leader[s] == s) continue;
     const GpStartReport& l = report.starts[leader[s]];
     GpStartReport& r = report.starts[s];
@@ -495,7 +521,21 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     r.ok = l.ok;
     r.outcome = "same basin as start " + std::to_string(leader[s]) + " on the subset; shares its optimum";
   }
+}
 
+// Climbs the (restricted) likelihood from every start (report.starts) and picks the best
+// (report.best_start). Throws when no start gives a factorisable covariance.
+void tune_hyper_parameters(const NormalisedData& data, const Eigen::VectorXd& known_noise, const GpTrainingOptions& options,
+                           const LogBounds& bounds, const std::vector<Eigen::VectorXd>& starts, GpTrainingReport& report) {
+  const int threads = options.threads > 0 ? options.threads : usable_cores();  // affinity and OMP_NUM_THREADS
+  report.starts.resize(starts.size());
+  for (size_t s = 0; s < starts.size(); ++s) {
+    report.starts[s].initial_log = starts[s];
+    report.starts[s].final_log = starts[s];
+  }
+  TrainingProgress progress(options.progress);
+  const SubsetStage stage = climb_on_a_subset(data, known_noise, options, bounds, starts, threads, progress, report);
+  climb_on_all_data(data, known_noise, options, bounds, stage, threads, progress, report);
   for (size_t s = 0; s < report.starts.size(); ++s) {
     const auto& start = report.starts[s];
     if (start.ok && (report.best_start < 0 ||
@@ -508,19 +548,57 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
     for (const auto& start : report.starts) reasons += "\n  start: " + start.outcome;
     throw Error("Gaussian process fit failed: no start produced a factorisable covariance" + reasons);
   }
-  const auto& best = report.starts[static_cast<size_t>(report.best_start)];
-  state.hyper = GpHyperParameters::from_log(best.final_log, d, options.noise_term);
+}
 
+// Factorises K at the chosen hyper-parameters, solves for α, estimates the constant mean when asked
+// and fills the summary with the leave-one-out figures.
+void fit_at_hyper_parameters(GaussianProcess::State& state, const NormalisedData& data, const GpTrainingOptions& options,
+                             GpTrainingReport& report) {
   Eigen::MatrixXd kf;
-  rbf_signal_covariance(x_unit, state.hyper, kf);
+  rbf_signal_covariance(data.x_unit, state.hyper, kf);
   const auto chol = cholesky_with_jitter(kf, state.hyper.noise_variance, state.cholesky, state.known_noise);
   if (!chol.ok) throw Error("Gaussian process fit failed at the optimum: " + chol.reason);
   state.jitter = chol.jitter;
   report.jitter = chol.jitter;
-  state.alpha = state.cholesky.triangularView<Eigen::Lower>().solve(y);
+  state.alpha = state.cholesky.triangularView<Eigen::Lower>().solve(data.y);
   state.cholesky.triangularView<Eigen::Lower>().transpose().solveInPlace(state.alpha);
   if (options.estimate_mean) estimate_constant_mean(state);
+  if (chol.jitter > 0.0) {
+    std::ostringstream w;
+    w << "jitter " << chol.jitter << " added to the covariance diagonal (" << chol.attempts
+      << " factorisation attempts): inputs are nearly duplicated";
+    report.warnings.push_back(w.str());
+  }
+  leave_one_out(state, state.summary);
+}
 
+// "… is at its lower/upper bound" for each optimised hyper-parameter within kAtBoundLog of one.
+void warn_at_bounds(const Eigen::VectorXd& theta, const LogBounds& bounds, const TrainingSet& data,
+                    const GpTrainingOptions& options, GpTrainingReport& report) {
+  if (!options.optimise) return;
+  auto at_bound = [&](Eigen::Index i, const std::string& name) {
+    if (theta(i) - bounds.lo(i) < kAtBoundLog) report.warnings.push_back(name + " is at its lower bound");
+    if (bounds.hi(i) - theta(i) < kAtBoundLog) report.warnings.push_back(name + " is at its upper bound");
+  };
+  const auto d = static_cast<Eigen::Index>(data.inputs.size());
+  at_bound(0, "signal variance");
+  for (Eigen::Index k = 0; k < d; ++k) at_bound(1 + k, "length scale of " + data.inputs[static_cast<size_t>(k)].name);
+  if (options.noise_term) at_bound(d + 1, "noise variance");
+}
+
+}  // namespace
+
+GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTrainingOptions& options,
+                                       GpTrainingReport* report_out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  GpTrainingReport report;
+  GaussianProcess::State state;
+  const NormalisedData normalised = prepare_training_data(data, options, state, report);
+  const auto d = static_cast<Eigen::Index>(data.inputs.size());
+  const LogBounds bounds = log_bounds(options.bounds, d, options.noise_term);
+  tune_hyper_parameters(normalised, state.known_noise, options, bounds, starting_points(options, bounds, d), report);
+  const auto& best = report.starts[static_cast<size_t>(report.best_start)];
+  state.hyper = GpHyperParameters::from_log(best.final_log, d, options.noise_term);
   auto& summary = state.summary;
   summary.log_marginal_likelihood = best.log_marginal_likelihood;
   summary.starts = static_cast<long long>(report.starts.size());
@@ -529,24 +607,8 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   summary.dataset_sha256 = data.source_hash;
   summary.code_version = code_version();
   summary.created_utc = utc_timestamp();
-  leave_one_out(state, summary);
-
-  if (chol.jitter > 0.0) {
-    std::ostringstream w;
-    w << "jitter " << chol.jitter << " added to the covariance diagonal (" << chol.attempts
-      << " factorisation attempts): inputs are nearly duplicated";
-    report.warnings.push_back(w.str());
-  }
-  const Eigen::VectorXd theta = best.final_log;
-  auto at_bound = [&](Eigen::Index i, const std::string& name) {
-    if (theta(i) - bounds.lo(i) < kAtBoundLog) report.warnings.push_back(name + " is at its lower bound");
-    if (bounds.hi(i) - theta(i) < kAtBoundLog) report.warnings.push_back(name + " is at its upper bound");
-  };
-  if (options.optimise) {
-    at_bound(0, "signal variance");
-    for (Eigen::Index k = 0; k < d; ++k) at_bound(1 + k, "length scale of " + data.inputs[static_cast<size_t>(k)].name);
-    if (options.noise_term) at_bound(d + 1, "noise variance");
-  }
+  fit_at_hyper_parameters(state, normalised, options, report);
+  warn_at_bounds(best.final_log, bounds, data, options, report);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   summary.seconds = report.seconds;
   if (report_out) *report_out = report;
