@@ -291,8 +291,8 @@ void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summa
   const Eigen::Index n = state.x_train.rows();
   Eigen::MatrixXd inverse = state.cholesky;
   if (n < 2 || !inverse_from_cholesky(inverse)) return;
-  inverse.triangularView<Eigen::StrictlyUpper>() = inverse.transpose().eval();
-  if (state.mean_estimated) {
+  if (state.mean_estimated) {  // needs whole rows of K⁻¹; simple kriging reads only its diagonal
+    inverse.triangularView<Eigen::StrictlyUpper>() = inverse.transpose().eval();
     const Eigen::VectorXd k_inv_ones = inverse.rowwise().sum();
     inverse -= k_inv_ones * k_inv_ones.transpose() / k_inv_ones.sum();
   }

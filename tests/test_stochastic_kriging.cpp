@@ -21,6 +21,33 @@ InputSpace unit_cube() {
   return {{"contact_pressure", "Pa", 0.0, 1.0}, {"sliding_velocity", "m/s", 0.0, 1.0}, {"temperature", "K", 0.0, 1.0}};
 }
 
+// exp(−½ Σ ((a − b)/(width · l))²) at SI points, written out from the state's box and length scales.
+double rbf_correlation(const GaussianProcess::State& s, const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) {
+  double r2 = 0.0;
+  for (Eigen::Index j = 0; j < a.size(); ++j) {
+    const double width = s.inputs[static_cast<size_t>(j)].hi - s.inputs[static_cast<size_t>(j)].lo;
+    const double t = (a(j) - b(j)) / width / s.hyper.length_scales(j);
+    r2 += t * t;
+  }
+  return std::exp(-0.5 * r2);
+}
+
+// n samples of a smooth μ in the unit cube, each with its own, very different standard error.
+TrainingSet samples_with_own_errors(Eigen::Index n, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  TrainingSet data;
+  data.inputs = unit_cube();
+  data.x.resize(n, 3);
+  data.mu.resize(n);
+  data.mu_std.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < 3; ++j) data.x(i, j) = unit(rng);
+    data.mu(i) = 0.2 + 0.05 * std::sin(3.0 * data.x(i, 0)) + 0.02 * data.x(i, 1) + 0.01 * unit(rng);
+    data.mu_std(i) = 0.002 + 0.01 * unit(rng);
+  }
+  return data;
+}
+
 // R&W eq. 2.20–2.24 with K = σ²R + diag(known + σn²), solved by full-pivoting LU: no Cholesky, no
 // inverse factor, no blocking — the model's own path shares none of it.
 struct DensePosterior {
@@ -28,15 +55,7 @@ struct DensePosterior {
 };
 DensePosterior dense_posterior(const GaussianProcess::State& s, const Eigen::RowVectorXd& query) {
   const Eigen::Index n = s.x_train.rows();
-  auto correlation = [&](const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) {
-    double r2 = 0.0;
-    for (Eigen::Index j = 0; j < a.size(); ++j) {
-      const double width = s.inputs[static_cast<size_t>(j)].hi - s.inputs[static_cast<size_t>(j)].lo;
-      const double t = (a(j) - b(j)) / width / s.hyper.length_scales(j);
-      r2 += t * t;
-    }
-    return std::exp(-0.5 * r2);
-  };
+  auto correlation = [&](const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) { return rbf_correlation(s, a, b); };
   Eigen::MatrixXd k(n, n);
   Eigen::VectorXd k_star(n);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -54,17 +73,7 @@ DensePosterior dense_posterior(const GaussianProcess::State& s, const Eigen::Row
 TEST(StochasticKriging, AKnownDiagonalGivesTheDensePosterior) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  TrainingSet data;
-  data.inputs = unit_cube();
-  constexpr Eigen::Index n = 25;
-  data.x.resize(n, 3);
-  data.mu.resize(n);
-  data.mu_std.resize(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (Eigen::Index j = 0; j < 3; ++j) data.x(i, j) = unit(rng);
-    data.mu(i) = 0.2 + 0.05 * std::sin(3.0 * data.x(i, 0)) + 0.02 * data.x(i, 1) + 0.01 * unit(rng);
-    data.mu_std(i) = 0.002 + 0.01 * unit(rng);  // very different per sample
-  }
+  const TrainingSet data = samples_with_own_errors(25, rng);
   GpTrainingOptions options;
   options.optimise = false;
   options.sample_noise = true;
@@ -102,15 +111,7 @@ TEST(StochasticKriging, AKnownDiagonalGivesTheDensePosterior) {
 DensePosterior dense_ordinary_kriging(const GaussianProcess::State& s, const Eigen::MatrixXd& x, const Eigen::VectorXd& mu,
                                       const Eigen::RowVectorXd& query, Eigen::Index skip = -1, double own_variance = 0.0) {
   const Eigen::Index n = x.rows(), m = skip >= 0 ? n - 1 : n;
-  auto correlation = [&](const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) {
-    double r2 = 0.0;
-    for (Eigen::Index j = 0; j < a.size(); ++j) {
-      const double width = s.inputs[static_cast<size_t>(j)].hi - s.inputs[static_cast<size_t>(j)].lo;
-      const double t = (a(j) - b(j)) / width / s.hyper.length_scales(j);
-      r2 += t * t;
-    }
-    return std::exp(-0.5 * r2);
-  };
+  auto correlation = [&](const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) { return rbf_correlation(s, a, b); };
   std::vector<Eigen::Index> rows;
   for (Eigen::Index i = 0; i < n; ++i) {
     if (i != skip) rows.push_back(i);
@@ -139,17 +140,8 @@ DensePosterior dense_ordinary_kriging(const GaussianProcess::State& s, const Eig
 TEST(StochasticKriging, AnEstimatedMeanGivesTheDenseOrdinaryKrigingPosterior) {
   std::mt19937_64 rng(21);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  TrainingSet data;
-  data.inputs = unit_cube();
   constexpr Eigen::Index n = 30;
-  data.x.resize(n, 3);
-  data.mu.resize(n);
-  data.mu_std.resize(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (Eigen::Index j = 0; j < 3; ++j) data.x(i, j) = unit(rng);
-    data.mu(i) = 0.2 + 0.05 * std::sin(3.0 * data.x(i, 0)) + 0.02 * data.x(i, 1) + 0.01 * unit(rng);
-    data.mu_std(i) = 0.002 + 0.01 * unit(rng);
-  }
+  const TrainingSet data = samples_with_own_errors(n, rng);
   GpTrainingOptions options;
   options.optimise = false;
   options.sample_noise = true;
