@@ -90,7 +90,7 @@ void plan_command(const PlanOptions& o) {
   spec.scene_json = sc.effective.dump(2);
   // What a reader of `dataset status` needs first: which physics, and whether the named scene was changed.
   const std::string scene_label = sc.source + (o.overrides.empty() ? "" : " with " + std::to_string(o.overrides.size()) + " --set") +
-                                  ", physics " + sc.physics;
+                                  ", physics " + scene::choice_name(sc.physics);
   spec.source = "micro-model plan (" + scene_label + ")";
   const Dataset plan = empty_dataset(spec);
   write_dataset(o.out, plan);

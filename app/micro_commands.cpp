@@ -250,7 +250,7 @@ int run_command(const RunCommandOptions& o) {
   write_file_atomically(o.out + "/result.json", m.to_json(sc).dump(2) + "\n");
   print_summary(m, sc);
   std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu%s (first draw)\n", o.out.c_str(), o.out.c_str(), o.out.c_str(),
-              sc.physics == "lubricated" ? (", " + o.out + "/film.vtu").c_str() : "");
+              sc.physics == scene::Physics::lubricated ? (", " + o.out + "/film.vtu").c_str() : "");
   return m.completed ? 0 : 3;
 }
 
@@ -259,7 +259,7 @@ void run_check(const RunCommandOptions& o) {
   const scene::SceneCost cost = scene::estimate_scene_cost(sc);
   const scene::Scene reference = scene::load_scene("", {});
   const scene::SceneCost base = scene::estimate_scene_cost(reference);
-  std::printf("%s: %s, %d x %d elements of degree %d\n", sc.source.c_str(), sc.physics.c_str(), sc.elements_x,
+  std::printf("%s: %s, %d x %d elements of degree %d\n", sc.source.c_str(), scene::choice_name(sc.physics), sc.elements_x,
               sc.elements_y, sc.degree);
   std::printf("  %lld solid unknowns (%.3gx the default scene's %lld), %lld stiffness nonzeros\n", cost.dofs,
               static_cast<double>(cost.dofs) / static_cast<double>(base.dofs), base.dofs, cost.stiffness_nonzeros);

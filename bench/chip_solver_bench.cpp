@@ -53,9 +53,9 @@ int main(int argc, char** argv) {
     const int parts = 1 << level;
     const auto patch = spline::SplineSurface::extruded(surface, -5e-6, 2, 4).subdivided(parts, parts);
     solid::SolidProblem problem(solid::IgaSpace(patch), std::make_shared<solid::J2JohnsonCook>(jc), initial);
-    problem.fix_side(solid::Side::bottom, 0);
-    problem.fix_side(solid::Side::bottom, 1);
-    problem.add_load({solid::Side::top, Eigen::Vector2d(200e6, 0.0), 800e6, [](double t) { return t / 4e-9; }});
+    problem.fix_side(numerics::Side::bottom, 0);
+    problem.fix_side(numerics::Side::bottom, 1);
+    problem.add_load({numerics::Side::top, Eigen::Vector2d(200e6, 0.0), 800e6, [](double t) { return t / 4e-9; }});
     solid::TimeIntegrationOptions options;
     options.scheme = solid::TimeScheme::quasi_static;
     options.dt = 1e-9;

@@ -9,6 +9,8 @@
 
 namespace mufric::solid::test {
 
+using numerics::LinearSolverKind;
+
 // One quasi-static step of a linear problem, solved to 1e-13 of its force scale.
 inline Eigen::VectorXd solve_static(SolidProblem& problem, LinearSolverKind solver = LinearSolverKind::lu) {
   TimeIntegrationOptions options;

@@ -42,8 +42,8 @@ TEST(MortarContact, PatchTestTransmitsUniformPressureAndNoShear) {
   auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
                                                  penalty);
   problem.add_interaction(contact);
-  problem.fix_side(solid::Side::bottom, 0);
-  problem.add_load({solid::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  problem.fix_side(numerics::Side::bottom, 0);
+  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
   const Eigen::VectorXd u = solid::test::solve_static(problem);
   const ContactState s = contact->state(u);
   for (size_t q = 0; q < s.point_pressure.size(); ++q) {
@@ -109,8 +109,8 @@ TEST(MortarContact, HertzLineContactOfACylinderOnARigidFlat) {
   auto contact = std::make_shared<MortarContact>(
       problem.space(), RigidTool{SplineCurve(SplineBasis::open_uniform(1, 1, 0, 1), flat)}, 1e4);
   problem.add_interaction(contact);
-  problem.fix_side(solid::Side::bottom, 0);
-  problem.fix_side(solid::Side::bottom, 1, 4e-3, [](double t) { return t; });
+  problem.fix_side(numerics::Side::bottom, 0);
+  problem.fix_side(numerics::Side::bottom, 1, 4e-3, [](double t) { return t; });
   solid::TimeIntegrationOptions options;
   options.scheme = solid::TimeScheme::quasi_static;
   options.dt = 0.5;

@@ -548,7 +548,7 @@ TEST(ChipInterface, LoadsMoveToTheChipConservatively) {
   for (int a = 0; a < chip.node_count(); ++a) sum += f.segment<2>(2 * a);
   EXPECT_LT((sum - total).norm(), 1e-14 * total.norm());
   // Only the surface's control points are loaded.
-  const auto top = chip.side_nodes(solid::Side::top);
+  const auto top = chip.side_nodes(numerics::Side::top);
   for (int a = 0; a < chip.node_count(); ++a) {
     if (std::find(top.begin(), top.end(), a) == top.end()) {
       EXPECT_EQ(f.segment<2>(2 * a).norm(), 0.0);
@@ -803,13 +803,13 @@ TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
     auto problem = std::make_unique<solid::SolidProblem>(
         solid::IgaSpace(solid::chip_patch(surface, {.degree = 2, .spans_x = 16, .spans_y = 3, .y_bottom = -2e-6})),
         std::make_shared<solid::LinearElastic>(205e9, 0.29, 7800.0));
-    problem->fix_side(solid::Side::bottom, 0);
-    problem->fix_side(solid::Side::bottom, 1);
+    problem->fix_side(numerics::Side::bottom, 0);
+    problem->fix_side(numerics::Side::bottom, 1);
     return problem;
   };
   const auto load = [&](const solid::SolidProblem& p, double scale) {
     Eigen::VectorXd f = Eigen::VectorXd::Zero(p.dof_count());
-    for (int node : p.space().side_nodes(solid::Side::top)) f.segment<2>(2 * node) = scale * Eigen::Vector2d(0.1, -1.0);
+    for (int node : p.space().side_nodes(numerics::Side::top)) f.segment<2>(2 * node) = scale * Eigen::Vector2d(0.1, -1.0);
     return f;
   };
   solid::TimeIntegrationOptions o;
@@ -826,19 +826,17 @@ TEST(CoupledStep, TheLastTrialIsTheAcceptedStep) {
   auto coupled_problem = build();
   auto coupled_load = std::make_shared<NodalLoad>(coupled_problem->dof_count());
   coupled_problem->add_interaction(coupled_load);
-  solid::TimeIntegrator* integrator = nullptr;
   int trials = 0;
-  o.coupled_step = [&](double t0, double dt, std::string& reason) {
+  o.coupled_step = [&](solid::TimeIntegrator& integrator, double t0, double dt, std::string& reason) {
     for (double scale : {1.0, 2.0}) {
       coupled_load->set(load(*coupled_problem, scale));
-      if (!integrator->solve_trial(t0, dt, reason)) return false;
+      if (!integrator.solve_trial(t0, dt, reason)) return false;
       ++trials;
     }
     return true;
   };
   coupled_load->set(load(*coupled_problem, 2.0));  // the same load at t = 0 as the plain run (the α-average uses it)
   solid::TimeIntegrator coupled(*coupled_problem, o);
-  integrator = &coupled;
   const solid::IntegrationReport report = coupled.run();
   ASSERT_TRUE(report.completed) << report.reason;
   EXPECT_EQ(trials, 6);

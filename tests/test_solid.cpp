@@ -17,6 +17,12 @@
 namespace mufric::solid {
 namespace {
 
+using numerics::LinearSolver;
+using numerics::LinearSolverKind;
+using numerics::MatrixStorage;
+using numerics::Side;
+using numerics::gauss_legendre;
+
 using test::expect_tangent_matches_finite_differences;
 using test::solve_static;
 
@@ -540,7 +546,7 @@ TEST(TimeIntegration, AFailingStepStopsWhenAskedBeforeItsCutBacksRunOut) {
   options.scheme = TimeScheme::quasi_static;
   options.max_cutbacks = 8;
   int attempts = 0, asked = 0;
-  options.coupled_step = [&](double, double, std::string& reason) {
+  options.coupled_step = [&](TimeIntegrator&, double, double, std::string& reason) {
     ++attempts;
     reason = "never converges";
     return false;

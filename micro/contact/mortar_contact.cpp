@@ -28,13 +28,13 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
       graph_.push_back({p.x(), p.y(), u});
     }
   }
-  surface_nodes_ = space.side_nodes(solid::Side::top);
+  surface_nodes_ = space.side_nodes(numerics::Side::top);
   std::unordered_map<int, int> surface_index;
   for (size_t a = 0; a < surface_nodes_.size(); ++a) surface_index[surface_nodes_[a]] = static_cast<int>(a);
   node_area_.assign(surface_nodes_.size(), 0.0);
   node_points_.resize(surface_nodes_.size());
   const int per_span = points_per_span > 0 ? points_per_span : space.patch().u_basis().degree() + 3;
-  for (const auto& bp : space.boundary(solid::Side::top, per_span)) {
+  for (const auto& bp : space.boundary(numerics::Side::top, per_span)) {
     SurfacePoint sp;
     sp.weight = bp.weight;
     sp.position = bp.position;

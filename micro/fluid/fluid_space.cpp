@@ -24,8 +24,8 @@ FluidSpace::FluidSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
   elements_u_ = static_cast<int>(bu.size()) - 1;
   elements_v_ = static_cast<int>(bv.size()) - 1;
   std::vector<double> gu, wu, gv, wv;
-  solid::gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
-  solid::gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
+  numerics::gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
+  numerics::gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
   for (int ev = 0; ev < elements_v_; ++ev) {
     for (int eu = 0; eu < elements_u_; ++eu) {
       const double u0 = bu[static_cast<size_t>(eu)], u1 = bu[static_cast<size_t>(eu) + 1];
@@ -50,7 +50,7 @@ FluidSpace::FluidSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
     const auto& across = along_u(side) ? patch_.v_basis() : patch_.u_basis();
     const double fixed = (side == Side::bottom || side == Side::left) ? across.lo() : across.hi();
     std::vector<double> g, w;
-    solid::gauss_legendre(along.degree() + 1, g, w);
+    numerics::gauss_legendre(along.degree() + 1, g, w);
     const auto breaks = along.breakpoints();
     for (size_t e = 0; e + 1 < breaks.size(); ++e) {
       for (size_t k = 0; k < g.size(); ++k) {

@@ -12,12 +12,13 @@
 
 #include <Eigen/Dense>
 
-#include "micro/solid/iga_space.hpp"
+#include "micro/numerics/patch_side.hpp"
+#include "micro/numerics/quadrature.hpp"
 #include "micro/spline/spline_surface.hpp"
 
 namespace mufric::fluid {
 
-using solid::Side;
+using numerics::Side;
 
 // The non-zero basis functions at a parameter point and their parametric derivatives (rows of
 // `derivatives`: N, N_u, N_v, N_uu, N_uv, N_vv).

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "micro/fluid/fluid_space.hpp"
-#include "micro/solid/linear_solver.hpp"
+#include "micro/numerics/linear_solver.hpp"
 
 namespace mufric::fluid {
 
@@ -38,7 +38,7 @@ class MeshUpdate {
 
  private:
   MeshUpdateOptions options_;
-  solid::LinearSolver solver_{solid::LinearSolverKind::cholesky};
+  numerics::LinearSolver solver_{numerics::LinearSolverKind::cholesky};
 };
 
 }  // namespace mufric::fluid

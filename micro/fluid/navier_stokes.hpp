@@ -18,7 +18,7 @@
 #include <Eigen/Sparse>
 
 #include "micro/fluid/fluid_space.hpp"
-#include "micro/solid/linear_solver.hpp"
+#include "micro/numerics/linear_solver.hpp"
 
 namespace mufric::fluid {
 
@@ -175,7 +175,7 @@ class NavierStokes {
   std::vector<SideCondition> conditions_;
   PressureLeak leak_;
   Eigen::VectorXd state_, old_state_, mesh_velocity_;
-  solid::LinearSolver solver_{solid::LinearSolverKind::lu};
+  numerics::LinearSolver solver_{numerics::LinearSolverKind::lu};
 
   // Empty, or why the velocity given on an enclosed fluid's whole boundary admits no solution (its
   // net flux does not vanish: the incompressibility dilemma of a Dirichlet–Neumann coupling).

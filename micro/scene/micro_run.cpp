@@ -163,21 +163,22 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
   for (const auto& c : solver.cutbacks) cuts.push_back({{"time_s", c.time}, {"dt_failed_s", c.dt_failed}, {"reason", c.reason}});
   auto& h = j["history"] = nlohmann::json::array();
   for (const auto& s : history) {
+    const coupling::LubricatedStep film = s.lubricant.value_or(coupling::LubricatedStep{});  // dry: all zero
     h.push_back({{"time_s", s.time},
                  {"sliding_distance_m", s.sliding_distance},
                  {"mu", s.mu ? nlohmann::json(*s.mu) : nlohmann::json(nullptr)},
                  {"force_x_n_per_m", s.force.x()},
                  {"force_y_n_per_m", s.force.y()},
-                 {"fluid_force_x_n_per_m", s.fluid_force.x()},
-                 {"fluid_force_y_n_per_m", s.fluid_force.y()},
-                 {"coupling_iterations", s.coupling_iterations},
-                 {"film_area_m2_per_m", s.film_area},
-                 {"pocket_areas_m2_per_m", s.pocket_areas},
-                 {"cavitated_fraction", s.cavitated_fraction},
-                 {"cavity_area_m2_per_m", s.cavity_area},
-                 {"liquid_area_m2_per_m", s.liquid_area},
-                 {"leaked_area_m2_per_m", s.leaked_area},
-                 {"film_volume_error", s.film_volume_error},
+                 {"fluid_force_x_n_per_m", film.fluid_force.x()},
+                 {"fluid_force_y_n_per_m", film.fluid_force.y()},
+                 {"coupling_iterations", film.coupling_iterations},
+                 {"film_area_m2_per_m", film.film_area},
+                 {"pocket_areas_m2_per_m", film.pocket_areas},
+                 {"cavitated_fraction", film.cavitated_fraction},
+                 {"cavity_area_m2_per_m", film.cavity_area},
+                 {"liquid_area_m2_per_m", film.liquid_area},
+                 {"leaked_area_m2_per_m", film.leaked_area},
+                 {"film_volume_error", film.volume_error},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
                  {"newton_iterations", s.newton_iterations}});
@@ -259,26 +260,24 @@ namespace {
 coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_start) {
   const LubricantSpec& l = scene.lubricant;
   coupling::LubricantOptions o;
-  o.fluid = {l.density, l.viscosity, l.compressibility == "none" ? 0.0 : l.bulk_modulus,
-             l.compressibility == "dowson-higginson" ? fluid::kDowsonHigginsonStiffening : 0.0};
+  o.fluid = {l.density, l.viscosity, l.compressibility == Compressibility::none ? 0.0 : l.bulk_modulus,
+             l.compressibility == Compressibility::dowson_higginson ? fluid::kDowsonHigginsonStiffening : 0.0};
   o.mesh.degree = 2;  // equal-order quadratic velocity and pressure
   o.mesh.elements_x = l.elements_x > 0 ? l.elements_x : scene.elements_x;
   o.mesh.elements_y = l.elements_y;
   o.mesh.min_film = l.min_film;
-  o.mesh_motion = l.mesh_motion == "elastic" ? coupling::FilmMeshMotion::elastic : coupling::FilmMeshMotion::columns;
+  o.mesh_motion = l.mesh_motion;
   o.mesh_update.stiffening_exponent = l.mesh_stiffening;
   o.robin_weight = l.robin_weight;
   o.robin_stiffness = l.robin_stiffness;
   o.chip_mass_per_area = scene.material.density * scene.chip_height;
   o.shortest_weight_step = scene.dt;
-  o.film_from = l.fill == "after-pressing" ? slide_start : 0.0;
+  o.film_from = l.fill == FilmFill::after_pressing ? slide_start : 0.0;
   o.contact_fade = l.contact_fade;
-  if (l.leak != "none") o.leak = l.leak == "ambient" ? fluid::LeakTarget::ambient : fluid::LeakTarget::mean;
+  if (l.leak != LeakModel::none) o.leak = l.leak == LeakModel::ambient ? fluid::LeakTarget::ambient : fluid::LeakTarget::mean;
   o.leak_length = l.leak_length;
-  if (l.cavitation == "mass-conserving") o.cavitation_pressure = l.cavitation_pressure;
-  o.coupling.acceleration = l.acceleration == "aitken"       ? coupling::Acceleration::aitken
-                            : l.acceleration == "relaxation" ? coupling::Acceleration::constant_relaxation
-                                                             : coupling::Acceleration::iqn_ils;
+  if (l.cavitation == CavitationModel::mass_conserving) o.cavitation_pressure = l.cavitation_pressure;
+  o.coupling.acceleration = l.acceleration;
   o.coupling.relaxation = l.relaxation;
   o.coupling.reuse_steps = l.reuse_steps;
   o.coupling.qr_filter = l.qr_filter;
@@ -293,13 +292,16 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
   return o;
 }
 
-}  // namespace
+// The chip under its loads: the IGA patch fitted to the chip surface, Johnson–Cook at the scene's
+// temperature, mortar contact with the rigid tool, and Γ_B dragged along x (at the sliding velocity
+// from t = 0 for seed 000; after pressing for press-slide) and pushed toward the tool by p (or moved
+// by a prescribed vertical displacement), the vertical load ramped over `ramp`.
+struct LoadedChip {
+  std::unique_ptr<solid::SolidProblem> problem;
+  std::shared_ptr<contact::MortarContact> contact;
+};
 
-MicroResult run_micro(const Scene& scene, const RunOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  MicroResult result;
-  const bool seed000 = scene.protocol.name == Protocol::seed000;
-  const SceneGeometry geometry = build_geometry(scene);
+LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const BottomMotion& motion) {
   const auto fit_spans = static_cast<int>(geometry.chip_surface.basis().breakpoints().size()) - 1;
   if (scene.elements_x < fit_spans) {
     throw Error(scene.source + ": discretisation.elements_x (" + std::to_string(scene.elements_x) +
@@ -313,31 +315,32 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
                                                 .grading = scene.grading});
   solid::MaterialState initial;
   initial.temperature = scene.temperature;
-  solid::SolidProblem problem(solid::IgaSpace(patch), std::make_shared<solid::J2JohnsonCook>(scene.material), initial);
-  auto contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
+  LoadedChip chip;
+  chip.problem = std::make_unique<solid::SolidProblem>(solid::IgaSpace(patch),
+                                                       std::make_shared<solid::J2JohnsonCook>(scene.material), initial);
+  solid::SolidProblem& problem = *chip.problem;
+  chip.contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
                                                           scene.penalty, scene.contact_points_per_span);
-  problem.add_interaction(contact);
-  // Γ_B: dragged along x (at the sliding velocity from t = 0 for seed 000; after pressing for
-  // press-slide), pushed toward the tool by p (or moved by a prescribed vertical displacement), the
-  // vertical load ramped over `ramp`.
+  problem.add_interaction(chip.contact);
   const double velocity = scene.velocity, ramp_time = scene.ramp;
-  const BottomMotion motion(scene);
-  if (seed000) {
-    problem.fix_side(solid::Side::bottom, 0, velocity, [](double t) { return t; });
+  if (scene.protocol.name == Protocol::seed000) {
+    problem.fix_side(numerics::Side::bottom, 0, velocity, [](double t) { return t; });
   } else {
-    problem.fix_side(solid::Side::bottom, 0, 1.0, [motion](double t) { return motion.displacement(t); });
+    problem.fix_side(numerics::Side::bottom, 0, 1.0, [motion](double t) { return motion.displacement(t); });
   }
   if (scene.pressure_controlled) {
-    problem.add_load({solid::Side::bottom, Eigen::Vector2d::Zero(), scene.pressure,
+    problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), scene.pressure,
                       [ramp_time](double t) { return ramp(t, ramp_time); }});
   } else {
-    problem.fix_side(solid::Side::bottom, 1, scene.vertical_displacement,
+    problem.fix_side(numerics::Side::bottom, 1, scene.vertical_displacement,
                      [ramp_time](double t) { return ramp(t, ramp_time); });
   }
-  result.dofs = problem.dof_count();
-  result.elements = problem.space().element_count();
-  result.slide_start_time = motion.slide_start();
+  return chip;
+}
 
+// The scene's time-integration choices, and the protocol's step lengths.
+solid::TimeIntegrationOptions integration_options(const Scene& scene, const BottomMotion& motion) {
+  const bool seed000 = scene.protocol.name == Protocol::seed000;
   solid::TimeIntegrationOptions o;
   o.scheme = scene.scheme;
   o.spectral_radius = scene.spectral_radius;
@@ -352,126 +355,161 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
     // Once sliding, steps are sized by distance: inertia plays no part at these sliding speeds
     // (an asperity passes in ~100 ns, the chip's slowest mode rings at ~5 ns), so slow sliding
     // costs no more steps than fast sliding.
-    const double sliding_step = scene.protocol.step_distance / std::abs(velocity);
+    const double sliding_step = scene.protocol.step_distance / std::abs(scene.velocity);
     const double pressing_step = scene.max_dt, slide_start = motion.slide_start();
     o.max_dt_at = [=](double t) { return t < slide_start ? pressing_step : sliding_step; };
   }
-  // The wall-time limit also ends a step that keeps failing, after its next failed attempt (accepted
-  // steps are checked in the step callback below, where the sliding distance is known).
-  const auto past_deadline = [&options] { return std::chrono::steady_clock::now() > options.deadline; };
-  char limit_reached[80];
-  std::snprintf(limit_reached, sizeof limit_reached, "wall-time limit of %g s reached", options.wall_seconds_limit);
-  bool stopped_by_deadline = false;
-  if (options.deadline != std::chrono::steady_clock::time_point::max()) {
-    o.should_stop = [&](std::string& reason) {
-      if (!past_deadline()) return false;
-      reason = limit_reached;
-      stopped_by_deadline = true;
+  return o;
+}
+
+// A run's wall-time limit, checked in two places: after every failed attempt of a step (so that a
+// step that keeps failing does not outlast it by its cut-backs) and after every accepted step (where
+// the message can say how far the run got).
+class WallTimeLimit {
+ public:
+  explicit WallTimeLimit(const RunOptions& options) : deadline_(options.deadline) {
+    std::snprintf(message_, sizeof message_, "wall-time limit of %g s reached", options.wall_seconds_limit);
+  }
+  void watch_failed_attempts(solid::TimeIntegrationOptions& o) {
+    if (deadline_ == std::chrono::steady_clock::time_point::max()) return;
+    o.should_stop = [this](std::string& reason) {
+      if (!passed()) return false;
+      reason = message_;
+      stopped_a_failing_step_ = true;
       return true;
     };
   }
-  std::unique_ptr<solid::HeatConduction> heat;
-  if (scene.heat_conduction) {
-    heat = std::make_unique<solid::HeatConduction>(
-        problem.space(), solid::HeatConductionOptions{.conductivity = scene.conductivity,
-                                                      .density = scene.material.density,
-                                                      .specific_heat = scene.material.specific_heat,
-                                                      .held_side = solid::Side::bottom,
-                                                      .held_temperature = scene.temperature});
-    o.after_step = [&problem, &heat](double, double dt, const Eigen::VectorXd& u, std::string& reason) {
-      std::vector<solid::MaterialState> states = problem.states();
-      if (!heat->step(u, dt, states, reason)) return false;
-      problem.commit(std::move(states));
-      return true;
-    };
+  // Throws (a failed sample) when the limit has passed after an accepted step.
+  void check_accepted_step(const MicroStep& step, size_t steps) const {
+    if (!passed()) return;
+    char where[120];
+    std::snprintf(where, sizeof where, " at t = %.4g s (sliding distance %.4g um, step %zu)", step.time,
+                  1e6 * step.sliding_distance, steps);
+    throw Error(message_ + std::string(where));
   }
-  // The lubricant: its load joins the chip's boundary interactions before the integrator assembles.
-  std::unique_ptr<coupling::LubricatedChip> lubricant;
-  solid::TimeIntegrator* integrator_of_step = nullptr;
-  if (scene.physics == "lubricated") {
-    lubricant = std::make_unique<coupling::LubricatedChip>(problem, geometry.tool_surface,
-                                                           lubricant_options(scene, motion.slide_start()));
-    o.coupled_step = [&lubricant, &integrator_of_step](double t0, double dt, std::string& reason) {
-      return lubricant->step(*integrator_of_step, t0, dt, reason);
-    };
-    result.lubricant.emplace();
-    result.lubricant->fluid_dofs = 3 * lubricant->fluid().space().node_count();
+  // A run that stopped inside a failing step fails like one stopped after an accepted step.
+  void check_report(const solid::IntegrationReport& report) const {
+    if (stopped_a_failing_step_) throw Error(report.reason);
   }
-  solid::TimeIntegrator integrator(problem, o);
-  integrator_of_step = &integrator;
-  if (seed000 && scene.scheme == solid::TimeScheme::generalized_alpha) {
-    // The chip starts moving with Γ_B: a rigid translation at the sliding velocity.
-    Eigen::VectorXd v0 = Eigen::VectorXd::Zero(problem.dof_count());
-    for (Eigen::Index i = 0; i < v0.size(); i += 2) v0(i) = velocity;
-    integrator.set_initial(Eigen::VectorXd::Zero(problem.dof_count()), v0);
-  }
-  // Seed 000 averages over time, press-slide over sliding distance.
-  // (Seed 000's window has no upper end: the run stops at its end, and the arithmetic stays the one
-  // that gave the published figures, to the bit.)
-  WindowAverage average = seed000 ? WindowAverage(scene.average_from, std::numeric_limits<double>::infinity(), 0)
-                                  : WindowAverage(scene.protocol.run_in, scene.protocol.run_in + scene.protocol.window,
-                                                  scene.protocol.blocks);
-  const auto position = [&](double t) { return seed000 ? t : motion.distance(t); };
-  contact::ContactState last;
-  double previous_time = 0.0;
-  result.solver = integrator.run([&](const solid::StepView& view) {
-    last = contact->state(view.u);
+
+ private:
+  bool passed() const { return std::chrono::steady_clock::now() > deadline_; }
+  std::chrono::steady_clock::time_point deadline_;
+  char message_[80];
+  bool stopped_a_failing_step_ = false;
+};
+
+// Heat conduction through the chip, staggered after every accepted mechanical step (the plastic work
+// and the frictional heat raise the quadrature points' temperature; conduction spreads it).
+std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, solid::SolidProblem& problem,
+                                                           solid::TimeIntegrationOptions& o) {
+  if (!scene.heat_conduction) return nullptr;
+  auto heat = std::make_unique<solid::HeatConduction>(
+      problem.space(), solid::HeatConductionOptions{.conductivity = scene.conductivity,
+                                                    .density = scene.material.density,
+                                                    .specific_heat = scene.material.specific_heat,
+                                                    .held_side = numerics::Side::bottom,
+                                                    .held_temperature = scene.temperature});
+  o.after_step = [&problem, conduction = heat.get()](double, double dt, const Eigen::VectorXd& u, std::string& reason) {
+    std::vector<solid::MaterialState> states = problem.states();
+    if (!conduction->step(u, dt, states, reason)) return false;
+    problem.commit(std::move(states));
+    return true;
+  };
+  return heat;
+}
+
+// The lubricant: its load joins the chip's boundary interactions before the integrator assembles,
+// and every step becomes its fluid–structure exchange.
+std::unique_ptr<coupling::LubricatedChip> add_lubricant(const Scene& scene, solid::SolidProblem& problem,
+                                                        const SceneGeometry& geometry, const BottomMotion& motion,
+                                                        solid::TimeIntegrationOptions& o) {
+  if (scene.physics != Physics::lubricated) return nullptr;
+  auto lubricant = std::make_unique<coupling::LubricatedChip>(problem, geometry.tool_surface,
+                                                              lubricant_options(scene, motion.slide_start()));
+  o.coupled_step = [film = lubricant.get()](solid::TimeIntegrator& integrator, double t0, double dt,
+                                            std::string& reason) { return film->step(integrator, t0, dt, reason); };
+  return lubricant;
+}
+
+// What every accepted step records: the contact state, the lubricant's own record of the step, μ by
+// eq. (17) over the whole chip boundary (contact and fluid traction), and μ into the window average
+// (seed 000 averages over time, press-slide over sliding distance).
+class StepRecorder {
+ public:
+  StepRecorder(const Scene& scene, const BottomMotion& motion, const contact::MortarContact& contact,
+               const coupling::LubricatedChip* lubricant)
+      : seed000_(scene.protocol.name == Protocol::seed000),
+        motion_(motion),
+        contact_(contact),
+        lubricant_(lubricant),
+        // (Seed 000's window has no upper end: the run stops at its end, and the arithmetic stays the
+        // one that gave the published figures, to the bit.)
+        average_(seed000_ ? WindowAverage(scene.average_from, std::numeric_limits<double>::infinity(), 0)
+                          : WindowAverage(scene.protocol.run_in, scene.protocol.run_in + scene.protocol.window,
+                                          scene.protocol.blocks)) {}
+
+  const MicroStep& record(const solid::StepView& view) {
+    last_contact_ = contact_.state(view.u);
     MicroStep step;
     step.time = view.time;
-    step.sliding_distance = motion.distance(view.time);
-    step.force = last.force;
-    if (lubricant && !lubricant->history().empty()) {
-      const coupling::LubricatedStep& l = lubricant->history().back();
-      step.fluid_force = l.fluid_force;
-      step.force += l.fluid_force;  // eq. (17) over the whole chip boundary: contact and fluid traction
-      step.coupling_iterations = l.coupling_iterations;
-      step.film_area = l.film_area;
-      step.pocket_areas = l.pocket_areas;
-      step.cavitated_fraction = l.cavitated_fraction;
-      step.cavity_area = l.cavity_area;
-      step.liquid_area = l.liquid_area;
-      step.film_volume_error = l.volume_error;
-      step.leaked_area = l.leaked_area;
+    step.sliding_distance = motion_.distance(view.time);
+    step.force = last_contact_.force;
+    if (lubricant_ && !lubricant_->history().empty()) {
+      step.lubricant = lubricant_->history().back();
+      step.force += step.lubricant->fluid_force;
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
-    step.contact_fraction = last.contact_length / last.surface_length;
-    step.max_pressure = last.max_pressure;
-    result.history.push_back(step);
-    if (step.mu) average.add(position(previous_time), position(view.time), *step.mu);
-    previous_time = view.time;
-    if (options.on_step) options.on_step(step, scene);
-    if (past_deadline()) {
-      char where[120];
-      std::snprintf(where, sizeof where, " at t = %.4g s (sliding distance %.4g um, step %zu)", view.time,
-                    1e6 * step.sliding_distance, result.history.size());
-      throw Error(limit_reached + std::string(where));
-    }
-  });
-  if (stopped_by_deadline) throw Error(result.solver.reason);  // like the accepted-step check: a failed sample
-  result.averaged_steps = average.steps();
-  const solid::IntegrationReport& report = result.solver;
-  for (size_t k = 0; k < report.steps.size() && k < result.history.size(); ++k) {
-    result.history[k].newton_iterations = report.steps[k].newton_iterations;
+    step.contact_fraction = last_contact_.contact_length / last_contact_.surface_length;
+    step.max_pressure = last_contact_.max_pressure;
+    if (step.mu) average_.add(position(previous_time_), position(view.time), *step.mu);
+    previous_time_ = view.time;
+    history_.push_back(std::move(step));
+    return history_.back();
   }
-  if (lubricant) {
-    auto& l = *result.lubricant;
-    for (const auto& h : lubricant->history()) {
-      l.coupling_iterations += h.coupling_iterations;
-      l.coupling_restarts += h.coupling_restarts;
-      l.max_coupling_iterations = std::max(l.max_coupling_iterations, h.coupling_iterations);
-      l.fluid_newton_iterations += h.fluid_newton_iterations;
-      l.leaked_area += h.leaked_area;
-      l.exchanged_area += h.exchanged_area;
-      l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);
-    }
-    l.initial_film_area = lubricant->formed_film_area();
-    l.initial_liquid_area = lubricant->formed_liquid_area();
-    if (!lubricant->history().empty()) {
-      l.final_film_area = lubricant->history().back().film_area;
-      l.final_liquid_area = lubricant->history().back().liquid_area;
-      l.final_pocket_areas = lubricant->history().back().pocket_areas;
-    }
+  std::vector<MicroStep>& history() { return history_; }
+  const WindowAverage& average() const { return average_; }
+  const contact::ContactState& last_contact() const { return last_contact_; }
+
+ private:
+  double position(double t) const { return seed000_ ? t : motion_.distance(t); }
+  bool seed000_;
+  const BottomMotion& motion_;
+  const contact::MortarContact& contact_;
+  const coupling::LubricatedChip* lubricant_;
+  WindowAverage average_;
+  contact::ContactState last_contact_;
+  double previous_time_ = 0.0;
+  std::vector<MicroStep> history_;
+};
+
+// The lubricant's totals over the accepted steps, and its film when formed and at the end.
+LubricantRecord lubricant_record(const coupling::LubricatedChip& lubricant) {
+  LubricantRecord l;
+  l.fluid_dofs = 3 * lubricant.fluid().space().node_count();
+  for (const auto& h : lubricant.history()) {
+    l.coupling_iterations += h.coupling_iterations;
+    l.coupling_restarts += h.coupling_restarts;
+    l.max_coupling_iterations = std::max(l.max_coupling_iterations, h.coupling_iterations);
+    l.fluid_newton_iterations += h.fluid_newton_iterations;
+    l.leaked_area += h.leaked_area;
+    l.exchanged_area += h.exchanged_area;
+    l.min_relative_jacobian = std::min(l.min_relative_jacobian, h.min_relative_jacobian);
   }
+  l.initial_film_area = lubricant.formed_film_area();
+  l.initial_liquid_area = lubricant.formed_liquid_area();
+  if (!lubricant.history().empty()) {
+    l.final_film_area = lubricant.history().back().film_area;
+    l.final_liquid_area = lubricant.history().back().liquid_area;
+    l.final_pocket_areas = lubricant.history().back().pocket_areas;
+  }
+  return l;
+}
+
+// The chip's state at the end: contact, the extremes over its quadrature points, and a warning when
+// any of them reached the melting temperature (μ is then outside what the model describes).
+void record_end_state(const Scene& scene, const solid::SolidProblem& problem, const contact::ContactState& last,
+                      MicroResult& result) {
   result.contact_fraction = last.surface_length > 0.0 ? last.contact_length / last.surface_length : 0.0;
   result.max_contact_pressure = last.max_pressure;
   result.final_contact = last;
@@ -487,28 +525,74 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
                               std::to_string(molten) + " of " + std::to_string(problem.states().size()) +
                               " quadrature points: Johnson-Cook leaves it no strength there, so mu is outside the model's range");
   }
-  if (!report.completed) {
-    result.reason = report.reason;
+}
+
+// μ over the window, or why there is none.
+void record_outcome(const Scene& scene, const WindowAverage& average, MicroResult& result) {
+  if (!result.solver.completed) {
+    result.reason = result.solver.reason;
   } else if (average.weight() <= 0.0) {
     result.reason = "the chip did not touch the tool during the averaging window; raise load.pressure or lower "
                     "geometry.initial_gap";
   } else {
     result.completed = true;
     result.mu = average.mean();
-    if (!seed000) {
+    if (scene.protocol.name != Protocol::seed000) {
       result.block_means = average.block_means();
       result.drift = (result.block_means.back() - result.block_means.front()) / std::max(std::abs(result.mu), 1e-300);
     }
   }
+}
+
+}  // namespace
+
+MicroResult run_micro(const Scene& scene, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const SceneGeometry geometry = build_geometry(scene);
+  const BottomMotion motion(scene);
+  LoadedChip chip = load_chip(scene, geometry, motion);
+  solid::SolidProblem& problem = *chip.problem;
+  MicroResult result;
+  result.dofs = problem.dof_count();
+  result.elements = problem.space().element_count();
+  result.slide_start_time = motion.slide_start();
+
+  solid::TimeIntegrationOptions o = integration_options(scene, motion);
+  WallTimeLimit limit(options);
+  limit.watch_failed_attempts(o);
+  const auto heat = add_heat_conduction(scene, problem, o);
+  const auto lubricant = add_lubricant(scene, problem, geometry, motion, o);
+  solid::TimeIntegrator integrator(problem, o);
+  if (scene.protocol.name == Protocol::seed000 && scene.scheme == solid::TimeScheme::generalized_alpha) {
+    // The chip starts moving with Γ_B: a rigid translation at the sliding velocity.
+    Eigen::VectorXd v0 = Eigen::VectorXd::Zero(problem.dof_count());
+    for (Eigen::Index i = 0; i < v0.size(); i += 2) v0(i) = scene.velocity;
+    integrator.set_initial(Eigen::VectorXd::Zero(problem.dof_count()), v0);
+  }
+  StepRecorder recorder(scene, motion, *chip.contact, lubricant.get());
+  result.solver = integrator.run([&](const solid::StepView& view) {
+    const MicroStep& step = recorder.record(view);
+    if (options.on_step) options.on_step(step, scene);
+    limit.check_accepted_step(step, recorder.history().size());
+  });
+  limit.check_report(result.solver);
+
+  result.history = std::move(recorder.history());
+  for (size_t k = 0; k < result.solver.steps.size() && k < result.history.size(); ++k) {
+    result.history[k].newton_iterations = result.solver.steps[k].newton_iterations;
+  }
+  result.averaged_steps = recorder.average().steps();
+  if (lubricant) result.lubricant = lubricant_record(*lubricant);
+  record_end_state(scene, problem, recorder.last_contact(), result);
+  record_outcome(scene, recorder.average(), result);
   if (!options.vtu_directory.empty()) {
-    write_chip_vtu(options.vtu_directory + "/chip.vtu", problem, integrator.u(), last);
+    write_chip_vtu(options.vtu_directory + "/chip.vtu", problem, integrator.u(), recorder.last_contact());
     write_tool_vtu(options.vtu_directory + "/tool.vtu", geometry.tool_surface);
     if (lubricant) write_film_vtu(options.vtu_directory + "/film.vtu", lubricant->fluid());
   }
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
-
 
 std::vector<Draw> protocol_draws(const Scene& scene) {
   if (scene.protocol.name == Protocol::seed000) return {Draw{0, 0, 0.0, scene.tool_surface.synthetic.seed, {}, {}}};
@@ -695,7 +779,7 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
          {"step_distance_m", q.step_distance},
          {"phases", q.phases},
          {"realisations", q.realisations},
-         {"drawn_surfaces", drawn_surfaces_name(q.draws)},
+         {"drawn_surfaces", choice_name(q.draws)},
          {"draws", draws.size()},
          {"max_abs_drift", max_abs_drift()}};
   }

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "micro/contact/mortar_contact.hpp"
+#include "micro/coupling/lubricated_chip.hpp"
 #include "micro/scene/scene.hpp"
 
 namespace mufric::scene {
@@ -24,15 +25,9 @@ struct MicroStep {
   double sliding_distance = 0.0;                    // m, of Γ_B since sliding started
   std::optional<double> mu;                         // ∫Tx/∫Ty; none while nothing touches
   Eigen::Vector2d force = Eigen::Vector2d::Zero();  // resultant on the chip (contact + lubricant), N/m
-  Eigen::Vector2d fluid_force = Eigen::Vector2d::Zero();  // the lubricant's part of it, N/m
-  int coupling_iterations = 0;                      // lubricated: fluid–structure exchanges in the step
-  double film_area = 0.0;                           // lubricated: the film's area, m² per unit depth
-  std::vector<double> pocket_areas;                 // lubricated: between contact spots, m² per unit depth
-  double cavitated_fraction = 0.0;                  // lubricated: of the interface, cavitated pockets
-  double cavity_area = 0.0;                         // lubricated: their space not filled by liquid, m² per unit depth
-  double liquid_area = 0.0;                         // lubricated: the liquid's volume, m² per unit depth (film less cavities)
-  double leaked_area = 0.0;                         // lubricated: liquid that left the plane in the step, m² per unit depth
-  double film_volume_error = 0.0;                   // lubricated: liquid moved through the film's wall by the coupling's mismatch, of the film
+  // Lubricated, once the film has formed: the lubricant's own record of the step (its force on the
+  // chip, coupling work, film, pockets, cavities, liquid), as the coupled step wrote it.
+  std::optional<coupling::LubricatedStep> lubricant;
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;

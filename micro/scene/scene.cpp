@@ -81,6 +81,20 @@ class Section {
     }
     return s;
   }
+  // A word from the choice's one table (SceneChoice<E>::names).
+  template <class E>
+  E choice(const std::string& key, E fallback) {
+    const json* v = take(key);
+    if (v == nullptr) return fallback;
+    if (!v->is_string()) fail(key, "must be a string");
+    const auto word = v->get<std::string>();
+    std::string list;
+    for (const auto& c : SceneChoice<E>::names) {
+      if (word == c.name) return c.value;
+      list += (list.empty() ? "" : ", ") + std::string(c.name);
+    }
+    fail(key, "'" + word + "' is not one of: " + list);
+  }
   Section child(const std::string& key) {
     static const json empty = json::object();
     const json* v = take(key);
@@ -133,10 +147,6 @@ SurfaceSpec read_surface(Section s, const std::string& base_directory) {
 
 }  // namespace
 
-const char* drawn_surfaces_name(DrawnSurfaces d) {
-  return d == DrawnSurfaces::tools ? "tools" : "tools-and-chip";
-}
-
 nlohmann::json read_scene_json(const std::string& path) {
   const auto text = read_whole_file(path);
   if (!text) throw Error(path + ": cannot read the scene file");
@@ -183,7 +193,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   s.source = source;
   s.effective = j;
   Section root(j, "", source);
-  s.physics = root.text("physics", "dry", {"dry", "lubricated"});
+  s.physics = root.choice("physics", s.physics);
   {
     Section g = root.child("geometry");
     s.interval = g.quantity("interval", QuantityKind::length, s.interval, 1e-9, 1e-2);
@@ -201,7 +211,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     s.elements_x = d.integer("elements_x", s.elements_x, 4, 100000);
     s.elements_y = d.integer("elements_y", s.elements_y, 1, 100000);
     s.grading = d.number("grading", s.grading, 1.0, 6.0);
-    s.contact_points_per_span = d.integer("contact_points_per_span", 0, 0, 20);
+    s.contact_points_per_span = d.integer("contact_points_per_span", s.contact_points_per_span, 0, 20);
     d.finish();
   }
   {
@@ -242,8 +252,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   }
   {
     Section t = root.child("time");
-    const std::string scheme = t.text("scheme", "generalized-alpha", {"generalized-alpha", "quasi-static"});
-    s.scheme = scheme == "quasi-static" ? solid::TimeScheme::quasi_static : solid::TimeScheme::generalized_alpha;
+    s.scheme = t.choice("scheme", s.scheme);
     s.spectral_radius = t.number("spectral_radius", s.spectral_radius, 0.0, 1.0);
     s.dt = t.quantity("step", QuantityKind::time, s.dt, 1e-15, 1.0);
     s.duration = t.quantity("duration", QuantityKind::time, s.duration, 1e-15, 10.0);
@@ -257,7 +266,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   {
     Section p = root.child("protocol");
     auto& q = s.protocol;
-    q.name = p.text("name", "press-slide", {"press-slide", "seed-000"}) == "seed-000" ? Protocol::seed000 : Protocol::press_slide;
+    q.name = p.choice("name", q.name);
     q.press_hold = p.quantity("press_hold", QuantityKind::time, q.press_hold, 0.0, 1.0);
     q.run_in = p.quantity("run_in", QuantityKind::length, q.run_in, 0.0, 1.0);
     q.window = p.quantity("window", QuantityKind::length, q.window, 1e-12, 1.0);
@@ -278,9 +287,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
       }
       if (q.step_distance > q.window) p.fail("step_distance", "is longer than the window");
       const bool chip_drawable = s.chip_surface.is_synthetic();
-      q.draws = p.text("draws", chip_drawable ? "tools-and-chip" : "tools", {"tools", "tools-and-chip"}) == "tools"
-                    ? DrawnSurfaces::tools
-                    : DrawnSurfaces::tools_and_chip;
+      q.draws = p.choice("draws", chip_drawable ? DrawnSurfaces::tools_and_chip : DrawnSurfaces::tools);
       if (q.draws == DrawnSurfaces::tools_and_chip && !chip_drawable) {
         p.fail("draws", "tools-and-chip draws the chip surface anew; this chip is " +
                             std::string(s.chip_surface.flat ? "flat" : "a measured profile") + " (use tools)");
@@ -301,25 +308,25 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     auto& l = s.lubricant;
     l.density = f.number("density", l.density, 1.0, 1e5);
     l.viscosity = f.number("viscosity", l.viscosity, 1e-6, 1e6);
-    l.compressibility = f.text("compressibility", l.compressibility, {"none", "linear", "dowson-higginson"});
+    l.compressibility = f.choice("compressibility", l.compressibility);
     l.bulk_modulus = f.quantity("bulk_modulus", QuantityKind::pressure, l.bulk_modulus, 1e6, 1e13);
     l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
     l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
     l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
-    l.fill = f.text("fill", s.protocol.name == Protocol::press_slide ? l.fill : "gap", {"gap", "after-pressing"});
-    if (l.fill == "after-pressing" && s.protocol.name != Protocol::press_slide) {
+    l.fill = f.choice("fill", s.protocol.name == Protocol::press_slide ? l.fill : FilmFill::gap);
+    if (l.fill == FilmFill::after_pressing && s.protocol.name != Protocol::press_slide) {
       f.fail("fill", "after-pressing needs the press-slide protocol (seed 000's presses while sliding)");
     }
-    l.cavitation = f.text("cavitation", l.cavitation, {"none", "mass-conserving"});
+    l.cavitation = f.choice("cavitation", l.cavitation);
     l.cavitation_pressure = f.quantity("cavitation_pressure", QuantityKind::pressure, l.cavitation_pressure, -1e9, 1e9);
-    l.leak = f.text("leak", s.protocol.name == Protocol::press_slide ? l.leak : "none", {"none", "ambient", "cell-mean"});
+    l.leak = f.choice("leak", s.protocol.name == Protocol::press_slide ? l.leak : LeakModel::none);
     l.leak_length = f.quantity("leak_length", QuantityKind::length, l.leak_length, 1e-9, 1.0);
     l.contact_fade = f.number("contact_fade", l.contact_fade, 1.01, 100.0);
     l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
     l.robin_stiffness = f.number("robin_stiffness", l.robin_stiffness, 0.0, 1e25);
-    l.mesh_motion = f.text("mesh_motion", l.mesh_motion, {"columns", "elastic"});
+    l.mesh_motion = f.choice("mesh_motion", l.mesh_motion);
     l.mesh_stiffening = f.number("mesh_stiffening", l.mesh_stiffening, 0.0, 5.0);
-    l.acceleration = f.text("acceleration", l.acceleration, {"iqn-ils", "aitken", "relaxation"});
+    l.acceleration = f.choice("acceleration", l.acceleration);
     l.relaxation = f.number("relaxation", l.relaxation, 1e-6, 1.0);
     l.reuse_steps = f.integer("reuse_steps", l.reuse_steps, 0, 100);
     l.qr_filter = f.number("qr_filter", l.qr_filter, 0.0, 0.999);
@@ -345,12 +352,11 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     // frozen over a step and the mass term make the tangent symmetric positive definite (measured:
     // symmetric to 1e-16); CHOLMOD halves the solve time against UMFPACK at 1800–3300 dofs
     // (bench/RESULTS.md) and hands any tangent it finds indefinite to LU.
-    s.linear_solver = v.text("linear_solver", "cholesky", {"lu", "cholesky"}) == "cholesky" ? solid::LinearSolverKind::cholesky
-                                                                                          : solid::LinearSolverKind::lu;
+    s.linear_solver = v.choice("linear_solver", s.linear_solver);
     v.finish();
   }
   root.finish();
-  if (s.physics == "dry" && j.contains("lubricant")) {
+  if (s.physics == Physics::dry && j.contains("lubricant")) {
     s.warnings.push_back("lubricant.* is read but has no effect: the scene's physics is dry (physics=lubricated to use it)");
   }
   const SceneCost cost = estimate_scene_cost(s);

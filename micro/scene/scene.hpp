@@ -2,17 +2,36 @@
 // A micro-model scene: everything one high-fidelity run needs, read from JSON. Dimensional values
 // are strings with units ("800MPa", "10um", "500C", "5ns"); counts and ratios are numbers. Unknown
 // keys and out-of-range values are errors that name the key (e.g. "load.pressure").
+#include <array>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "micro/coupling/lubricated_chip.hpp"
 #include "micro/fluid/navier_stokes.hpp"
 #include "micro/solid/materials.hpp"
 #include "micro/solid/time_integrator.hpp"
 #include "micro/spline/profile.hpp"
 
 namespace mufric::scene {
+
+// A choice a scene file spells as a word ("lubricated", "iqn-ils"): parsed once into its enum, and
+// spelled back from the same table (SceneChoice<E>::names, below the enums) in messages and results.
+template <class E>
+struct NamedChoice {
+  const char* name;
+  E value;
+};
+template <class E>
+struct SceneChoice;
+template <class E>
+const char* choice_name(E value) {
+  for (const auto& c : SceneChoice<E>::names) {
+    if (c.value == value) return c.name;
+  }
+  return "unknown";
+}
 
 // One rough surface: a measured profile (CSV), a synthetic one, or flat; fitted by a periodic spline.
 struct SurfaceSpec {
@@ -37,7 +56,6 @@ enum class Protocol { press_slide, seed000 };
 // synthetic chip: with the chip fixed, every run shares its error, measured at about 15 % of μ at the
 // box centre, issue 33).
 enum class DrawnSurfaces { tools, tools_and_chip };
-const char* drawn_surfaces_name(DrawnSurfaces d);
 
 struct ProtocolSpec {
   Protocol name = Protocol::press_slide;
@@ -59,6 +77,12 @@ struct ProtocolSpec {
 };
 inline constexpr double kAccelerationShareOfRunIn = 0.25;
 
+enum class Physics { dry, lubricated };
+enum class Compressibility { none, linear, dowson_higginson };
+enum class FilmFill { gap, after_pressing };
+enum class CavitationModel { none, mass_conserving };
+enum class LeakModel { none, ambient, cell_mean };
+
 // The lubricant in the pockets (physics "lubricated"; ignored by a dry run, so one scene serves both).
 struct LubricantSpec {
   double density = 800.0;      // kg/m³ (seed 000 Table 2)
@@ -66,7 +90,7 @@ struct LubricantSpec {
   // "none" (incompressible, seed 000), "linear" (ρ/ρ₀ = 1 + p/K₀) or "dowson-higginson" (ρ/ρ₀ =
   // 1 + (p/K₀)/(1 + 1.7 GPa⁻¹ p)); K₀ the bulk modulus at p = 0, Dowson & Higginson's 1/(0.6 GPa⁻¹) by
   // default (fluid::FluidProperties).
-  std::string compressibility = "none";
+  Compressibility compressibility = Compressibility::none;
   double bulk_modulus = fluid::kDowsonHigginsonBulkModulus;  // Pa
   int elements_x = 0;          // film columns; 0: the chip's discretisation.elements_x
   int elements_y = 4;          // elements across the film
@@ -76,17 +100,17 @@ struct LubricantSpec {
   // What the film holds: "gap", all the lubricant in the initial gap from t = 0 (seed-000 protocol's
   // default: it carries the load and no contact forms); "after-pressing" (press-slide's default), the
   // chip pressed dry (the lubricant drained) and the film formed in the gap it leaves when sliding starts.
-  std::string fill = "after-pressing";
+  FilmFill fill = FilmFill::after_pressing;
   // Tension in the film: "none", the liquid holds any (seed 000's model); "mass-conserving", where the
   // liquid would pull the chip below cavitation_pressure a cavity opens (micro/coupling/cavitation.hpp).
-  std::string cavitation = "mass-conserving";
+  CavitationModel cavitation = CavitationModel::mass_conserving;
   double cavitation_pressure = 0.0;  // Pa, relative to the ambient zero of the applied load
   // Liquid flowing out of the plane of the cell (coupling::LubricantOptions::leak): "none", sealed in
   // it (seed 000's protocol's default); "ambient" (press-slide's default), draining toward the ambient
   // zero; "cell-mean", moving between the film's parts toward its mean pressure (the film keeps its
   // liquid). Over leak_length either side of the slice. Decided from a study (README, "The lubricant";
   // bench/RESULTS.md, "The lubricant, eighth pass").
-  std::string leak = "ambient";
+  LeakModel leak = LeakModel::ambient;
   double leak_length = 1e-6;  // m: about the roughness' correlation length (tool 0.8 µm, chip 1 µm)
   // Minimum films over which the fluid's load fades out into a contact spot (a continuous switch).
   double contact_fade = 2.0;
@@ -95,9 +119,9 @@ struct LubricantSpec {
   double robin_stiffness = 0.0;  // β, Pa/m: the chip's stiffness in the automatic α_R (coupling/lubricated_chip.hpp)
   // How the film's interior follows its walls: "columns" (algebraic, cannot fold) or "elastic" (EMUM,
   // with mesh_stiffening the χ of its Jacobian-based stiffening); micro/coupling/lubricated_chip.hpp.
-  std::string mesh_motion = "columns";
+  coupling::FilmMeshMotion mesh_motion = coupling::FilmMeshMotion::columns;
   double mesh_stiffening = 1.0;
-  std::string acceleration = "iqn-ils";  // iqn-ils, aitken or relaxation
+  coupling::Acceleration acceleration = coupling::Acceleration::iqn_ils;  // iqn-ils, aitken or relaxation
   double relaxation = 0.5;
   int reuse_steps = 8;
   double qr_filter = 1e-8;
@@ -125,7 +149,7 @@ struct LubricantSpec {
 
 struct Scene {
   std::string source;  // file name, for messages
-  std::string physics = "dry";
+  Physics physics = Physics::dry;
   // geometry
   double interval = 10e-6;      // m, the periodic width (seed 000: 1e-5 m)
   double chip_height = 5e-6;    // m, from the mean chip surface down to Γ_B
@@ -168,10 +192,73 @@ struct Scene {
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
   int max_cutbacks = 8;
-  solid::LinearSolverKind linear_solver = solid::LinearSolverKind::cholesky;  // falls back to LU per matrix
+  numerics::LinearSolverKind linear_solver = numerics::LinearSolverKind::cholesky;  // falls back to LU per matrix
 
-  nlohmann::json effective;  // the scene as read, with overrides applied (for the result's provenance)
+  // The scene as read, with overrides applied (for the result's provenance). Kept as the user's words
+  // rather than written back from the parsed values: a dataset's scene hash and `micro run --set ...`
+  // replaying a sample rest on it, and parse_scene of it gives these very values (every key is read,
+  // unknown keys are errors), so it cannot say more or less than the run used.
+  nlohmann::json effective;
   std::vector<std::string> warnings;  // keys read but without effect (lubricant.* in a dry scene)
+};
+
+// The words of the scene file, in the order its error messages list them.
+template <>
+struct SceneChoice<Physics> {
+  static constexpr std::array<NamedChoice<Physics>, 2> names{{{"dry", Physics::dry}, {"lubricated", Physics::lubricated}}};
+};
+template <>
+struct SceneChoice<Protocol> {
+  static constexpr std::array<NamedChoice<Protocol>, 2> names{
+      {{"press-slide", Protocol::press_slide}, {"seed-000", Protocol::seed000}}};
+};
+template <>
+struct SceneChoice<DrawnSurfaces> {
+  static constexpr std::array<NamedChoice<DrawnSurfaces>, 2> names{
+      {{"tools", DrawnSurfaces::tools}, {"tools-and-chip", DrawnSurfaces::tools_and_chip}}};
+};
+template <>
+struct SceneChoice<solid::TimeScheme> {
+  static constexpr std::array<NamedChoice<solid::TimeScheme>, 2> names{
+      {{"generalized-alpha", solid::TimeScheme::generalized_alpha}, {"quasi-static", solid::TimeScheme::quasi_static}}};
+};
+template <>
+struct SceneChoice<numerics::LinearSolverKind> {
+  static constexpr std::array<NamedChoice<numerics::LinearSolverKind>, 2> names{
+      {{"lu", numerics::LinearSolverKind::lu}, {"cholesky", numerics::LinearSolverKind::cholesky}}};
+};
+template <>
+struct SceneChoice<Compressibility> {
+  static constexpr std::array<NamedChoice<Compressibility>, 3> names{{{"none", Compressibility::none},
+                                                                      {"linear", Compressibility::linear},
+                                                                      {"dowson-higginson", Compressibility::dowson_higginson}}};
+};
+template <>
+struct SceneChoice<FilmFill> {
+  static constexpr std::array<NamedChoice<FilmFill>, 2> names{
+      {{"gap", FilmFill::gap}, {"after-pressing", FilmFill::after_pressing}}};
+};
+template <>
+struct SceneChoice<CavitationModel> {
+  static constexpr std::array<NamedChoice<CavitationModel>, 2> names{
+      {{"none", CavitationModel::none}, {"mass-conserving", CavitationModel::mass_conserving}}};
+};
+template <>
+struct SceneChoice<LeakModel> {
+  static constexpr std::array<NamedChoice<LeakModel>, 3> names{
+      {{"none", LeakModel::none}, {"ambient", LeakModel::ambient}, {"cell-mean", LeakModel::cell_mean}}};
+};
+template <>
+struct SceneChoice<coupling::FilmMeshMotion> {
+  static constexpr std::array<NamedChoice<coupling::FilmMeshMotion>, 2> names{
+      {{"columns", coupling::FilmMeshMotion::columns}, {"elastic", coupling::FilmMeshMotion::elastic}}};
+};
+template <>
+struct SceneChoice<coupling::Acceleration> {
+  static constexpr std::array<NamedChoice<coupling::Acceleration>, 3> names{
+      {{"iqn-ils", coupling::Acceleration::iqn_ils},
+       {"aitken", coupling::Acceleration::aitken},
+       {"relaxation", coupling::Acceleration::constant_relaxation}}};
 };
 
 // What a scene costs before it runs: unknowns, stored nonzeros and a lower bound of the memory the

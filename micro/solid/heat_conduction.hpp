@@ -13,7 +13,7 @@
 #include <Eigen/Sparse>
 
 #include "micro/solid/iga_space.hpp"
-#include "micro/solid/linear_solver.hpp"
+#include "micro/numerics/linear_solver.hpp"
 #include "micro/solid/materials.hpp"
 
 namespace mufric::solid {
@@ -22,7 +22,7 @@ struct HeatConductionOptions {
   double conductivity = 50.0;      // W/(m K)
   double density = 7800.0;         // kg/m³ (reference)
   double specific_heat = 450.0;    // J/(kg K)
-  Side held_side = Side::bottom;   // held at held_temperature
+  numerics::Side held_side = numerics::Side::bottom;   // held at held_temperature
   double held_temperature = 293.15;  // K; also the initial temperature everywhere
 };
 
@@ -48,7 +48,7 @@ class HeatConduction {
   Eigen::VectorXd temperature_;            // per control point, K
   Eigen::SparseMatrix<double> capacity_;   // ∫ ρ₀ c R_a R_b dV₀ (full storage)
   std::vector<char> held_;                 // per node: on the held side
-  LinearSolver solver_{LinearSolverKind::cholesky};
+  numerics::LinearSolver solver_{numerics::LinearSolverKind::cholesky};
 };
 
 }  // namespace mufric::solid

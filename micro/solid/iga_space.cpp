@@ -6,27 +6,13 @@
 
 namespace mufric::solid {
 
-void gauss_legendre(int count, std::vector<double>& nodes, std::vector<double>& weights) {
-  Eigen::MatrixXd jacobi = Eigen::MatrixXd::Zero(count, count);
-  for (int k = 1; k < count; ++k) {
-    jacobi(k, k - 1) = jacobi(k - 1, k) = k / std::sqrt(4.0 * k * k - 1.0);
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jacobi);
-  nodes.resize(static_cast<size_t>(count));
-  weights.resize(static_cast<size_t>(count));
-  for (int k = 0; k < count; ++k) {
-    nodes[static_cast<size_t>(k)] = eigen.eigenvalues()(k);
-    weights[static_cast<size_t>(k)] = 2.0 * eigen.eigenvectors()(0, k) * eigen.eigenvectors()(0, k);
-  }
-}
-
 IgaSpace::IgaSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
   const auto bu = patch_.u_basis().breakpoints(), bv = patch_.v_basis().breakpoints();
   elements_u_ = static_cast<int>(bu.size()) - 1;
   elements_v_ = static_cast<int>(bv.size()) - 1;
   std::vector<double> gu, wu, gv, wv;
-  gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
-  gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
+  numerics::gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
+  numerics::gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
   for (int ev = 0; ev < elements_v_; ++ev) {
     for (int eu = 0; eu < elements_u_; ++eu) {
       const double u0 = bu[static_cast<size_t>(eu)], u1 = bu[static_cast<size_t>(eu) + 1];
@@ -58,17 +44,17 @@ IgaSpace::IgaSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
   }
 }
 
-std::vector<BoundaryPoint> IgaSpace::boundary(Side side, int points_per_span) const {
-  const bool along_u = side == Side::bottom || side == Side::top;
+std::vector<BoundaryPoint> IgaSpace::boundary(numerics::Side side, int points_per_span) const {
+  const bool along_u = side == numerics::Side::bottom || side == numerics::Side::top;
   if (!along_u && patch_.u_basis().is_periodic()) {
     throw Error("IGA patch: a periodic patch has no left or right side");
   }
   const auto& along = along_u ? patch_.u_basis() : patch_.v_basis();
   const auto& across = along_u ? patch_.v_basis() : patch_.u_basis();
-  const double fixed = (side == Side::bottom || side == Side::left) ? across.lo() : across.hi();
-  const double outward = (side == Side::bottom || side == Side::left) ? -1.0 : 1.0;
+  const double fixed = (side == numerics::Side::bottom || side == numerics::Side::left) ? across.lo() : across.hi();
+  const double outward = (side == numerics::Side::bottom || side == numerics::Side::left) ? -1.0 : 1.0;
   std::vector<double> g, w;
-  gauss_legendre(points_per_span > 0 ? points_per_span : along.degree() + 1, g, w);
+  numerics::gauss_legendre(points_per_span > 0 ? points_per_span : along.degree() + 1, g, w);
   const auto breaks = along.breakpoints();
   std::vector<BoundaryPoint> out;
   for (size_t e = 0; e + 1 < breaks.size(); ++e) {
@@ -93,16 +79,16 @@ std::vector<BoundaryPoint> IgaSpace::boundary(Side side, int points_per_span) co
   return out;
 }
 
-std::vector<int> IgaSpace::side_nodes(Side side) const {
+std::vector<int> IgaSpace::side_nodes(numerics::Side side) const {
   const int nu = patch_.u_basis().count(), nv = patch_.v_basis().count();
   std::vector<int> out;
   switch (side) {
-    case Side::bottom: for (int i = 0; i < nu; ++i) out.push_back(patch_.index(i, 0)); break;
-    case Side::top: for (int i = 0; i < nu; ++i) out.push_back(patch_.index(i, nv - 1)); break;
-    case Side::left:
-    case Side::right:
+    case numerics::Side::bottom: for (int i = 0; i < nu; ++i) out.push_back(patch_.index(i, 0)); break;
+    case numerics::Side::top: for (int i = 0; i < nu; ++i) out.push_back(patch_.index(i, nv - 1)); break;
+    case numerics::Side::left:
+    case numerics::Side::right:
       if (patch_.u_basis().is_periodic()) throw Error("IGA patch: a periodic patch has no left or right side");
-      for (int j = 0; j < nv; ++j) out.push_back(patch_.index(side == Side::left ? 0 : nu - 1, j));
+      for (int j = 0; j < nv; ++j) out.push_back(patch_.index(side == numerics::Side::left ? 0 : nu - 1, j));
       break;
   }
   return out;

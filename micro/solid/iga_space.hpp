@@ -8,6 +8,8 @@
 
 #include <Eigen/Dense>
 
+#include "micro/numerics/patch_side.hpp"
+#include "micro/numerics/quadrature.hpp"
 #include "micro/spline/spline_surface.hpp"
 
 namespace mufric::solid {
@@ -23,7 +25,6 @@ struct QuadraturePoint {
   int element = 0;
 };
 
-enum class Side { bottom, top, left, right };  // v = lo, v = hi, u = lo, u = hi
 
 // A quadrature point on a boundary side: values, the weight × line Jacobian, and the outward unit
 // normal (reference configuration); `parameter` is the curve parameter along the side.
@@ -46,9 +47,9 @@ class IgaSpace {
   const std::vector<QuadraturePoint>& quadrature() const { return points_; }
   // Gauss points along a side, `points_per_span` per span (0: degree + 1). Throws Error for left or
   // right of a periodic patch: it has none.
-  std::vector<BoundaryPoint> boundary(Side side, int points_per_span = 0) const;
+  std::vector<BoundaryPoint> boundary(numerics::Side side, int points_per_span = 0) const;
   // Control points on a side (for Dirichlet conditions).
-  std::vector<int> side_nodes(Side side) const;
+  std::vector<int> side_nodes(numerics::Side side) const;
   // The nodes' reference control-point positions (for linear fields: affine covariance).
   Eigen::Vector2d node_position(int node) const { return patch_.points().row(node).transpose(); }
 
@@ -77,8 +78,5 @@ struct ChipMeshOptions {
   double grading = 1.0;
 };
 spline::SplineSurface chip_patch(const spline::SplineCurve& surface, const ChipMeshOptions& options);
-
-// Gauss–Legendre nodes and weights on [−1, 1] (Golub & Welsch 1969, via the symmetric Jacobi matrix).
-void gauss_legendre(int count, std::vector<double>& nodes, std::vector<double>& weights);
 
 }  // namespace mufric::solid

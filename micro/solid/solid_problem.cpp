@@ -150,7 +150,7 @@ void SolidProblem::add_dirichlet(DirichletCondition condition) {
   dirichlet_.push_back(std::move(condition));
 }
 
-void SolidProblem::fix_side(Side side, int component, double value, TimeFunction scale) {
+void SolidProblem::fix_side(numerics::Side side, int component, double value, TimeFunction scale) {
   for (const int node : space_.side_nodes(side)) add_dirichlet({node, component, value, scale});
 }
 

@@ -45,7 +45,7 @@ struct DirichletCondition {
 };
 
 struct SideLoad {
-  Side side = Side::top;
+  numerics::Side side = numerics::Side::top;
   Eigen::Vector2d traction = Eigen::Vector2d::Zero();  // N/m² (force per reference length and unit depth)
   double pressure = 0.0;  // Pa, acting against the reference outward normal (dead load)
   TimeFunction scale;     // empty: 1
@@ -88,7 +88,7 @@ class SolidProblem {
 
   void add_dirichlet(DirichletCondition condition);
   // Every control point of a side, one component.
-  void fix_side(Side side, int component, double value = 0.0, TimeFunction scale = {});
+  void fix_side(numerics::Side side, int component, double value = 0.0, TimeFunction scale = {});
   void add_load(SideLoad load);
   // Displacement-dependent boundary forces (contact). Rebuilds the sparsity pattern.
   void add_interaction(std::shared_ptr<const BoundaryInteraction> interaction);

@@ -74,8 +74,8 @@ void TimeIntegrator::set_initial(const Eigen::VectorXd& u, const Eigen::VectorXd
     problem_.constrain(m);
     Eigen::VectorXd rhs = problem_.external(0.0) - f_int_;
     problem_.zero_constrained(rhs);
-    LinearSolver mass_solver(LinearSolverKind::cholesky);
-    if (!mass_solver.factorize(m, MatrixStorage::lower_symmetric)) throw Error("time integration: the mass matrix is singular");
+    numerics::LinearSolver mass_solver(numerics::LinearSolverKind::cholesky);
+    if (!mass_solver.factorize(m, numerics::MatrixStorage::lower_symmetric)) throw Error("time integration: the mass matrix is singular");
     a_ = mass_solver.solve(rhs);
   }
 }
@@ -85,7 +85,7 @@ TimeIntegrator::Attempt TimeIntegrator::step(double t0, double dt) {
   trial_.newton_iterations = trial_.line_search_reductions = 0;
   Attempt at;
   if (options_.coupled_step) {
-    if (!options_.coupled_step(t0, dt, at.reason)) return at;
+    if (!options_.coupled_step(*this, t0, dt, at.reason)) return at;
     if (!trial_.valid || trial_.t0 != t0 || trial_.dt != dt) {
       at.reason = "the coupled step ended without a solved trial of this step";
       return at;
@@ -221,7 +221,7 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     const auto start = std::chrono::steady_clock::now();
     // In the quadratic phase the tangent hardly changes between iterations: the last factorisation
     // serves once more (a chord step), and any sign of trouble brings a fresh one.
-    const bool reuse = options_.linear_solver == LinearSolverKind::lu && factorized && last_full_step &&
+    const bool reuse = options_.linear_solver == numerics::LinearSolverKind::lu && factorized && last_full_step &&
                        current.norm < kReuseFactorizationBelow * previous_norm;
     if (!reuse) {
       MovableSparseMatrix k = std::move(current.assembly.tangent);
@@ -232,7 +232,7 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
             mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
       }
       problem_.constrain(k);
-      if (!solver_.factorize(k, MatrixStorage::lower_symmetric)) {
+      if (!solver_.factorize(k, numerics::MatrixStorage::lower_symmetric)) {
         at.reason = solver_.reason();
         return at;
       }

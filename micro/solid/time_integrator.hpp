@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "micro/solid/linear_solver.hpp"
+#include "micro/numerics/linear_solver.hpp"
 #include "micro/solid/solid_problem.hpp"
 
 namespace mufric::solid {
@@ -41,6 +41,8 @@ inline constexpr double kShortestControlledStep = 0.25;
 // evaluated without its tangent (it is expected to end the step).
 inline constexpr double kPredictedConvergenceMargin = 0.1;
 
+class TimeIntegrator;
+
 struct TimeIntegrationOptions {
   TimeScheme scheme = TimeScheme::generalized_alpha;
   double spectral_radius = 0.8;  // ρ∞ ∈ [0, 1]: 1 conserves energy (trapezoidal), 0 damps the highest modes at once
@@ -54,11 +56,12 @@ struct TimeIntegrationOptions {
   // false (with a reason) ends the run as not completed.
   std::function<bool(double t, double dt, const Eigen::VectorXd& u, std::string& reason)> after_step;
   // When set, a step coupled with another field (the lubricant): called instead of one Newton solve
-  // of the step from t0 over dt. It may call TimeIntegrator::solve_trial(t0, dt, …) any number of
-  // times (each from the step's start, with whatever loads it set in between) and returns false with
-  // a reason when the coupled step fails (cut back like any failed step); on true, the last trial is
-  // accepted.
-  std::function<bool(double t0, double dt, std::string& reason)> coupled_step;
+  // of the step from t0 over dt, with the integrator itself, whose solve_trial(t0, dt, …) it may call
+  // any number of times (each from the step's start, with whatever loads it set in between). It
+  // returns false with a reason when the coupled step fails (cut back like any failed step); on true,
+  // the last trial is accepted. (The partner owns its exchange loop, as a preCICE participant does;
+  // the integrator owns time.)
+  std::function<bool(TimeIntegrator& integrator, double t0, double dt, std::string& reason)> coupled_step;
   // When set, asked after every failed attempt, before the step is cut back: true (with a reason)
   // ends the run as not completed. A wall-time limit, so that a step that keeps failing does not
   // outlast it by up to max_cutbacks more attempts (accepted steps are the caller's to check).
@@ -68,7 +71,7 @@ struct TimeIntegrationOptions {
   int max_newton_iterations = 30;
   bool line_search = true;
   int max_cutbacks = 8;          // consecutive halvings of a failing step before giving up
-  LinearSolverKind linear_solver = LinearSolverKind::lu;
+  numerics::LinearSolverKind linear_solver = numerics::LinearSolverKind::lu;
 };
 
 struct StepRecord {
@@ -158,7 +161,7 @@ class TimeIntegrator {
   Eigen::VectorXd last_increment_;  // u of the last accepted step minus u before it
   double last_dt_ = 0.0;            // its length; 0 before the first accepted step
   std::vector<Eigen::Matrix2d> stresses_;
-  LinearSolver solver_;
+  numerics::LinearSolver solver_;
   IntegrationReport report_;
 };
 

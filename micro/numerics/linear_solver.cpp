@@ -1,4 +1,4 @@
-#include "micro/solid/linear_solver.hpp"
+#include "micro/numerics/linear_solver.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
@@ -6,7 +6,7 @@
 
 #include <vector>
 
-namespace mufric::solid {
+namespace mufric::numerics {
 namespace {
 
 // Debian's CHOLMOD 3 (SuiteSparse 5) opens OpenMP teams of a compiled-in 4 threads in its supernodal
@@ -115,4 +115,4 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {
   return last_by_lu_ ? Eigen::VectorXd(impl_->lu.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
 }
 
-}  // namespace mufric::solid
+}  // namespace mufric::numerics

@@ -9,7 +9,7 @@
 
 #include <Eigen/Sparse>
 
-namespace mufric::solid {
+namespace mufric::numerics {
 
 enum class LinearSolverKind { lu, cholesky };
 // How a matrix given to the solver is stored: every entry, or the lower triangle of a symmetric
@@ -42,4 +42,4 @@ class LinearSolver {
   bool factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage);
 };
 
-}  // namespace mufric::solid
+}  // namespace mufric::numerics
