@@ -1,16 +1,15 @@
 #include "campaign/dataset_generation.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 #include <mutex>
 #include <set>
-#include <thread>
 
 #include "common/error.hpp"
 #include "common/version.hpp"
+#include "common/work_pool.hpp"
 
 namespace mufric {
 
@@ -212,67 +211,57 @@ GenerationReport generate_dataset(const Dataset& plan, const std::string& db_pat
   }
   write_dataset(db_path, db);  // the database exists (and is valid) before the first sample finishes
 
-  // The work pool: `jobs` workers (this thread one of them) take the pending rows in order. measure_mu
-  // (micro/scene/micro_run.cpp) runs its draws in a pool of the same shape, without the stop on a
-  // failed write; one helper for both would sit in common/ and is left for the rest of issue 31.
+  // `jobs` workers take the pending rows in order; a failed write stops them (the database on disk
+  // keeps every sample written before it).
   std::mutex lock;
-  std::atomic<size_t> next{0};
-  std::atomic<bool> stop{false};
+  bool write_failed = false;
   std::exception_ptr write_failure;
-  auto worker = [&] {
-    while (!stop) {
-      const size_t k = next++;
-      if (k >= pending.size()) return;
-      const long long row = pending[k];
-      SampleRequest request;
-      request.x = plan.plan.row(row).transpose();
-      request.plan_row = row;
-      if (plan.draws == DrawDesign::independent) request.seeds = row_draw_seeds(plan.plan_seed, row);
-      const Eigen::VectorXd& x = request.x;
-      const auto sample_start = std::chrono::steady_clock::now();
-      SampleOutcome outcome;
-      try {
-        outcome = evaluate(request);
-        if (outcome.converged && !std::isfinite(outcome.mu)) {
-          outcome.converged = false;
-          outcome.failure_reason = "the evaluator returned a non-finite mu";
-        }
-      } catch (const std::exception& e) {
-        outcome = SampleOutcome{};
-        outcome.failure_reason = std::string("exception: ") + e.what();
+  run_work_pool(pending.size(), options.jobs, [&](size_t k) {
+    const long long row = pending[k];
+    SampleRequest request;
+    request.x = plan.plan.row(row).transpose();
+    request.plan_row = row;
+    if (plan.draws == DrawDesign::independent) request.seeds = row_draw_seeds(plan.plan_seed, row);
+    const Eigen::VectorXd& x = request.x;
+    const auto sample_start = std::chrono::steady_clock::now();
+    SampleOutcome outcome;
+    try {
+      outcome = evaluate(request);
+      if (outcome.converged && !std::isfinite(outcome.mu)) {
+        outcome.converged = false;
+        outcome.failure_reason = "the evaluator returned a non-finite mu";
       }
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sample_start).count();
-      outcome.diagnostics["wall_seconds"] = seconds;
-      std::lock_guard<std::mutex> guard(lock);
-      if (stop) return;
-      try {
-        append_sample(db, x, row, outcome, request.seeds);
-        write_dataset(db_path, db);
-      } catch (...) {
-        write_failure = std::current_exception();
-        stop = true;
-        return;
-      }
-      ++report.ran;
-      (outcome.converged ? report.converged : report.failed) += 1;
-      if (options.on_sample) {
-        GenerationProgress p;
-        p.finished = report.ran;
-        p.to_run = static_cast<long long>(pending.size());
-        p.failed = report.failed;
-        p.plan_row = row;
-        p.outcome = &outcome;
-        p.sample_seconds = seconds;
-        p.elapsed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        options.on_sample(p);
-      }
+    } catch (const std::exception& e) {
+      outcome = SampleOutcome{};
+      outcome.failure_reason = std::string("exception: ") + e.what();
     }
-  };
-  const int threads = static_cast<int>(std::min<size_t>(static_cast<size_t>(options.jobs), std::max<size_t>(pending.size(), 1)));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sample_start).count();
+    outcome.diagnostics["wall_seconds"] = seconds;
+    std::lock_guard<std::mutex> guard(lock);
+    if (write_failed) return false;
+    try {
+      append_sample(db, x, row, outcome, request.seeds);
+      write_dataset(db_path, db);
+    } catch (...) {
+      write_failure = std::current_exception();
+      write_failed = true;
+      return false;
+    }
+    ++report.ran;
+    (outcome.converged ? report.converged : report.failed) += 1;
+    if (options.on_sample) {
+      GenerationProgress p;
+      p.finished = report.ran;
+      p.to_run = static_cast<long long>(pending.size());
+      p.failed = report.failed;
+      p.plan_row = row;
+      p.outcome = &outcome;
+      p.sample_seconds = seconds;
+      p.elapsed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      options.on_sample(p);
+    }
+    return true;
+  });
   if (write_failure) std::rethrow_exception(write_failure);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;

@@ -6,13 +6,47 @@
 #include <filesystem>
 #include <random>
 #include <set>
+#include <thread>
 
 #include "campaign/dataset_generation.hpp"
 #include "campaign/refine.hpp"
 #include "common/error.hpp"
+#include "common/work_pool.hpp"
 
 namespace mufric {
 namespace {
+
+// The one work pool (a measurement's draws, a campaign's samples): every index once, whatever the
+// number of workers, and none taken after the work says stop.
+TEST(WorkPool, EveryIndexRunsOnceWhateverTheWorkers) {
+  for (int workers : {1, 2, 5}) {
+    for (size_t count : {size_t{0}, size_t{1}, size_t{7}, size_t{200}}) {
+      std::vector<std::atomic<int>> runs(count);
+      run_work_pool(count, workers, [&](size_t k) {
+        ++runs[k];
+        return true;
+      });
+      for (size_t k = 0; k < count; ++k) EXPECT_EQ(runs[k].load(), 1) << workers << " workers, " << count << " jobs, job " << k;
+    }
+  }
+}
+
+TEST(WorkPool, FalseStopsTheTakingOfIndices) {
+  std::vector<size_t> ran;
+  run_work_pool(100, 1, [&](size_t k) {
+    ran.push_back(k);
+    return k != 3;
+  });
+  EXPECT_EQ(ran, (std::vector<size_t>{0, 1, 2, 3}));
+  std::atomic<int> taken{0};
+  run_work_pool(1000, 3, [&](size_t k) {
+    ++taken;
+    if (k != 10) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    return k != 10;
+  });
+  EXPECT_GE(taken.load(), 11);
+  EXPECT_LT(taken.load(), 100);  // the others stop after the job they hold
+}
 
 std::string temp_path(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("mufric_gen_" + std::to_string(::getpid()));

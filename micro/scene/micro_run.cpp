@@ -1,13 +1,11 @@
 #include "micro/scene/micro_run.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
 #include <numeric>
-#include <thread>
 
 #include <omp.h>
 
@@ -15,6 +13,7 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
+#include "common/work_pool.hpp"
 #include "micro/coupling/lubricated_chip.hpp"
 #include "micro/scene/vtu.hpp"
 #include "micro/solid/heat_conduction.hpp"
@@ -689,35 +688,29 @@ MuMeasurement measure_mu(const Scene& scene, const MeasureOptions& options) {
   // assembly (a single draw gets them all).
   const int threads_per_draw = std::max(cores / workers, 1);
   std::mutex progress_lock;
-  std::atomic<size_t> next{0};
   std::vector<std::string> failures(m.draws.size());
-  auto worker = [&] {
+  run_work_pool(m.draws.size(), workers, [&](size_t i) {
     omp_set_num_threads(threads_per_draw);
-    for (size_t i = next++; i < m.draws.size(); i = next++) {
-      RunOptions run;
-      if (i == 0) run.vtu_directory = options.vtu_directory;
-      if (options.wall_seconds_limit > 0.0) {
-        run.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                   std::chrono::duration<double>(options.wall_seconds_limit));
-        run.wall_seconds_limit = options.wall_seconds_limit;
-      }
-      if (options.on_step) {
-        run.on_step = [&, i](const MicroStep& step, const Scene& sc) {
-          const std::lock_guard<std::mutex> lock(progress_lock);
-          options.on_step(static_cast<int>(i), step, sc);
-        };
-      }
-      try {
-        m.draws[i].result = run_micro(draw_scene(scene, m.draws[i]), run);
-      } catch (const std::exception& e) {  // a bad scene fails every draw alike: reported once below
-        failures[i] = e.what();
-      }
+    RunOptions run;
+    if (i == 0) run.vtu_directory = options.vtu_directory;
+    if (options.wall_seconds_limit > 0.0) {
+      run.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(options.wall_seconds_limit));
+      run.wall_seconds_limit = options.wall_seconds_limit;
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+    if (options.on_step) {
+      run.on_step = [&, i](const MicroStep& step, const Scene& sc) {
+        const std::lock_guard<std::mutex> lock(progress_lock);
+        options.on_step(static_cast<int>(i), step, sc);
+      };
+    }
+    try {
+      m.draws[i].result = run_micro(draw_scene(scene, m.draws[i]), run);
+    } catch (const std::exception& e) {  // a bad scene fails every draw alike: reported once below
+      failures[i] = e.what();
+    }
+    return true;
+  });
   for (size_t i = 0; i < failures.size(); ++i) {
     if (!failures[i].empty()) throw Error(failures[i]);
   }
