@@ -131,28 +131,13 @@ double NavierStokes::leak_target_pressure() const {
   return total > 0.0 ? integrate_over_leak([](double k, double p) { return k * p; }) / total : 0.0;
 }
 
-void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values,
-                            Eigen::VectorXd& residual, Eigen::SparseMatrix<double>& jacobian, Eigen::VectorXd* rank_one_a,
-                            Eigen::VectorXd* rank_one_b) const {
-  const double rho = options_.fluid.density, mu = options_.fluid.viscosity, nu = mu / rho;
-  const double inv_dt = dt > 0.0 ? 1.0 / dt : 0.0;
-  // ∂(ln ρ)/∂t at the mesh's points (ALE), backward Euler; the convective part c·∇(ln ρ) is left
-  // out: the liquid's speeds are ~1e-7 of its sound speed, so it is that much smaller than ∇·v.
-  const bool compressible = options_.fluid.bulk_modulus > 0.0 && inv_dt > 0.0;
-  const Eigen::Vector2d body = options_.body_force;
-  residual = Eigen::VectorXd::Zero(state_.size());
-  // The mean-pressure leak's sink is κ(p − p̄) with p̄ = ∫κp/∫κ: assembled as κp, then −(∂R/∂p̄) p̄
-  // added once p̄ is known (∂R/∂p̄ collects −κ N_a in continuity and LSIC's share in momentum).
-  const bool mean_leak = leak_.coefficient && leak_.target == LeakTarget::mean;
-  const double leak_ambient = mean_leak ? 0.0 : leak_.ambient_pressure;
-  Eigen::VectorXd per_mean, mean_weights;  // −∂R/∂p̄, and ∫κ N_b at each pressure dof
-  if (mean_leak) {
-    per_mean = Eigen::VectorXd::Zero(state_.size());
-    mean_weights = Eigen::VectorXd::Zero(state_.size());
-  }
-  double leak_total = 0.0;  // ∫κ
+// Where local contributions go: the residual of every free row and the Jacobian's triplets (a
+// prescribed row gets u − ū and a unit diagonal at the end).
+struct NavierStokes::GlobalSystem {
+  const std::vector<char>& fixed;
+  Eigen::VectorXd& residual;
   std::vector<Eigen::Triplet<double>> triplets;
-  const auto add_local = [&](const std::vector<int>& nodes, const Eigen::VectorXd& r, const Eigen::MatrixXd& k) {
+  void add(const std::vector<int>& nodes, const Eigen::VectorXd& r, const Eigen::MatrixXd& k) {
     const auto n = static_cast<Eigen::Index>(nodes.size());
     for (Eigen::Index a = 0; a < 3 * n; ++a) {
       const int row = 3 * nodes[static_cast<size_t>(a / 3)] + static_cast<int>(a % 3);
@@ -162,106 +147,135 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
         if (k(a, b) != 0.0) triplets.emplace_back(row, 3 * nodes[static_cast<size_t>(b / 3)] + static_cast<int>(b % 3), k(a, b));
       }
     }
-  };
+  }
+};
 
+struct NavierStokes::AssemblyConstants {
+  double rho, mu, nu, inv_dt;
+  // ∂(ln ρ)/∂t at the mesh's points (ALE), backward Euler; the convective part c·∇(ln ρ) is left
+  // out: the liquid's speeds are ~1e-7 of its sound speed, so it is that much smaller than ∇·v.
+  bool compressible;
+  Eigen::Vector2d body;
+  bool mean_leak;       // LeakTarget::mean: the sink toward p̄, added once p̄ is known
+  double leak_ambient;  // the pressure the sink drains toward in the element loop (0 for the mean leak)
+};
+
+struct NavierStokes::LocalSystem {
+  Eigen::VectorXd r;
+  Eigen::MatrixXd k;
   Eigen::VectorXd advect;                // c·∇N_b at a point
   std::vector<Eigen::Matrix2d> dstrong;  // ∂(strong)/∂v_b at a point
-  for (int e = 0; e < space_.element_count(); ++e) {
-    const std::vector<int>& nodes = space_.element_nodes(e);
-    const auto n = static_cast<Eigen::Index>(nodes.size());
+  void reset(Eigen::Index n) {
     advect.resize(n);
     dstrong.resize(static_cast<size_t>(n));
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
-    Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-    for (const ParametricPoint& p : space_.element_points(e)) {
-      const PhysicalPoint q = space_.map(p);
-      const double wt = q.weight;
-      const Eigen::Vector2d v = velocity(p), v_old = FluidSpace::interpolate2(p, old_state_, 3, 0);
-      const Eigen::Vector2d w = FluidSpace::interpolate2(p, mesh_velocity_, 2, 0);
-      const double pressure_here = pressure(p);
-      double density_rate = 0.0, density_rate_per_pressure = 0.0;  // ∂(ln ρ)/∂t and its derivative in p
-      if (compressible) {
-        const double old_pressure = FluidSpace::interpolate1(p, old_state_, 3, 2);
-        density_rate = inv_dt * (log_density_ratio(options_.fluid, pressure_here) - log_density_ratio(options_.fluid, old_pressure));
-        density_rate_per_pressure = inv_dt * log_density_ratio_derivative(options_.fluid, pressure_here);
-      }
-      const double leak = leak_.coefficient ? leak_.coefficient(q.position, p.u) : 0.0;  // κ here
-      const double sink = leak * (pressure_here - leak_ambient);
-      leak_total += wt * leak;
-      VelocityDerivatives d;
-      for (Eigen::Index a = 0; a < n; ++a) {
-        const Eigen::Vector2d va = state_.segment<2>(3 * nodes[static_cast<size_t>(a)]);
-        const double pa = state_(3 * nodes[static_cast<size_t>(a)] + 2);
-        const Eigen::Matrix2d h = hessian(q, a);
-        d.gradient += va * q.gradients.col(a).transpose();
-        d.laplacian += (h(0, 0) + h(1, 1)) * va;
-        d.grad_div += h * va;
-        d.pressure_gradient += pa * q.gradients.col(a);
-      }
-      const Eigen::Vector2d c = v - w;  // convective velocity relative to the mesh
-      const double divergence = d.gradient.trace();
-      // Continuity's residual, whose least-squares (LSIC) term must vanish on an exact solution.
-      const double continuity = divergence + density_rate + sink;
-      const double continuity_per_pressure = density_rate_per_pressure + leak;
-      // τ_M = (4/Δt² + c·G c + C_I ν² G:G)^(−1/2), ν_C = 1/(τ_M tr G) (Bazilevs et al. 2007, eq. 63–65).
-      const double tau_m = 1.0 / std::sqrt(4.0 * inv_dt * inv_dt + c.dot(q.metric * c) +
-                                           kInverseEstimateConstant * nu * nu * q.metric.squaredNorm());
-      const double nu_c = 1.0 / (tau_m * q.metric.trace());
-      const Eigen::Vector2d inertia = rho * ((v - v_old) * inv_dt + d.gradient * c);
-      const Eigen::Vector2d strong = inertia + d.pressure_gradient - mu * (d.laplacian + d.grad_div) - rho * body;
-      const Eigen::Matrix2d sym = d.gradient + d.gradient.transpose();
-      // Per shape function b, once per point (not once per a): c·∇N_b, ΔN_b and ∂(strong_i)/∂v_bk =
-      // ρ(δ_ik(N_b/Δt + c·∇N_b) + N_b ∂_k v_i) − μ(δ_ik ΔN_b + ∂_i∂_k N_b).
-      for (Eigen::Index b = 0; b < n; ++b) {
-        advect(b) = c.dot(q.gradients.col(b));
-        const Eigen::Matrix2d hb = hessian(q, b);
-        Eigen::Matrix2d& ds = dstrong[static_cast<size_t>(b)];
-        ds = rho * q.values(b) * d.gradient - mu * hb;
-        ds.diagonal().array() += rho * (q.values(b) * inv_dt + advect(b)) - mu * (hb(0, 0) + hb(1, 1));
-      }
+    r = Eigen::VectorXd::Zero(3 * n);
+    k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  }
+};
 
-      for (Eigen::Index a = 0; a < n; ++a) {
-        const double na = q.values(a);
-        const Eigen::Vector2d ga = q.gradients.col(a);
-        for (int i = 0; i < 2; ++i) {
-          r(3 * a + i) += wt * (na * (inertia(i) - rho * body(i)) + mu * sym.row(i).dot(ga) - pressure_here * ga(i) +
-                                tau_m * advect(a) * strong(i) + rho * nu_c * ga(i) * continuity);
-        }
-        r(3 * a + 2) += wt * (na * continuity + tau_m / rho * ga.dot(strong));
-        for (Eigen::Index b = 0; b < n; ++b) {
-          const double nb = q.values(b);
-          const Eigen::Vector2d gb = q.gradients.col(b);
-          const Eigen::Matrix2d& ds = dstrong[static_cast<size_t>(b)];
-          const double mass_advection = na * rho * (nb * inv_dt + advect(b)), diffusion = mu * ga.dot(gb);
-          for (int i = 0; i < 2; ++i) {
-            for (int kk = 0; kk < 2; ++kk) {
-              const double galerkin = (i == kk ? mass_advection + diffusion : 0.0) + na * rho * nb * d.gradient(i, kk) +
-                                      mu * ga(kk) * gb(i);
-              const double supg = tau_m * (advect(a) * ds(i, kk) + nb * ga(kk) * strong(i));
-              k(3 * a + i, 3 * b + kk) += wt * (galerkin + supg + rho * nu_c * ga(i) * gb(kk));
-            }
-            k(3 * a + i, 3 * b + 2) +=
-                wt * (-nb * ga(i) + tau_m * advect(a) * gb(i) + rho * nu_c * ga(i) * continuity_per_pressure * nb);
-          }
-          for (int kk = 0; kk < 2; ++kk) {
-            k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(ds.col(kk)));
-          }
-          k(3 * a + 2, 3 * b + 2) += wt * (tau_m / rho * ga.dot(gb) + na * continuity_per_pressure * nb);
-        }
-        if (mean_leak) {
-          const auto row = static_cast<Eigen::Index>(3 * nodes[static_cast<size_t>(a)]);
-          if (!fixed[static_cast<size_t>(row + 2)]) per_mean(row + 2) += wt * na * leak;
-          for (int i = 0; i < 2; ++i) {
-            if (!fixed[static_cast<size_t>(row + i)]) per_mean(row + i) += wt * rho * nu_c * ga(i) * leak;
-          }
-          mean_weights(row + 2) += wt * na * leak;
-        }
-      }
-    }
-    add_local(nodes, r, k);
+// The mean-pressure leak's sink is κ(p − p̄) with p̄ = ∫κp/∫κ: assembled as κp, then −(∂R/∂p̄) p̄
+// added once p̄ is known (∂R/∂p̄ collects −κ N_a in continuity and LSIC's share in momentum).
+struct NavierStokes::MeanLeakSums {
+  Eigen::VectorXd per_mean, mean_weights;  // −∂R/∂p̄, and ∫κ N_b at each pressure dof (mean leak only)
+  double total = 0.0;                      // ∫κ
+};
+
+void NavierStokes::add_point(const ParametricPoint& p, const std::vector<int>& nodes, const AssemblyConstants& constants,
+                             const std::vector<char>& fixed, LocalSystem& local, MeanLeakSums& leak_sums) const {
+  const double rho = constants.rho, mu = constants.mu, nu = constants.nu, inv_dt = constants.inv_dt;
+  const Eigen::Vector2d& body = constants.body;
+  const auto n = static_cast<Eigen::Index>(nodes.size());
+  Eigen::VectorXd& r = local.r;
+  Eigen::MatrixXd& k = local.k;
+  Eigen::VectorXd& advect = local.advect;
+  std::vector<Eigen::Matrix2d>& dstrong = local.dstrong;
+  const PhysicalPoint q = space_.map(p);
+  const double wt = q.weight;
+  const Eigen::Vector2d v = velocity(p), v_old = FluidSpace::interpolate2(p, old_state_, 3, 0);
+  const Eigen::Vector2d w = FluidSpace::interpolate2(p, mesh_velocity_, 2, 0);
+  const double pressure_here = pressure(p);
+  double density_rate = 0.0, density_rate_per_pressure = 0.0;  // ∂(ln ρ)/∂t and its derivative in p
+  if (constants.compressible) {
+    const double old_pressure = FluidSpace::interpolate1(p, old_state_, 3, 2);
+    density_rate = inv_dt * (log_density_ratio(options_.fluid, pressure_here) - log_density_ratio(options_.fluid, old_pressure));
+    density_rate_per_pressure = inv_dt * log_density_ratio_derivative(options_.fluid, pressure_here);
+  }
+  const double leak = leak_.coefficient ? leak_.coefficient(q.position, p.u) : 0.0;  // κ here
+  const double sink = leak * (pressure_here - constants.leak_ambient);
+  leak_sums.total += wt * leak;
+  VelocityDerivatives d;
+  for (Eigen::Index a = 0; a < n; ++a) {
+    const Eigen::Vector2d va = state_.segment<2>(3 * nodes[static_cast<size_t>(a)]);
+    const double pa = state_(3 * nodes[static_cast<size_t>(a)] + 2);
+    const Eigen::Matrix2d h = hessian(q, a);
+    d.gradient += va * q.gradients.col(a).transpose();
+    d.laplacian += (h(0, 0) + h(1, 1)) * va;
+    d.grad_div += h * va;
+    d.pressure_gradient += pa * q.gradients.col(a);
+  }
+  const Eigen::Vector2d c = v - w;  // convective velocity relative to the mesh
+  const double divergence = d.gradient.trace();
+  // Continuity's residual, whose least-squares (LSIC) term must vanish on an exact solution.
+  const double continuity = divergence + density_rate + sink;
+  const double continuity_per_pressure = density_rate_per_pressure + leak;
+  // τ_M = (4/Δt² + c·G c + C_I ν² G:G)^(−1/2), ν_C = 1/(τ_M tr G) (Bazilevs et al. 2007, eq. 63–65).
+  const double tau_m = 1.0 / std::sqrt(4.0 * inv_dt * inv_dt + c.dot(q.metric * c) +
+                                       kInverseEstimateConstant * nu * nu * q.metric.squaredNorm());
+  const double nu_c = 1.0 / (tau_m * q.metric.trace());
+  const Eigen::Vector2d inertia = rho * ((v - v_old) * inv_dt + d.gradient * c);
+  const Eigen::Vector2d strong = inertia + d.pressure_gradient - mu * (d.laplacian + d.grad_div) - rho * body;
+  const Eigen::Matrix2d sym = d.gradient + d.gradient.transpose();
+  // Per shape function b, once per point (not once per a): c·∇N_b, ΔN_b and ∂(strong_i)/∂v_bk =
+  // ρ(δ_ik(N_b/Δt + c·∇N_b) + N_b ∂_k v_i) − μ(δ_ik ΔN_b + ∂_i∂_k N_b).
+  for (Eigen::Index b = 0; b < n; ++b) {
+    advect(b) = c.dot(q.gradients.col(b));
+    const Eigen::Matrix2d hb = hessian(q, b);
+    Eigen::Matrix2d& ds = dstrong[static_cast<size_t>(b)];
+    ds = rho * q.values(b) * d.gradient - mu * hb;
+    ds.diagonal().array() += rho * (q.values(b) * inv_dt + advect(b)) - mu * (hb(0, 0) + hb(1, 1));
   }
 
-  // Traction and Robin sides: −∫ N_a h and, for Robin, −∫ N_a α (g − v) (eq. 13 in weak form).
+  for (Eigen::Index a = 0; a < n; ++a) {
+    const double na = q.values(a);
+    const Eigen::Vector2d ga = q.gradients.col(a);
+    for (int i = 0; i < 2; ++i) {
+      r(3 * a + i) += wt * (na * (inertia(i) - rho * body(i)) + mu * sym.row(i).dot(ga) - pressure_here * ga(i) +
+                            tau_m * advect(a) * strong(i) + rho * nu_c * ga(i) * continuity);
+    }
+    r(3 * a + 2) += wt * (na * continuity + tau_m / rho * ga.dot(strong));
+    for (Eigen::Index b = 0; b < n; ++b) {
+      const double nb = q.values(b);
+      const Eigen::Vector2d gb = q.gradients.col(b);
+      const Eigen::Matrix2d& ds = dstrong[static_cast<size_t>(b)];
+      const double mass_advection = na * rho * (nb * inv_dt + advect(b)), diffusion = mu * ga.dot(gb);
+      for (int i = 0; i < 2; ++i) {
+        for (int kk = 0; kk < 2; ++kk) {
+          const double galerkin = (i == kk ? mass_advection + diffusion : 0.0) + na * rho * nb * d.gradient(i, kk) +
+                                  mu * ga(kk) * gb(i);
+          const double supg = tau_m * (advect(a) * ds(i, kk) + nb * ga(kk) * strong(i));
+          k(3 * a + i, 3 * b + kk) += wt * (galerkin + supg + rho * nu_c * ga(i) * gb(kk));
+        }
+        k(3 * a + i, 3 * b + 2) +=
+            wt * (-nb * ga(i) + tau_m * advect(a) * gb(i) + rho * nu_c * ga(i) * continuity_per_pressure * nb);
+      }
+      for (int kk = 0; kk < 2; ++kk) {
+        k(3 * a + 2, 3 * b + kk) += wt * (na * gb(kk) + tau_m / rho * ga.dot(ds.col(kk)));
+      }
+      k(3 * a + 2, 3 * b + 2) += wt * (tau_m / rho * ga.dot(gb) + na * continuity_per_pressure * nb);
+    }
+    if (constants.mean_leak) {
+      const auto row = static_cast<Eigen::Index>(3 * nodes[static_cast<size_t>(a)]);
+      if (!fixed[static_cast<size_t>(row + 2)]) leak_sums.per_mean(row + 2) += wt * na * leak;
+      for (int i = 0; i < 2; ++i) {
+        if (!fixed[static_cast<size_t>(row + i)]) leak_sums.per_mean(row + i) += wt * rho * nu_c * ga(i) * leak;
+      }
+      leak_sums.mean_weights(row + 2) += wt * na * leak;
+    }
+  }
+}
+
+// Traction and Robin sides: −∫ N_a h and, for Robin, −∫ N_a α (g − v) (eq. 13 in weak form).
+void NavierStokes::add_side_conditions(GlobalSystem& system) const {
   for (const auto& c : conditions_) {
     if (c.kind == SideConditionKind::velocity) continue;
     if (c.kind == SideConditionKind::robin && !c.velocity) throw Error("fluid: a Robin side needs its velocity");
@@ -281,14 +295,46 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
           for (Eigen::Index b = 0; b < n; ++b) k(3 * a + i, 3 * b + i) += q.weight * alpha * q.values(a) * q.values(b);
         }
       }
-      add_local(p.nodes, r, k);
+      system.add(p.nodes, r, k);
     }
   }
+}
 
-  if (mean_leak && leak_total > 0.0) {
-    const Eigen::VectorXd b = mean_weights / leak_total;  // ∂p̄/∂p
-    residual -= per_mean * b.dot(state_);
-    if (rank_one_a != nullptr) *rank_one_a = per_mean;
+// The form owns the loops (elements, then sides), the point kernel the physics (MFEM's split of a
+// form and its integrators; PetIGA's residual and Jacobian at a point).
+void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values,
+                            Eigen::VectorXd& residual, Eigen::SparseMatrix<double>& jacobian, Eigen::VectorXd* rank_one_a,
+                            Eigen::VectorXd* rank_one_b) const {
+  const double inv_dt = dt > 0.0 ? 1.0 / dt : 0.0;
+  const bool mean_leak = leak_.coefficient && leak_.target == LeakTarget::mean;
+  const AssemblyConstants constants{.rho = options_.fluid.density,
+                                    .mu = options_.fluid.viscosity,
+                                    .nu = options_.fluid.viscosity / options_.fluid.density,
+                                    .inv_dt = inv_dt,
+                                    .compressible = options_.fluid.bulk_modulus > 0.0 && inv_dt > 0.0,
+                                    .body = options_.body_force,
+                                    .mean_leak = mean_leak,
+                                    .leak_ambient = mean_leak ? 0.0 : leak_.ambient_pressure};
+  residual = Eigen::VectorXd::Zero(state_.size());
+  MeanLeakSums leak_sums;
+  if (mean_leak) {
+    leak_sums.per_mean = Eigen::VectorXd::Zero(state_.size());
+    leak_sums.mean_weights = Eigen::VectorXd::Zero(state_.size());
+  }
+  GlobalSystem system{fixed, residual, {}};
+  LocalSystem local;
+  for (int e = 0; e < space_.element_count(); ++e) {
+    const std::vector<int>& nodes = space_.element_nodes(e);
+    local.reset(static_cast<Eigen::Index>(nodes.size()));
+    for (const ParametricPoint& p : space_.element_points(e)) add_point(p, nodes, constants, fixed, local, leak_sums);
+    system.add(nodes, local.r, local.k);
+  }
+  add_side_conditions(system);
+
+  if (mean_leak && leak_sums.total > 0.0) {
+    const Eigen::VectorXd b = leak_sums.mean_weights / leak_sums.total;  // ∂p̄/∂p
+    residual -= leak_sums.per_mean * b.dot(state_);
+    if (rank_one_a != nullptr) *rank_one_a = leak_sums.per_mean;
     if (rank_one_b != nullptr) *rank_one_b = b;
   } else {
     if (rank_one_a != nullptr) rank_one_a->resize(0);
@@ -297,10 +343,10 @@ void NavierStokes::assemble(double dt, const std::vector<char>& fixed, const Eig
   for (Eigen::Index row = 0; row < state_.size(); ++row) {
     if (!fixed[static_cast<size_t>(row)]) continue;
     residual(row) = state_(row) - values(row);
-    triplets.emplace_back(static_cast<int>(row), static_cast<int>(row), 1.0);
+    system.triplets.emplace_back(static_cast<int>(row), static_cast<int>(row), 1.0);
   }
   jacobian.resize(state_.size(), state_.size());
-  jacobian.setFromTriplets(triplets.begin(), triplets.end());
+  jacobian.setFromTriplets(system.triplets.begin(), system.triplets.end());
 }
 
 FluidStepReport NavierStokes::solve_step(double dt) {

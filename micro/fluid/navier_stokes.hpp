@@ -191,6 +191,18 @@ class NavierStokes {
   void assemble(double dt, const std::vector<char>& fixed, const Eigen::VectorXd& values, Eigen::VectorXd& residual,
                 Eigen::SparseMatrix<double>& jacobian, Eigen::VectorXd* rank_one_a = nullptr,
                 Eigen::VectorXd* rank_one_b = nullptr) const;
+  // The pieces of assemble (defined in the .cpp): the global system local contributions go into, the
+  // constants of one assembly, an element's local system with the point kernel's scratch, and the
+  // mean-pressure leak's sums.
+  struct GlobalSystem;
+  struct AssemblyConstants;
+  struct LocalSystem;
+  struct MeanLeakSums;
+  // The VMS point kernel: one quadrature point's share of its element's residual and Jacobian.
+  void add_point(const ParametricPoint& p, const std::vector<int>& nodes, const AssemblyConstants& constants,
+                 const std::vector<char>& fixed, LocalSystem& local, MeanLeakSums& leak) const;
+  // The traction and Robin sides.
+  void add_side_conditions(GlobalSystem& system) const;
 };
 
 }  // namespace mufric::fluid
