@@ -200,6 +200,10 @@ void refine_command(const RefineCommandOptions& c) {
     std::printf("%s: box %s\n", o.db.c_str(), g.record.c_str());
     std::fflush(stdout);
   };
+  o.on_drop = [&o](long long dropped) {
+    std::printf("%s: %lld plan rows not yet run left out of the plan (--drop-pending)\n", o.db.c_str(), dropped);
+    std::fflush(stdout);
+  };
   o.on_round = [](const RefineRound& r) {
     std::printf("round %d: %lld training samples, LOO mean relative error %.3f %%, max %.3f %%", r.round,
                 r.training_samples, 100.0 * r.loo_mean_relative_error, 100.0 * r.loo_max_relative_error);
@@ -404,6 +408,9 @@ void add_dataset_commands(CLI::App& app) {
                      "Stop a run still going after this many seconds and record it as failed (0: no limit)")
       ->capture_default_str()->check(FiniteRange(0.0, 1e7));
   refine->add_option("--seed", f->refine.seed, "Seed of the candidate sets and GP restarts")->capture_default_str();
+  refine->add_flag("--drop-pending", f->refine.drop_pending,
+                   "First leave the plan rows not yet run out of the plan (they must all follow the last row run),\n"
+                   "so that the budget goes to the picks: a campaign that ran a prefix of its plan hands over");
   refine->footer("Each round trains a GP on the converged samples, picks --batch candidates by the largest posterior\n"
                  "variance (each pick conditioning the next), appends them to the plan, runs them with the database's\n"
                  "scene, and reports the leave-one-out error (and the held-out error with --test).\n"

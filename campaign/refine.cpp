@@ -132,11 +132,41 @@ constexpr unsigned long long kReferenceSeedOffset = 0x5eedULL;
 
 }  // namespace
 
+long long drop_pending_plan_rows(Dataset& db, const std::string& source) {
+  long long last_run = -1;
+  for (const long long row : db.plan_index) last_run = std::max(last_run, row);
+  std::vector<bool> answered(static_cast<size_t>(db.plan.rows()), false);
+  for (const long long row : db.plan_index) {
+    if (row >= 0 && row < db.plan.rows()) answered[static_cast<size_t>(row)] = true;
+  }
+  std::vector<long long> gaps;
+  for (long long row = 0; row < last_run; ++row) {
+    if (!answered[static_cast<size_t>(row)]) gaps.push_back(row);
+  }
+  if (!gaps.empty()) {
+    std::string list;
+    for (size_t k = 0; k < std::min<size_t>(gaps.size(), 8); ++k) list += (k ? ", " : "") + std::to_string(gaps[k]);
+    if (gaps.size() > 8) list += ", ...";
+    throw Error(source + ": plan rows " + list + " have not run but lie before row " + std::to_string(last_run) +
+                ", which has; run them first (mufric dataset run) so that only the plan's tail is left out");
+  }
+  const long long kept = last_run + 1, dropped = db.plan.rows() - kept;
+  if (dropped <= 0) return 0;
+  db.plan.conservativeResize(kept, Eigen::NoChange);
+  db.plan_design = (db.plan_design.empty() ? std::string("plan") : db.plan_design) + " prefix of " + std::to_string(kept);
+  return dropped;
+}
+
 RefineReport refine_dataset(const RefineOptions& o) {
   if (!o.make_evaluator) throw Error("refine_dataset: no make_evaluator given");
   Dataset db = read_dataset_isolated(o.db);
   if (db.plan.rows() == 0 || db.plan_index.size() != static_cast<size_t>(db.size())) {
     throw Error(o.db + ": not a micro-model database (no plan rows); start with mufric dataset plan and run");
+  }
+  if (o.drop_pending) {
+    const long long dropped = drop_pending_plan_rows(db, o.db);
+    if (dropped > 0) write_dataset(o.db, db);
+    if (o.on_drop) o.on_drop(dropped);
   }
   if (o.grow) {
     const BoxGrowth growth = grow_plan_box(o, db);

@@ -61,11 +61,16 @@ struct RefineOptions {
   long long candidate_count = 4096;  // Sobol' candidates per round
   long long reference_count = 512;   // Sobol' points over which the integrated variance is averaged
   unsigned long long seed = 1;       // of the candidate sets and GP restarts
+  // Leave the plan rows not yet run out of the plan before the first round, so that the budget goes
+  // to the picks: a campaign that ran a prefix of its plan (e.g. the first 128 rows of a Sobol'
+  // sequence) hands over to refinement. They must all follow the last row run (drop_pending_plan_rows).
+  bool drop_pending = false;
   // The evaluator of the samples, made once after the box growth from the database as it then is
   // (the mufric executable: the micro-model with the database's scene). Required.
   std::function<SampleEvaluator(const Dataset& db)> make_evaluator;
   // Progress, in the order it happens; each may be empty.
   std::function<void(const BoxGrowth&)> on_box;
+  std::function<void(long long dropped_rows)> on_drop;  // with drop_pending, after the database is rewritten
   std::function<void(const RefineRound&)> on_round;
   std::function<void(const RefinePick&)> on_pick;
   // Each sample run (under generate_dataset's lock), with its point in the database's inputs.
@@ -75,6 +80,12 @@ struct RefineOptions {
 struct RefineReport {
   long long spent = 0;  // runs made, of options.budget
 };
+
+// Removes the plan rows no sample answers from the database's plan and returns how many; the plan's
+// design records the prefix ("sobol" becomes "sobol prefix of 128"). Throws Error, naming the rows,
+// when a row not run lies before one that was (the rows' numbers, and with them the seeds of their
+// draws, would change).
+long long drop_pending_plan_rows(Dataset& db, const std::string& source);
 
 // Throws Error for a database without plan rows, and whatever reading, training, running or
 // writing throws (the database then holds every sample finished so far).

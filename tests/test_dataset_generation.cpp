@@ -348,6 +348,57 @@ TEST(DatasetGeneration, IndependentDrawsGiveEachRowItsOwnReproducibleSeeds) {
   EXPECT_EQ(c.draw_mu.cols(), 0);
 }
 
+// A campaign that ran a prefix of its plan hands over to refine: the rows not run leave the plan, so
+// the budget goes to the picks; a row not run before one that was is refused by number.
+TEST(DatasetGeneration, RefineCanLeaveThePendingTailOfItsPlanOut) {
+  Dataset plan = small_plan(20);
+  plan.draws = DrawDesign::independent;
+  plan.plan_seed = 9;
+  const SampleEvaluator noisy = [](const SampleRequest& r) {
+    SampleOutcome o;
+    o.converged = true;
+    std::mt19937_64 rng(r.seeds->tool ^ (r.seeds->chip << 1));
+    std::normal_distribution<double> normal(0.0, 0.005);
+    for (int k = 0; k < 4; ++k) o.draw_mu.push_back(exact_mu(r.x) + normal(rng));
+    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2] + o.draw_mu[3]) / 4.0;
+    return o;
+  };
+  const std::string db = temp_path("prefix.h5");
+  std::filesystem::remove(db);
+  GenerationOptions first;
+  first.limit = 12;
+  generate_dataset(plan, db, noisy, first);
+  RefineOptions o;
+  o.db = db;
+  o.budget = 2;
+  o.batch = 2;
+  o.restarts = 0;
+  o.drop_pending = true;
+  o.make_evaluator = [&](const Dataset&) { return noisy; };
+  long long dropped = -1;
+  o.on_drop = [&](long long n) { dropped = n; };
+  EXPECT_EQ(refine_dataset(o).spent, 2);
+  EXPECT_EQ(dropped, 8);
+  const Dataset d = read_dataset(db);
+  EXPECT_EQ(d.plan.rows(), 14);  // the 12 run, then the two picks
+  EXPECT_EQ(d.size(), 14);
+  EXPECT_NE(d.plan_design.find("test prefix of 12"), std::string::npos) << d.plan_design;
+  for (Eigen::Index i = 0; i < 12; ++i) EXPECT_EQ(d.plan.row(i), plan.plan.row(i));
+
+  Dataset gap = plan;
+  gap.plan_index = {0, 1, 2, 5};
+  try {
+    drop_pending_plan_rows(gap, "gap.h5");
+    ADD_FAILURE() << "rows 3 and 4 lie before row 5, which ran";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("plan rows 3, 4 have not run"), std::string::npos) << e.what();
+  }
+  Dataset tail = plan;
+  tail.plan_index = {0, 2, 1};
+  EXPECT_EQ(drop_pending_plan_rows(tail, "tail.h5"), 17);
+  EXPECT_EQ(tail.plan.rows(), 3);
+}
+
 // dataset refine on independent draws: stochastic kriging, picks by IMSE among new points and more
 // draws at existing ones. With one Sobol' candidate per round, a batch of three must repeat existing
 // points: each repeat is a new plan row at that row's point, run with its own seeds.
