@@ -7,7 +7,8 @@
 # is rewritten after every sample. Never part of CI.
 #   nohup bash campaigns/dry_default/run.sh > campaign.log 2>&1 &       # one core, one free for builds
 #   JOBS=2 bash campaigns/dry_default/run.sh                              # both cores
-# Then: mufric train --data campaigns/dry_default/db.h5 --out models/dry_default.h5
+# After a prefix of the plan (128 rows), refine.sh spends the rest of the budget where the interval is
+# widest. Then: bash campaigns/dry_default/train.sh (the shipped model, committed with db.h5).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 mufric=${MUFRIC:-$here/../../build/app/mufric}
