@@ -42,19 +42,6 @@ std::pair<double, double> parse_range(const std::string& text, QuantityKind kind
   return {lo, hi};
 }
 
-std::string duration_text(double seconds) {
-  char text[32];
-  if (!std::isfinite(seconds)) return "?";
-  if (seconds < 90) {
-    std::snprintf(text, sizeof text, "%.0fs", seconds);
-  } else if (seconds < 5400) {
-    std::snprintf(text, sizeof text, "%.0fm%02.0fs", std::floor(seconds / 60), std::fmod(seconds, 60.0));
-  } else {
-    std::snprintf(text, sizeof text, "%.0fh%02.0fm", std::floor(seconds / 3600), std::fmod(seconds / 60, 60.0));
-  }
-  return text;
-}
-
 void print_box(const InputSpace& box) {
   for (const auto& input : box) {
     std::printf("  %-17s %s .. %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),

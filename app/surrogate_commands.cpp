@@ -11,6 +11,7 @@
 
 #include "app/commands.hpp"
 #include "client/friction_client.hpp"
+#include "campaign/campaign_summary.hpp"
 #include "common/csv_table.hpp"
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
@@ -250,7 +251,8 @@ void add_train(CLI::App& app) {
   cmd->callback([o] {
     o->gp.noise_term = !o->no_noise;
     const Dataset dataset = read_dataset_isolated(o->data);
-    const TrainingSet data = training_set(dataset, o->data);
+    TrainingSet data = training_set(dataset, o->data);
+    data.description = campaign_summary(dataset);
     std::printf("training data: %s (%lld converged of %s, %s)\n", o->data.c_str(), static_cast<long long>(data.x.rows()),
                 count_of(dataset.size(), "sample", "samples").c_str(),
                 count_of(static_cast<long long>(data.inputs.size()), "input", "inputs").c_str());

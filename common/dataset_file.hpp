@@ -84,6 +84,7 @@ struct TrainingSet {
   long long outside_model = 0;  // samples left out because they lie outside the model (molten)
   std::string source_path;
   std::string source_hash;  // SHA-256 of the file bytes, for model provenance
+  std::string description;  // how the samples were made (campaign_summary), kept in a model's provenance
 };
 
 // Reads .h5 (dataset schema) or .csv; throws Error naming the file and the problem.

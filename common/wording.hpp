@@ -1,5 +1,7 @@
 #pragma once
 // Small pieces of the English every message is written in, so "1 files" and "a angle" do not reach a user.
+#include <cmath>
+#include <cstdio>
 #include <string>
 #include <string_view>
 
@@ -15,6 +17,20 @@ inline std::string count_of(long long n, std::string_view singular, std::string_
 inline std::string with_article(std::string_view word) {
   const bool vowel = !word.empty() && std::string_view("aeiouAEIOU").find(word.front()) != std::string_view::npos;
   return std::string(vowel ? "an " : "a ") + std::string(word);
+}
+
+// "42s", "3m07s", "2h05m": a duration as a person reads it ("?" when not finite).
+inline std::string duration_text(double seconds) {
+  char text[32];
+  if (!std::isfinite(seconds)) return "?";
+  if (seconds < 90) {
+    std::snprintf(text, sizeof text, "%.0fs", seconds);
+  } else if (seconds < 5400) {
+    std::snprintf(text, sizeof text, "%.0fm%02.0fs", std::floor(seconds / 60), std::fmod(seconds, 60.0));
+  } else {
+    std::snprintf(text, sizeof text, "%.0fh%02.0fm", std::floor(seconds / 3600), std::fmod(seconds / 60, 60.0));
+  }
+  return text;
 }
 
 }  // namespace mufric

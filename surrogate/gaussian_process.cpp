@@ -529,6 +529,7 @@ std::string GaussianProcess::summary() const {
   const auto& t = state_.summary;
   s << (state_.mean_estimated ? "  log restricted likelihood (REML) " : "  log marginal likelihood ") << t.log_marginal_likelihood
     << "\n";
+  if (!t.dataset_description.empty()) s << "  trained on: " << t.dataset_description << "\n";
   s << "  leave-one-out: mean relative error " << 100.0 * t.loo_mean_relative_error << " %, max "
     << 100.0 * t.loo_max_relative_error << " %, RMSE " << t.loo_rmse << ", 95 % coverage "
     << 100.0 * t.loo_coverage_95 << " %";

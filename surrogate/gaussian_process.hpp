@@ -58,6 +58,7 @@ struct GpTrainingSummary {
   double seconds = 0.0;
   std::string dataset_path;
   std::string dataset_sha256;
+  std::string dataset_description;  // the campaign behind the data (TrainingSet::description); "" before it was kept
   std::string code_version;
   std::string created_utc;
 };

@@ -605,6 +605,7 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
   summary.best_start = report.best_start;
   summary.dataset_path = data.source_path;
   summary.dataset_sha256 = data.source_hash;
+  summary.dataset_description = data.description;
   summary.code_version = code_version();
   summary.created_utc = utc_timestamp();
   fit_at_hyper_parameters(state, normalised, options, report);

@@ -66,6 +66,8 @@ constexpr std::pair<const char*, std::string GpTrainingSummary::*> kSummaryTexts
     {"dataset_sha256", &GpTrainingSummary::dataset_sha256},
     {"code_version", &GpTrainingSummary::code_version},
     {"created_utc", &GpTrainingSummary::created_utc}};
+// Written by every model since it was kept; a file from before has none (read as "").
+constexpr const char* kSummaryDatasetDescription = "dataset_description";
 // Nodes of a stored fast evaluator recomputed with the exact model at load. A node is the exact
 // model's value, but computed in another batch: near the noise floor σ is the square root of a
 // difference of nearly equal numbers, and two evaluation paths differ there far beyond 1e-9 (issue
@@ -381,6 +383,7 @@ void GaussianProcess::write_group(h5::Writer& out, const std::string& group) con
   for (const auto& [name, field] : kSummaryNumbers) out.double_attribute(summary_group, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryCounts) out.int_attribute(summary_group, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryTexts) out.string_attribute(summary_group, name, s.summary.*field);
+  out.string_attribute(summary_group, kSummaryDatasetDescription, s.summary.dataset_description);
   if (fast_) {
     const std::vector<long long> cells(fast_->grid().cells().begin(), fast_->grid().cells().end());
     const FastEvaluatorBounds& b = fast_->bounds();
@@ -505,6 +508,9 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
     for (const auto& [name, field] : kSummaryNumbers) s.summary.*field = in.double_attribute(summary_group, name);
     for (const auto& [name, field] : kSummaryCounts) s.summary.*field = in.int_attribute(summary_group, name);
     for (const auto& [name, field] : kSummaryTexts) s.summary.*field = in.string_attribute(summary_group, name);
+    if (in.has_attribute(summary_group, kSummaryDatasetDescription)) {
+      s.summary.dataset_description = in.string_attribute(summary_group, kSummaryDatasetDescription);
+    }
   }
   const InputSpace inputs_of_model = s.inputs;
   GaussianProcess gp(std::move(s));

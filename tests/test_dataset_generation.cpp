@@ -8,6 +8,7 @@
 #include <set>
 #include <thread>
 
+#include "campaign/campaign_summary.hpp"
 #include "campaign/dataset_generation.hpp"
 #include "campaign/refine.hpp"
 #include "common/error.hpp"
@@ -346,6 +347,31 @@ TEST(DatasetGeneration, IndependentDrawsGiveEachRowItsOwnReproducibleSeeds) {
   EXPECT_EQ(c.draws, DrawDesign::common);
   for (long long seed : c.tool_seed) EXPECT_EQ(seed, -1);
   EXPECT_EQ(c.draw_mu.cols(), 0);
+}
+
+// What a model says of its training data: source and code, plan, draws, mesh, outcomes, time.
+TEST(DatasetGeneration, TheCampaignSummarySaysPlanDrawsMeshOutcomesAndTime) {
+  Dataset plan = small_plan(6, R"({"discretisation": {"degree": 2, "elements_x": 64, "elements_y": 12}})");
+  plan.draws = DrawDesign::independent;
+  plan.plan_seed = 3;
+  plan.plan_design = "sobol";
+  const std::string db = temp_path("summary.h5");
+  std::filesystem::remove(db);
+  generate_dataset(plan, db, [](const SampleRequest& r) {
+    SampleOutcome o = fake(r);
+    if (o.converged) o.draw_mu = {o.mu, o.mu, o.mu};
+    return o;
+  }, {});
+  const Dataset d = read_dataset(db);
+  const std::string s = campaign_summary(d);
+  for (const std::string part : {"test plan", "plan 6 points, design sobol (seed 3)", "draws independent", "15 draws, 3 per sample",
+                                 "mesh 64 x 12 of degree 2", "6 samples (5 converged, 0 outside the model, 1 failed)",
+                                 "micro-model wall time"}) {
+    EXPECT_NE(s.find(part), std::string::npos) << "'" << part << "' not in: " << s;
+  }
+  Dataset bare = d;
+  bare.scene_json = "not json";
+  EXPECT_EQ(campaign_summary(bare).find("mesh"), std::string::npos);
 }
 
 // A campaign that ran a prefix of its plan hands over to refine: the rows not run leave the plan, so

@@ -397,6 +397,30 @@ TEST(ModelFile, AnOlderSchemaLoadsWithoutAFastEvaluator) {
 }
 
 
+// The campaign behind a model's data travels with its file and `describe` shows it; a file from
+// before it was kept loads with none.
+TEST(ModelFile, TheDatasetDescriptionRoundTripsAndAnOlderFileHasNone) {
+  TrainingSet data = test::smooth_training_set(40, 2);
+  data.description = "micro-model plan (a test scene); plan 40 points, design sobol (seed 3)";
+  GpTrainingOptions options;
+  options.restarts = 0;
+  const GaussianProcess gp = train_gaussian_process(data, options);
+  EXPECT_EQ(gp.state().summary.dataset_description, data.description);
+  const std::string path = temp_path("described.h5");
+  save_model(path, gp);
+  const auto loaded = load_model(path);
+  EXPECT_EQ(dynamic_cast<const GaussianProcess&>(*loaded).state().summary.dataset_description, data.description);
+  EXPECT_NE(loaded->summary().find("trained on: " + data.description), std::string::npos) << loaded->summary();
+  {
+    H5::H5File file(path, H5F_ACC_RDWR);
+    file.openGroup("/gp/training").removeAttr("dataset_description");
+  }
+  const auto older = load_model(path);
+  EXPECT_EQ(dynamic_cast<const GaussianProcess&>(*older).state().summary.dataset_description, "");
+  EXPECT_EQ(older->summary().find("trained on:"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
 // A model's extrapolation policy and μ range travel with its file; a bad one is refused by name.
 TEST(ModelFile, ExtrapolationPolicyAndMuRangeRoundTrip) {
   const std::string path = temp_path("policy.h5");
