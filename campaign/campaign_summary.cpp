@@ -42,7 +42,7 @@ std::string campaign_summary(const Dataset& d) {
     }
   }
   std::string s = d.source.empty() ? std::string("samples of unknown origin") : d.source;
-  if (!d.code_version.empty()) s += ", code " + d.code_version;
+  if (!d.code_version.empty()) s += ", created by code " + d.code_version;  // a resumed campaign keeps its first
   if (d.plan.rows() > 0) {
     s += "; plan " + count_of(d.plan.rows(), "point", "points");
     if (!d.plan_design.empty()) s += ", design " + d.plan_design + " (seed " + std::to_string(d.plan_seed) + ")";

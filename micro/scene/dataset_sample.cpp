@@ -54,7 +54,7 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     o.mu_std = m.std_error.value_or(std::numeric_limits<double>::quiet_NaN());
     o.failure_reason = m.reason;
     o.warnings = m.warnings;
-    o.diagnostics = m.totals().to_json().get<std::map<std::string, double>>();
+    o.diagnostics = m.totals().named_values();
     o.diagnostics["draws"] = static_cast<double>(m.draws.size());
     o.diagnostics["max_abs_drift"] = m.max_abs_drift();
     o.diagnostics["micro_wall_seconds"] = m.wall_seconds;

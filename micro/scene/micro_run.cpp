@@ -635,15 +635,33 @@ MeasurementTotals MuMeasurement::totals() const {
   return t;
 }
 
+namespace {
+
+constexpr std::pair<const char*, int MeasurementTotals::*> kTotalsCounts[] = {
+    {"newton_iterations", &MeasurementTotals::newton_iterations},
+    {"coupling_iterations", &MeasurementTotals::coupling_iterations},
+    {"cutbacks", &MeasurementTotals::cutbacks},
+    {"dofs", &MeasurementTotals::dofs}};
+constexpr std::pair<const char*, double MeasurementTotals::*> kTotalsValues[] = {
+    {"max_contact_pressure_pa", &MeasurementTotals::max_contact_pressure},
+    {"max_plastic_strain", &MeasurementTotals::max_plastic_strain},
+    {"max_temperature_k", &MeasurementTotals::max_temperature},
+    {"contact_area_fraction", &MeasurementTotals::contact_fraction}};
+
+}  // namespace
+
 nlohmann::json MeasurementTotals::to_json() const {
-  return {{"newton_iterations", newton_iterations},
-          {"coupling_iterations", coupling_iterations},
-          {"cutbacks", cutbacks},
-          {"max_contact_pressure_pa", max_contact_pressure},
-          {"max_plastic_strain", max_plastic_strain},
-          {"max_temperature_k", max_temperature},
-          {"contact_area_fraction", contact_fraction},
-          {"dofs", dofs}};
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [name, field] : kTotalsCounts) j[name] = this->*field;
+  for (const auto& [name, field] : kTotalsValues) j[name] = this->*field;
+  return j;
+}
+
+std::map<std::string, double> MeasurementTotals::named_values() const {
+  std::map<std::string, double> values;
+  for (const auto& [name, field] : kTotalsCounts) values[name] = static_cast<double>(this->*field);
+  for (const auto& [name, field] : kTotalsValues) values[name] = this->*field;
+  return values;
 }
 
 double MuMeasurement::max_abs_drift() const {

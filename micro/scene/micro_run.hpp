@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -101,8 +102,10 @@ struct MeasurementTotals {
   double contact_fraction = 0.0;   // mean over the draws, at their ends
   double draw_seconds_sum = 0.0;   // one-core time of all draws together
   int dofs = 0;                    // of the chip (every draw has the same mesh)
-  // The diagnostics both result.json and a dataset sample report, under the same keys.
+  // The diagnostics both result.json and a dataset sample report, under the same keys (one table,
+  // kTotalsCounts and kTotalsValues in micro_run.cpp): counts as JSON integers, values as numbers.
   nlohmann::json to_json() const;
+  std::map<std::string, double> named_values() const;  // the same, for a dataset's /samples/diagnostics
 };
 
 // A draw whose μ moves by more than this fraction of μ between the first and the last block of its
