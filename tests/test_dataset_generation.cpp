@@ -70,6 +70,20 @@ Dataset small_plan(Eigen::Index rows, const std::string& scene = "{\"scene\": 1}
 
 double exact_mu(const Eigen::VectorXd& x) { return 0.1 + 1e-10 * x(0) + 0.01 * x(1) + 1e-5 * x(2); }
 
+// Four draws of exact_mu with normal scatter of the given standard deviation, seeded by the row's
+// own surfaces (independent draws: the same row gives the same draws).
+SampleEvaluator four_noisy_draws(double scatter) {
+  return [scatter](const SampleRequest& r) {
+    SampleOutcome o;
+    o.converged = true;
+    std::mt19937_64 rng(r.seeds->tool ^ (r.seeds->chip << 1));
+    std::normal_distribution<double> normal(0.0, scatter);
+    for (int k = 0; k < 4; ++k) o.draw_mu.push_back(exact_mu(r.x) + normal(rng));
+    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2] + o.draw_mu[3]) / 4.0;
+    return o;
+  };
+}
+
 // Converges everywhere except at plan rows whose pressure ends in 30 MPa steps (rows 3, 6, ...).
 SampleOutcome fake(const SampleRequest& request) {
   const Eigen::VectorXd& x = request.x;
@@ -380,15 +394,7 @@ TEST(DatasetGeneration, RefineCanLeaveThePendingTailOfItsPlanOut) {
   Dataset plan = small_plan(20);
   plan.draws = DrawDesign::independent;
   plan.plan_seed = 9;
-  const SampleEvaluator noisy = [](const SampleRequest& r) {
-    SampleOutcome o;
-    o.converged = true;
-    std::mt19937_64 rng(r.seeds->tool ^ (r.seeds->chip << 1));
-    std::normal_distribution<double> normal(0.0, 0.005);
-    for (int k = 0; k < 4; ++k) o.draw_mu.push_back(exact_mu(r.x) + normal(rng));
-    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2] + o.draw_mu[3]) / 4.0;
-    return o;
-  };
+  const SampleEvaluator noisy = four_noisy_draws(0.005);
   const std::string db = temp_path("prefix.h5");
   std::filesystem::remove(db);
   GenerationOptions first;
@@ -438,15 +444,7 @@ TEST(DatasetGeneration, RefineOnIndependentDrawsRepeatsPointsWithNewDraws) {
   const std::string db = temp_path("refine.h5");
   std::filesystem::remove(db);
   // Four draws whose scatter (0.02) dwarfs the trend: repeats are worth as much as new points.
-  const SampleEvaluator noisy = [](const SampleRequest& r) {
-    SampleOutcome o;
-    o.converged = true;
-    std::mt19937_64 rng(r.seeds->tool ^ (r.seeds->chip << 1));
-    std::normal_distribution<double> normal(0.0, 0.02);
-    for (int k = 0; k < 4; ++k) o.draw_mu.push_back(exact_mu(r.x) + normal(rng));
-    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2] + o.draw_mu[3]) / 4.0;
-    return o;
-  };
+  const SampleEvaluator noisy = four_noisy_draws(0.02);
   generate_dataset(plan, db, noisy, {});
   RefineOptions o;
   o.db = db;
