@@ -14,6 +14,7 @@
 
 #include "app/commands.hpp"
 #include "campaign/dataset_generation.hpp"
+#include "campaign/campaign_summary.hpp"
 #include "campaign/refine.hpp"
 #include "common/environment.hpp"
 #include "common/error.hpp"
@@ -287,10 +288,9 @@ void status_command(const std::string& path) {
     std::printf("\n");
   }
   if (!d.note.empty()) std::printf("  note: %s\n", d.note.c_str());
-  if (const auto it = d.diagnostics.find("wall_seconds"); it != d.diagnostics.end() && d.size() > 0) {
-    const double total = it->second.array().isNaN().select(0.0, it->second.array()).sum();
-    std::printf("  micro-model time: %s in total, %s per sample\n", duration_text(total).c_str(),
-                duration_text(total / static_cast<double>(d.size())).c_str());
+  if (const std::optional<double> total = total_wall_seconds(d)) {
+    std::printf("  micro-model time: %s in total, %s per sample\n", duration_text(*total).c_str(),
+                duration_text(*total / static_cast<double>(d.size())).c_str());
   }
   for (const auto& [reason, count] : reasons) std::printf("  failed x%lld: %s\n", count, reason.c_str());
   for (const auto& [reason, count] : outside_reasons) {

@@ -58,12 +58,17 @@ std::string campaign_summary(const Dataset& d) {
   if (const std::string mesh = mesh_text(d.scene_json); !mesh.empty()) s += "; " + mesh;
   s += "; " + count_of(d.size(), "sample", "samples") + " (" + std::to_string(converged) + " converged, " +
        std::to_string(outside) + " outside the model, " + std::to_string(d.size() - converged - outside) + " failed)";
-  if (const auto it = d.diagnostics.find("wall_seconds"); it != d.diagnostics.end() && d.size() > 0) {
-    const double total = it->second.array().isNaN().select(0.0, it->second.array()).sum();
-    s += "; micro-model wall time " + duration_text(total) + " (" + duration_text(total / static_cast<double>(d.size())) +
+  if (const std::optional<double> total = total_wall_seconds(d)) {
+    s += "; micro-model wall time " + duration_text(*total) + " (" + duration_text(*total / static_cast<double>(d.size())) +
          " per sample)";
   }
   return s;
+}
+
+std::optional<double> total_wall_seconds(const Dataset& d) {
+  const auto it = d.diagnostics.find("wall_seconds");
+  if (it == d.diagnostics.end() || d.size() == 0) return std::nullopt;
+  return it->second.array().isNaN().select(0.0, it->second.array()).sum();
 }
 
 }  // namespace mufric
