@@ -248,6 +248,7 @@ TEST(StochasticKriging, LearnsTheMeanAndThePatchScatterOfIndependentDraws) {
   const GaussianProcess gp_small = train_stochastic_kriging(small, options, &report);
   EXPECT_EQ(report.scatter_samples, 60);
   EXPECT_EQ(report.draws, 240);
+  for (const auto& w : report.mean.warnings) EXPECT_EQ(w.find("samples: below"), std::string::npos) << w;
   const GaussianProcess gp_large = train_stochastic_kriging(large, options);
   ASSERT_NE(gp_large.patch_scatter(), nullptr);
 
@@ -293,6 +294,21 @@ TEST(StochasticKriging, LearnsTheMeanAndThePatchScatterOfIndependentDraws) {
   EXPECT_EQ(again.hi, e.hi);
   EXPECT_EQ(back->patch_std(q), patch);
   std::filesystem::remove(path);
+}
+
+// A model of a handful of samples says that its interval is not yet to be trusted (the test below
+// measures why), with one draw per sample as with four.
+TEST(StochasticKriging, WarnsWhenTrainedOnTooFewSamplesForACalibratedInterval) {
+  GpTrainingOptions options;
+  options.restarts = 1;
+  for (const int draws : {4, 1}) {
+    StochasticKrigingReport report;
+    train_stochastic_kriging(independent_draws(8, draws, 12), options, &report);
+    EXPECT_EQ(report.homoscedastic, draws == 1);
+    const auto& w = report.mean.warnings;
+    EXPECT_TRUE(std::any_of(w.begin(), w.end(), [](const std::string& s) { return s.find("only 8 samples: below 16") != std::string::npos; }))
+        << draws << " draws";
+  }
 }
 
 // A campaign's first few samples (bench/interval_calibration.py in miniature): 8 samples of a known
