@@ -422,6 +422,137 @@ TEST(GeneralizedAlpha, VibratingBarFollowsTheAmplificationMatrixAndKeepsItsPerio
   }
 }
 
+// ---- An interaction with an unsymmetric tangent (friction's structure: a shear that follows the
+// normal force). Springs on the top nodes push each one down by k u_y and along x by μ k u_y: the
+// tangent entry (x, y) lies above the diagonal and has no mirror image, so the tangent must be
+// stored full and factorised by LU.
+class ShearFollowingNormalSprings : public BoundaryInteraction {
+ public:
+  ShearFollowingNormalSprings(std::vector<int> nodes, double stiffness, double ratio)
+      : nodes_(std::move(nodes)), stiffness_(stiffness), ratio_(ratio) {}
+  std::vector<std::vector<int>> coupled_nodes() const override {
+    std::vector<std::vector<int>> groups;
+    for (const int node : nodes_) groups.push_back({node});
+    return groups;
+  }
+  bool add(const Eigen::VectorXd& u, Eigen::VectorXd& force, TangentAccumulator* tangent, std::string&) const override {
+    for (const int node : nodes_) {
+      const int x = 2 * node, y = 2 * node + 1;
+      force(y) += stiffness_ * u(y);
+      force(x) += ratio_ * stiffness_ * u(y);
+      if (tangent != nullptr) {
+        tangent->add(y, y, stiffness_);
+        tangent->add(x, y, ratio_ * stiffness_);
+      }
+    }
+    return true;
+  }
+  bool symmetric_tangent() const override { return false; }
+  // The same forces as a dense matrix A (force = A u), for the independent solve.
+  void add_to(Eigen::MatrixXd& a) const {
+    for (const int node : nodes_) {
+      a(2 * node + 1, 2 * node + 1) += stiffness_;
+      a(2 * node, 2 * node + 1) += ratio_ * stiffness_;
+    }
+  }
+
+ private:
+  std::vector<int> nodes_;
+  double stiffness_, ratio_;
+};
+
+SolidProblem loaded_block() {
+  SolidProblem problem(IgaSpace(unit_square(2, 4)), std::make_shared<LinearElastic>(200.0, 0.3, 1.0));
+  problem.fix_side(Side::bottom, 0);
+  problem.fix_side(Side::bottom, 1);
+  problem.add_load({Side::top, Eigen::Vector2d(5.0, 0.0), 20.0, {}});
+  return problem;
+}
+
+std::vector<int> top_nodes(const SolidProblem& problem) {
+  std::vector<int> nodes;
+  for (int node = 0; node < problem.space().node_count(); ++node) {
+    if (problem.space().node_position(node).y() > 1.0 - 1e-12) nodes.push_back(node);
+  }
+  return nodes;
+}
+
+TEST(UnsymmetricTangent, IsStoredFullAndSolvedByLuToTheDenseSolution) {
+  SolidProblem problem = loaded_block();
+  const Eigen::MatrixXd k = Eigen::MatrixXd(SparseMatrix(
+      problem.assemble(Eigen::VectorXd::Zero(problem.dof_count()), 1.0, true).tangent.selfadjointView<Eigen::Lower>()));
+  EXPECT_EQ(problem.tangent_storage(), MatrixStorage::lower_symmetric);
+  const auto springs = std::make_shared<ShearFollowingNormalSprings>(top_nodes(problem), 150.0, 0.4);
+  ASSERT_EQ(top_nodes(problem).size(), 6u);  // degree 2, 4 spans
+  problem.add_interaction(springs);
+  EXPECT_EQ(problem.tangent_storage(), MatrixStorage::full);
+  EXPECT_EQ(problem.tangent_symmetry(), numerics::Symmetry::unsymmetric);
+
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal;
+  Eigen::VectorXd u(problem.dof_count());
+  for (auto& value : u) value = 1e-3 * normal(rng);
+  test::expect_tangent_matches_finite_differences(problem, u, 1.0, "elastic block + unsymmetric springs", 1e-7);
+
+  // The independent answer: (K + A) u = f on the free dofs, dense LU.
+  Eigen::MatrixXd system = k;
+  springs->add_to(system);
+  const Eigen::VectorXd f = problem.external(1.0);
+  std::vector<int> free;
+  for (int i = 0; i < problem.dof_count(); ++i) {
+    if (!problem.constrained()[static_cast<size_t>(i)]) free.push_back(i);
+  }
+  const auto n = static_cast<Eigen::Index>(free.size());
+  Eigen::MatrixXd reduced(n, n);
+  Eigen::VectorXd rhs(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    rhs(i) = f(free[static_cast<size_t>(i)]);
+    for (Eigen::Index j = 0; j < n; ++j) reduced(i, j) = system(free[static_cast<size_t>(i)], free[static_cast<size_t>(j)]);
+  }
+  const Eigen::VectorXd reference = reduced.partialPivLu().solve(rhs);
+
+  for (const auto kind : {LinearSolverKind::lu, LinearSolverKind::cholesky}) {
+    TimeIntegrationOptions options;
+    options.scheme = TimeScheme::quasi_static;
+    options.dt = options.end_time = 1.0;
+    options.relative_tolerance = 1e-13;
+    options.linear_solver = kind;
+    TimeIntegrator integrator(problem, options);
+    const IntegrationReport report = integrator.run();
+    ASSERT_TRUE(report.completed) << report.reason;
+    EXPECT_EQ(report.lu_fallbacks, 0);  // an unsymmetric tangent goes to LU directly
+    ASSERT_EQ(report.steps.size(), 1u);
+    EXPECT_EQ(report.steps[0].newton_iterations, 1);  // linear, and the tangent is exact
+    for (Eigen::Index i = 0; i < n; ++i) {
+      EXPECT_NEAR(integrator.u()(free[static_cast<size_t>(i)]), reference(i), 1e-10 * reference.cwiseAbs().maxCoeff());
+    }
+  }
+}
+
+// Generalised-α adds the mass matrix to the tangent value by value: a full tangent needs the full
+// mass with its pattern. A linear problem then converges in one Newton iteration every step.
+TEST(UnsymmetricTangent, DynamicStepsAddTheFullMassAndConvergeInOneIteration) {
+  SolidProblem problem = loaded_block();
+  problem.add_interaction(std::make_shared<ShearFollowingNormalSprings>(top_nodes(problem), 150.0, 0.4));
+  const SparseMatrix& lower = problem.mass();
+  const SparseMatrix& full = problem.mass(MatrixStorage::full);
+  const SparseMatrix tangent = problem.assemble(Eigen::VectorXd::Zero(problem.dof_count()), 1.0, true).tangent;
+  EXPECT_EQ(full.nonZeros(), tangent.nonZeros());
+  EXPECT_TRUE(std::equal(full.innerIndexPtr(), full.innerIndexPtr() + full.nonZeros(), tangent.innerIndexPtr()));
+  EXPECT_DOUBLE_EQ((Eigen::MatrixXd(full) - Eigen::MatrixXd(SparseMatrix(lower.selfadjointView<Eigen::Lower>()))).norm(), 0.0);
+
+  TimeIntegrationOptions options;
+  options.scheme = TimeScheme::generalized_alpha;
+  options.dt = 0.01;
+  options.end_time = 0.05;
+  options.relative_tolerance = 1e-12;
+  TimeIntegrator integrator(problem, options);
+  const IntegrationReport report = integrator.run();
+  ASSERT_TRUE(report.completed) << report.reason;
+  ASSERT_EQ(report.steps.size(), 5u);
+  for (const auto& step : report.steps) EXPECT_EQ(step.newton_iterations, 1) << step.time;
+}
+
 // ---- Periodic patches.
 TEST(Periodicity, FlatPeriodicLayerUnderPressureMatchesTheClosedForm) {
   // Top y = H flat, x control points unevenly spaced (a distorted parameterisation along x).

@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#include "common/error.hpp"
+
 namespace mufric::numerics {
 namespace {
 
@@ -65,7 +67,11 @@ LinearSolver::~LinearSolver() = default;
 LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
 LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
 
-bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage) {
+bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage,
+                             Symmetry symmetry) {
+  if (symmetry == Symmetry::unsymmetric && storage == MatrixStorage::lower_symmetric) {
+    throw Error("linear solver: an unsymmetric matrix cannot be given by its lower triangle");
+  }
   const bool same_pattern =
       analyses_ > 0 && static_cast<Eigen::Index>(impl_->outer.size()) == a.outerSize() + 1 &&
       static_cast<Eigen::Index>(impl_->inner.size()) == a.nonZeros() &&
@@ -78,7 +84,7 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
     ++analyses_;
   }
   reason_.clear();
-  if (kind_ == LinearSolverKind::lu) return factorize_lu(a, storage);
+  if (kind_ == LinearSolverKind::lu || symmetry == Symmetry::unsymmetric) return factorize_lu(a, storage);
   const CholmodThreadsWithinOurs threads;
   if (!cholesky_analysed_) {
     impl_->cholesky.analyzePattern(a);

@@ -15,6 +15,9 @@ enum class LinearSolverKind { lu, cholesky };
 // How a matrix given to the solver is stored: every entry, or the lower triangle of a symmetric
 // matrix (SolidProblem's tangents and mass matrices).
 enum class MatrixStorage { full, lower_symmetric };
+// Whether a matrix is symmetric in value. A Cholesky solver factorises an unsymmetric one by LU (a
+// frictional contact's tangent, Wriggers 2006, ch. 5: slip makes it unsymmetric).
+enum class Symmetry { symmetric, unsymmetric };
 
 class LinearSolver {
  public:
@@ -23,8 +26,9 @@ class LinearSolver {
   LinearSolver(LinearSolver&&) noexcept;
   LinearSolver& operator=(LinearSolver&&) noexcept;
   // Factorises A (re-analysing only when its pattern differs from the last one). false: singular
-  // or not positive definite; `reason()` says which.
-  bool factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage = MatrixStorage::full);
+  // or not positive definite; `reason()` says which. An unsymmetric matrix must be stored full.
+  bool factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage = MatrixStorage::full,
+                 Symmetry symmetry = Symmetry::symmetric);
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   const std::string& reason() const { return reason_; }
   int analyses() const { return analyses_; }  // symbolic analyses done so far

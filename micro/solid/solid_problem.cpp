@@ -16,7 +16,7 @@ SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> mater
 }
 
 void TangentAccumulator::add(int row, int col, double value) {
-  if (row < col) return;  // the lower triangle is stored
+  if (storage_ == numerics::MatrixStorage::lower_symmetric && row < col) return;
   const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
   const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
   const int* at = std::lower_bound(begin, end, row);
@@ -26,8 +26,19 @@ void TangentAccumulator::add(int row, int col, double value) {
 
 void SolidProblem::add_interaction(std::shared_ptr<const BoundaryInteraction> interaction) {
   interactions_.push_back(std::move(interaction));
-  mass_ = SparseMatrix();
+  mass_ = full_mass_ = SparseMatrix();
   build_pattern();
+}
+
+numerics::Symmetry SolidProblem::tangent_symmetry() const {
+  const bool symmetric = std::all_of(interactions_.begin(), interactions_.end(),
+                                     [](const auto& interaction) { return interaction->symmetric_tangent(); });
+  return symmetric ? numerics::Symmetry::symmetric : numerics::Symmetry::unsymmetric;
+}
+
+numerics::MatrixStorage SolidProblem::tangent_storage() const {
+  return tangent_symmetry() == numerics::Symmetry::symmetric ? numerics::MatrixStorage::lower_symmetric
+                                                             : numerics::MatrixStorage::full;
 }
 
 void SolidProblem::build_pattern() {
@@ -319,7 +330,11 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
   }
   // Every element succeeded (a failure returned above): the boundary interactions come on top.
   const auto start = std::chrono::steady_clock::now();
-  TangentAccumulator accumulator(out.tangent);
+  const numerics::MatrixStorage storage = tangent_storage();
+  if (with_tangent && storage == numerics::MatrixStorage::full) {
+    out.tangent = MovableSparseMatrix(SparseMatrix(out.tangent.selfadjointView<Eigen::Lower>()));
+  }
+  TangentAccumulator accumulator(out.tangent, storage);
   for (const auto& interaction : interactions_) {
     if (!interaction->add(u, out.internal, with_tangent ? &accumulator : nullptr, out.reason)) {
       out.ok = false;
@@ -345,7 +360,12 @@ Eigen::VectorXd SolidProblem::external(double t) const {
   return f;
 }
 
-const SparseMatrix& SolidProblem::mass() const {
+const SparseMatrix& SolidProblem::mass(numerics::MatrixStorage storage) const {
+  if (storage == numerics::MatrixStorage::full) {
+    // The same mirror of the same lower pattern as a full tangent's: equal patterns, added by value.
+    if (full_mass_.nonZeros() == 0) full_mass_ = mass().selfadjointView<Eigen::Lower>();
+    return full_mass_;
+  }
   if (mass_.nonZeros() > 0) return mass_;
   mass_ = pattern_;
   double* values = mass_.valuePtr();

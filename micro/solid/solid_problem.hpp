@@ -2,10 +2,13 @@
 // The chip as a boundary-value problem: one IGA patch, one material, Dirichlet conditions on
 // control-point displacement components and dead tractions on sides, each scaled by a function of
 // time. Assembles internal forces, the tangent (a fixed sparsity pattern, filled element by
-// element), external forces and the consistent mass matrix. The tangent and the mass matrix are
-// symmetric and stored as their lower triangle (row ≥ column): products go through
-// selfadjointView<Eigen::Lower>(), and CHOLMOD reads that triangle anyway — storing only it halves
-// the scatter, the copies and CHOLMOD's transpose of every factorisation.
+// element), external forces and the consistent mass matrix. The mass matrix and, while every boundary
+// interaction's tangent is symmetric (frictionless contact, dead nodal loads), the tangent are stored
+// as their lower triangle (row ≥ column): products go through selfadjointView<Eigen::Lower>(), and
+// CHOLMOD reads that triangle anyway — storing only it halves the scatter, the copies and CHOLMOD's
+// transpose of every factorisation. An interaction with an unsymmetric tangent (friction: slip makes
+// it so) switches the tangent to full storage: the bulk, symmetric, is assembled into the lower
+// triangle as always and mirrored once per assembly, then the interactions add every entry.
 #include <functional>
 #include <memory>
 #include <string>
@@ -13,6 +16,7 @@
 
 #include <Eigen/Sparse>
 
+#include "micro/numerics/linear_solver.hpp"
 #include "micro/solid/iga_space.hpp"
 #include "micro/solid/materials.hpp"
 
@@ -64,17 +68,23 @@ class BoundaryInteraction {
   // and, when `tangent` is not null, its derivative. Returns false with a reason on failure.
   virtual bool add(const Eigen::VectorXd& u, Eigen::VectorXd& force, class TangentAccumulator* tangent,
                    std::string& reason) const = 0;
+  // Whether the tangent it adds is symmetric: then it adds full symmetric blocks, of which the
+  // accumulator keeps the lower triangle; otherwise every entry it adds is kept.
+  virtual bool symmetric_tangent() const { return true; }
 };
 
-// Adds entries to a tangent whose pattern already holds them. The tangent keeps its lower triangle:
-// an entry above the diagonal is dropped (symmetric interactions add its mirror image as well).
+// Adds entries to a tangent whose pattern already holds them. A tangent stored as its lower triangle
+// drops an entry above the diagonal (symmetric interactions add its mirror image as well); one
+// stored full keeps every entry.
 class TangentAccumulator {
  public:
-  explicit TangentAccumulator(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) : matrix_(matrix) {}
+  TangentAccumulator(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, numerics::MatrixStorage storage)
+      : matrix_(matrix), storage_(storage) {}
   void add(int row, int col, double value);
 
  private:
   Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix_;
+  numerics::MatrixStorage storage_;
 };
 
 class SolidProblem {
@@ -92,6 +102,9 @@ class SolidProblem {
   void add_load(SideLoad load);
   // Displacement-dependent boundary forces (contact). Rebuilds the sparsity pattern.
   void add_interaction(std::shared_ptr<const BoundaryInteraction> interaction);
+  // Symmetric unless an interaction's tangent is not; then the tangent is stored full.
+  numerics::Symmetry tangent_symmetry() const;
+  numerics::MatrixStorage tangent_storage() const;
   const std::vector<DirichletCondition>& dirichlet() const { return dirichlet_; }
   // true for each dof that carries a Dirichlet condition
   const std::vector<bool>& constrained() const { return constrained_; }
@@ -105,7 +118,7 @@ class SolidProblem {
 
   struct Assembly {
     Eigen::VectorXd internal;           // f_int(u)
-    MovableSparseMatrix tangent;        // ∂f_int/∂u (when requested), lower triangle
+    MovableSparseMatrix tangent;        // ∂f_int/∂u (when requested), stored as tangent_storage() says
     std::vector<MaterialState> states;  // trial states at u
     std::vector<Eigen::Matrix2d> stresses;  // S at each quadrature point
     bool ok = true;
@@ -118,7 +131,9 @@ class SolidProblem {
   Assembly assemble(const Eigen::VectorXd& u, double dt, bool with_tangent,
                     const std::vector<MaterialState>* iterate = nullptr) const;
   Eigen::VectorXd external(double t) const;
-  const SparseMatrix& mass() const;  // consistent, ∫ρ R_a R_b dX, lower triangle, built on first use
+  // Consistent, ∫ρ R_a R_b dX, built on first use; lower triangle, or full with the tangent's pattern
+  // when that is stored full (an inertia term is added to the tangent value by value).
+  const SparseMatrix& mass(numerics::MatrixStorage storage = numerics::MatrixStorage::lower_symmetric) const;
 
   const std::vector<MaterialState>& states() const { return states_; }
   void commit(std::vector<MaterialState> states) { states_ = std::move(states); }
@@ -151,7 +166,7 @@ class SolidProblem {
   std::vector<double> point_gradients_;        // per quadrature point, ∂R/∂X as a 2 × count row-major block
   std::vector<double> point_weights_;          // per quadrature point, weight × |det J|
   std::vector<std::vector<int>> colours_;      // elements grouped so that no two in a group share a node
-  mutable SparseMatrix mass_;
+  mutable SparseMatrix mass_, full_mass_;
 };
 
 }  // namespace mufric::solid

@@ -154,7 +154,10 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
                                         : u_;
   problem_.apply_dirichlet(t1, u1);
   const Eigen::VectorXd f_ext1 = problem_.external(t1), f_ext0 = problem_.external(t0);
+  const numerics::MatrixStorage storage = problem_.tangent_storage();
+  const numerics::Symmetry symmetry = problem_.tangent_symmetry();
   const SparseMatrix* mass = dynamic ? &problem_.mass() : nullptr;
+  const SparseMatrix* tangent_mass = dynamic ? &problem_.mass(storage) : nullptr;
   const double mass_factor = dynamic ? (1.0 - am) / (b * dt * dt) : 0.0;
   const double stiffness_factor = dynamic ? 1.0 - af : 1.0;
 
@@ -221,7 +224,8 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     const auto start = std::chrono::steady_clock::now();
     // In the quadratic phase the tangent hardly changes between iterations: the last factorisation
     // serves once more (a chord step), and any sign of trouble brings a fresh one.
-    const bool reuse = options_.linear_solver == numerics::LinearSolverKind::lu && factorized && last_full_step &&
+    const bool by_lu = options_.linear_solver == numerics::LinearSolverKind::lu || symmetry == numerics::Symmetry::unsymmetric;
+    const bool reuse = by_lu && factorized && last_full_step &&
                        current.norm < kReuseFactorizationBelow * previous_norm;
     if (!reuse) {
       MovableSparseMatrix k = std::move(current.assembly.tangent);
@@ -229,10 +233,10 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
       if (dynamic) {
         // Same pattern as the tangent: add value arrays.
         Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
-            mass_factor * Eigen::Map<const Eigen::VectorXd>(mass->valuePtr(), mass->nonZeros());
+            mass_factor * Eigen::Map<const Eigen::VectorXd>(tangent_mass->valuePtr(), tangent_mass->nonZeros());
       }
       problem_.constrain(k);
-      if (!solver_.factorize(k, numerics::MatrixStorage::lower_symmetric)) {
+      if (!solver_.factorize(k, storage, symmetry)) {
         at.reason = solver_.reason();
         return at;
       }
