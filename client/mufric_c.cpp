@@ -31,6 +31,27 @@ int fail(int code, std::string message) {
   return code;
 }
 
+// A call's body with the C API's error contract: an invalid argument or any other failure becomes its
+// code, and mufric_last_error says what, prefixed by the function's name.
+template <class Body>
+int guarded(const char* function, Body&& body) {
+  try {
+    return body();
+  } catch (const mufric::client::InvalidArgument& e) {
+    return fail(MUFRIC_INVALID_ARGUMENT, std::string(function) + ": " + e.what());
+  } catch (const std::exception& e) {
+    return fail(MUFRIC_FAILED, std::string(function) + ": " + e.what());
+  }
+}
+
+// A request with the client's tolerances and extrapolation policy (mufric_open's options).
+mufric::client::Answer evaluate_with_options(const mufric_client& client, const mufric::client::Block& block, mufric::EvaluationRequest what) {
+  what.mu_tolerance = client.mu_tolerance;
+  what.std_relative_tolerance = client.std_tolerance;
+  what.extrapolation = client.extrapolation;
+  return client.impl->evaluate(block, what);
+}
+
 // A Fortran CHARACTER argument: its hidden length, blank padding removed.
 std::string fortran_string(const char* text, size_t length) {
   std::string s(text, length);
@@ -95,13 +116,9 @@ int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pr
   if (want_interval && !(ci_level > 0.0 && ci_level < 1.0)) {
     return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: lo/hi requested but ci_level is not in (0, 1)");
   }
-  try {
+  return guarded("mufric_evaluate", [&] {
     const mufric::client::Block block{n, contact_pressure, sliding_velocity, temperature, fibre_angle};
-    mufric::EvaluationRequest what{.std = std != nullptr, .ci_level = want_interval ? ci_level : 0.0, .gradient = false};
-    what.mu_tolerance = client->mu_tolerance;
-    what.std_relative_tolerance = client->std_tolerance;
-    what.extrapolation = client->extrapolation;
-    const auto answer = client->impl->evaluate(block, what);
+    const auto answer = evaluate_with_options(*client, block, {.std = std != nullptr, .ci_level = want_interval ? ci_level : 0.0, .gradient = false});
     // Copies only: the outputs of points without an answer are NaN or the fill value, and nothing
     // here compares them (a caller trapping FE_INVALID would die on an ordered comparison with NaN).
     for (size_t i = 0; i < n; ++i) {
@@ -142,11 +159,7 @@ int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pr
     // A call with points without an answer succeeds; their message is what mufric_last_error says.
     last_error = answer.message;
     return MUFRIC_OK;
-  } catch (const mufric::client::InvalidArgument& e) {
-    return fail(MUFRIC_INVALID_ARGUMENT, std::string("mufric_evaluate: ") + e.what());
-  } catch (const std::exception& e) {
-    return fail(MUFRIC_FAILED, std::string("mufric_evaluate: ") + e.what());
-  }
+  });
 }
 
 int mufric_patch_std(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
@@ -157,25 +170,16 @@ int mufric_patch_std(mufric_client* client, size_t n, const double* contact_pres
     return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: the model has no patch scatter (it was not trained by "
                                          "stochastic kriging on a dataset of independent draws)");
   }
-  try {
+  return guarded("mufric_patch_std", [&] {
     const mufric::client::Block block{n, contact_pressure, sliding_velocity, temperature, fibre_angle};
-    mufric::EvaluationRequest what;
-    what.patch_std = true;
-    what.mu_tolerance = client->mu_tolerance;
-    what.std_relative_tolerance = client->std_tolerance;
-    what.extrapolation = client->extrapolation;
-    const auto answer = client->impl->evaluate(block, what);
+    const auto answer = evaluate_with_options(*client, block, {.patch_std = true});
     for (size_t i = 0; i < n; ++i) {  // copies only, as in mufric_evaluate_ex
       patch_std[i] = answer.patch_std[i];
       if (status) status[i] = static_cast<int>(answer.status[i]);
     }
     last_error = answer.message;
     return MUFRIC_OK;
-  } catch (const mufric::client::InvalidArgument& e) {
-    return fail(MUFRIC_INVALID_ARGUMENT, std::string("mufric_patch_std: ") + e.what());
-  } catch (const std::exception& e) {
-    return fail(MUFRIC_FAILED, std::string("mufric_patch_std: ") + e.what());
-  }
+  });
 }
 
 int mufric_has_patch_scatter(mufric_client* client) { return client != nullptr && client->has_patch_scatter ? 1 : 0; }

@@ -33,6 +33,20 @@ inline TrainingSet smooth_training_set(Eigen::Index n, unsigned seed) {
   return t;
 }
 
+// Stochastic kriging with given hyper-parameters (not optimised): each sample's μ_std² on the
+// diagonal, the interval the mean's.
+inline GpTrainingOptions fixed_stochastic_kriging(double signal_variance, const Eigen::Vector3d& length_scales,
+                                                  double noise_variance) {
+  GpTrainingOptions o;
+  o.optimise = false;
+  o.sample_noise = true;
+  o.interval_of_mean = true;
+  o.initial.signal_variance = signal_variance;
+  o.initial.length_scales = length_scales;
+  o.initial.noise_variance = noise_variance;
+  return o;
+}
+
 // A GP with these hyper-parameters (not optimised) on smooth_training_set(n, seed).
 inline GaussianProcess fixed_hyper_gp(Eigen::Index n, unsigned seed, double signal_variance,
                                       const Eigen::Vector3d& length_scales, double noise_variance) {

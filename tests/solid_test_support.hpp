@@ -12,13 +12,17 @@ namespace mufric::solid::test {
 using numerics::LinearSolverKind;
 
 // One quasi-static step of a linear problem, solved to 1e-13 of its force scale.
-inline Eigen::VectorXd solve_static(SolidProblem& problem, LinearSolverKind solver = LinearSolverKind::lu) {
+inline TimeIntegrationOptions static_step_options(LinearSolverKind solver = LinearSolverKind::lu) {
   TimeIntegrationOptions options;
   options.scheme = TimeScheme::quasi_static;
   options.dt = options.end_time = 1.0;
   options.relative_tolerance = 1e-13;
   options.linear_solver = solver;
-  TimeIntegrator integrator(problem, options);
+  return options;
+}
+
+inline Eigen::VectorXd solve_static(SolidProblem& problem, LinearSolverKind solver = LinearSolverKind::lu) {
+  TimeIntegrator integrator(problem, static_step_options(solver));
   const IntegrationReport report = integrator.run();
   EXPECT_TRUE(report.completed) << report.reason;
   return integrator.u();

@@ -105,14 +105,7 @@ TEST(ActiveLearning, ImseReductionMatchesBruteForceAndPicksItsArgmax) {
   TrainingSet t = test::smooth_training_set(30, 4);
   t.mu_std.resize(30);
   for (Eigen::Index i = 0; i < 30; ++i) t.mu_std(i) = 0.002 + 0.004 * static_cast<double>(i % 5);
-  GpTrainingOptions o;
-  o.optimise = false;
-  o.sample_noise = true;
-  o.interval_of_mean = true;
-  o.initial.signal_variance = 1.5;
-  o.initial.length_scales = Eigen::Vector3d(0.4, 0.6, 0.5);
-  o.initial.noise_variance = 1e-4;
-  const GaussianProcess gp = train_gaussian_process(t, o);
+  const GaussianProcess gp = train_gaussian_process(t, test::fixed_stochastic_kriging(1.5, Eigen::Vector3d(0.4, 0.6, 0.5), 1e-4));
   const auto& s = gp.state();
   Eigen::MatrixXd candidates = plan_in_box(PlanDesign::sobol, 40, s.inputs, 3);
   candidates.row(0) = s.x_train.row(2);  // replicates

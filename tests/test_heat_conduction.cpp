@@ -13,11 +13,7 @@
 namespace mufric::solid {
 namespace {
 
-using numerics::LinearSolver;
-using numerics::LinearSolverKind;
-using numerics::MatrixStorage;
 using numerics::Side;
-using numerics::gauss_legendre;
 
 using spline::Points2;
 using spline::SplineBasis;

@@ -512,12 +512,7 @@ TEST(UnsymmetricTangent, IsStoredFullAndSolvedByLuToTheDenseSolution) {
   const Eigen::VectorXd reference = reduced.partialPivLu().solve(rhs);
 
   for (const auto kind : {LinearSolverKind::lu, LinearSolverKind::cholesky}) {
-    TimeIntegrationOptions options;
-    options.scheme = TimeScheme::quasi_static;
-    options.dt = options.end_time = 1.0;
-    options.relative_tolerance = 1e-13;
-    options.linear_solver = kind;
-    TimeIntegrator integrator(problem, options);
+    TimeIntegrator integrator(problem, test::static_step_options(kind));
     const IntegrationReport report = integrator.run();
     ASSERT_TRUE(report.completed) << report.reason;
     EXPECT_EQ(report.lu_fallbacks, 0);  // an unsymmetric tangent goes to LU directly

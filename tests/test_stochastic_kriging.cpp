@@ -9,6 +9,7 @@
 #include <random>
 
 #include "common/error.hpp"
+#include "gp_test_data.hpp"
 #include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
@@ -74,13 +75,7 @@ TEST(StochasticKriging, AKnownDiagonalGivesTheDensePosterior) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const TrainingSet data = samples_with_own_errors(25, rng);
-  GpTrainingOptions options;
-  options.optimise = false;
-  options.sample_noise = true;
-  options.interval_of_mean = true;
-  options.initial.signal_variance = 1.3;
-  options.initial.length_scales = Eigen::Vector3d(0.4, 0.7, 1.1);
-  options.initial.noise_variance = 1e-3;
+  const GpTrainingOptions options = test::fixed_stochastic_kriging(1.3, Eigen::Vector3d(0.4, 0.7, 1.1), 1e-3);
   const GaussianProcess gp = train_gaussian_process(data, options);
   EXPECT_EQ(gp.interval_meaning(), IntervalMeaning::mean_over_draws);
   Eigen::MatrixXd queries(6, 3);
@@ -142,14 +137,8 @@ TEST(StochasticKriging, AnEstimatedMeanGivesTheDenseOrdinaryKrigingPosterior) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   constexpr Eigen::Index n = 30;
   const TrainingSet data = samples_with_own_errors(n, rng);
-  GpTrainingOptions options;
-  options.optimise = false;
-  options.sample_noise = true;
-  options.interval_of_mean = true;
+  GpTrainingOptions options = test::fixed_stochastic_kriging(0.4, Eigen::Vector3d(0.3, 0.5, 0.9), 1e-3);
   options.estimate_mean = true;
-  options.initial.signal_variance = 0.4;
-  options.initial.length_scales = Eigen::Vector3d(0.3, 0.5, 0.9);
-  options.initial.noise_variance = 1e-3;
   const GaussianProcess gp = train_gaussian_process(data, options);
   const auto& s = gp.state();
   ASSERT_TRUE(s.mean_estimated);

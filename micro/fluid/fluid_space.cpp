@@ -23,26 +23,14 @@ FluidSpace::FluidSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
   const auto bu = patch_.u_basis().breakpoints(), bv = patch_.v_basis().breakpoints();
   elements_u_ = static_cast<int>(bu.size()) - 1;
   elements_v_ = static_cast<int>(bv.size()) - 1;
-  std::vector<double> gu, wu, gv, wv;
-  numerics::gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
-  numerics::gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
-  for (int ev = 0; ev < elements_v_; ++ev) {
-    for (int eu = 0; eu < elements_u_; ++eu) {
-      const double u0 = bu[static_cast<size_t>(eu)], u1 = bu[static_cast<size_t>(eu) + 1];
-      const double v0 = bv[static_cast<size_t>(ev)], v1 = bv[static_cast<size_t>(ev) + 1];
-      std::vector<ParametricPoint> points;
-      for (size_t b = 0; b < gv.size(); ++b) {
-        for (size_t a = 0; a < gu.size(); ++a) {
-          ParametricPoint p = evaluate(0.5 * (u0 + u1) + 0.5 * (u1 - u0) * gu[a], 0.5 * (v0 + v1) + 0.5 * (v1 - v0) * gv[b]);
-          p.weight = wu[a] * wv[b] * 0.25 * (u1 - u0) * (v1 - v0);
-          p.element_scale = Eigen::Vector2d(2.0 / (u1 - u0), 2.0 / (v1 - v0));
-          points.push_back(std::move(p));
-        }
-      }
-      element_nodes_.push_back(points.front().nodes);
-      element_points_.push_back(std::move(points));
-    }
+  element_points_.resize(static_cast<size_t>(elements_u_ * elements_v_));
+  for (const auto& q : numerics::element_gauss_points(bu, bv, patch_.u_basis().degree() + 1, patch_.v_basis().degree() + 1)) {
+    ParametricPoint p = evaluate(q.u, q.v);
+    p.weight = q.weight;
+    p.element_scale = Eigen::Vector2d(2.0 / q.span_u, 2.0 / q.span_v);
+    element_points_[static_cast<size_t>(q.element)].push_back(std::move(p));
   }
+  for (const auto& points : element_points_) element_nodes_.push_back(points.front().nodes);
   side_points_.resize(4);
   for (Side side : {Side::bottom, Side::top, Side::left, Side::right}) {
     if (!has_side(side)) continue;

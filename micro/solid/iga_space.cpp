@@ -10,37 +10,24 @@ IgaSpace::IgaSpace(spline::SplineSurface patch) : patch_(std::move(patch)) {
   const auto bu = patch_.u_basis().breakpoints(), bv = patch_.v_basis().breakpoints();
   elements_u_ = static_cast<int>(bu.size()) - 1;
   elements_v_ = static_cast<int>(bv.size()) - 1;
-  std::vector<double> gu, wu, gv, wv;
-  numerics::gauss_legendre(patch_.u_basis().degree() + 1, gu, wu);
-  numerics::gauss_legendre(patch_.v_basis().degree() + 1, gv, wv);
-  for (int ev = 0; ev < elements_v_; ++ev) {
-    for (int eu = 0; eu < elements_u_; ++eu) {
-      const double u0 = bu[static_cast<size_t>(eu)], u1 = bu[static_cast<size_t>(eu) + 1];
-      const double v0 = bv[static_cast<size_t>(ev)], v1 = bv[static_cast<size_t>(ev) + 1];
-      for (size_t b = 0; b < gv.size(); ++b) {
-        for (size_t a = 0; a < gu.size(); ++a) {
-          const double u = 0.5 * (u0 + u1) + 0.5 * (u1 - u0) * gu[a];
-          const double v = 0.5 * (v0 + v1) + 0.5 * (v1 - v0) * gv[b];
-          const spline::RationalBasis basis = patch_.basis_at(u, v);
-          const double det = basis.jacobian.determinant();
-          if (!(det > 0.0)) {
-            throw Error("IGA patch: the parameterisation is not orientation-preserving (det J = " +
-                        std::to_string(det) + " at u = " + std::to_string(u) + ", v = " + std::to_string(v) + ")");
-          }
-          QuadraturePoint qp;
-          qp.nodes = basis.nodes;
-          qp.values = basis.r;
-          Eigen::Matrix2Xd parametric(2, basis.r.size());
-          parametric.row(0) = basis.r_u.transpose();
-          parametric.row(1) = basis.r_v.transpose();
-          qp.gradients = basis.jacobian.transpose().inverse() * parametric;
-          qp.weight = wu[a] * wv[b] * 0.25 * (u1 - u0) * (v1 - v0) * det;
-          qp.position = basis.x;
-          qp.element = eu + elements_u_ * ev;
-          points_.push_back(std::move(qp));
-        }
-      }
+  for (const auto& p : numerics::element_gauss_points(bu, bv, patch_.u_basis().degree() + 1, patch_.v_basis().degree() + 1)) {
+    const spline::RationalBasis basis = patch_.basis_at(p.u, p.v);
+    const double det = basis.jacobian.determinant();
+    if (!(det > 0.0)) {
+      throw Error("IGA patch: the parameterisation is not orientation-preserving (det J = " + std::to_string(det) +
+                  " at u = " + std::to_string(p.u) + ", v = " + std::to_string(p.v) + ")");
     }
+    QuadraturePoint qp;
+    qp.nodes = basis.nodes;
+    qp.values = basis.r;
+    Eigen::Matrix2Xd parametric(2, basis.r.size());
+    parametric.row(0) = basis.r_u.transpose();
+    parametric.row(1) = basis.r_v.transpose();
+    qp.gradients = basis.jacobian.transpose().inverse() * parametric;
+    qp.weight = p.weight * det;
+    qp.position = basis.x;
+    qp.element = p.element;
+    points_.push_back(std::move(qp));
   }
 }
 
