@@ -84,7 +84,7 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
     ++analyses_;
   }
   reason_.clear();
-  if (kind_ == LinearSolverKind::lu || symmetry == Symmetry::unsymmetric) return factorize_lu(a, storage);
+  if (factorizes_by_lu(symmetry)) return factorize_lu(a, storage);
   const CholmodThreadsWithinOurs threads;
   if (!cholesky_analysed_) {
     impl_->cholesky.analyzePattern(a);

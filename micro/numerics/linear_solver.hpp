@@ -30,6 +30,9 @@ class LinearSolver {
   bool factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage = MatrixStorage::full,
                  Symmetry symmetry = Symmetry::symmetric);
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  // Whether a matrix of this symmetry is factorised by LU (an LU solver, or any unsymmetric matrix);
+  // a Cholesky solver's LU fallback for a matrix not positive definite is not foreseen here.
+  bool factorizes_by_lu(Symmetry symmetry) const { return kind_ == LinearSolverKind::lu || symmetry == Symmetry::unsymmetric; }
   const std::string& reason() const { return reason_; }
   int analyses() const { return analyses_; }  // symbolic analyses done so far
   int lu_fallbacks() const { return lu_fallbacks_; }  // Cholesky solver: matrices factorised by LU instead

@@ -224,8 +224,7 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     const auto start = std::chrono::steady_clock::now();
     // In the quadratic phase the tangent hardly changes between iterations: the last factorisation
     // serves once more (a chord step), and any sign of trouble brings a fresh one.
-    const bool by_lu = options_.linear_solver == numerics::LinearSolverKind::lu || symmetry == numerics::Symmetry::unsymmetric;
-    const bool reuse = by_lu && factorized && last_full_step &&
+    const bool reuse = solver_.factorizes_by_lu(symmetry) && factorized && last_full_step &&
                        current.norm < kReuseFactorizationBelow * previous_norm;
     if (!reuse) {
       MovableSparseMatrix k = std::move(current.assembly.tangent);
