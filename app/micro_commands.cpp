@@ -249,8 +249,8 @@ int run_command(const RunCommandOptions& o) {
   m.advisories.insert(m.advisories.begin(), sc.warnings.begin(), sc.warnings.end());
   write_file_atomically(o.out + "/result.json", m.to_json(sc).dump(2) + "\n");
   print_summary(m, sc);
-  std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu%s (first draw)\n", o.out.c_str(), o.out.c_str(), o.out.c_str(),
-              sc.physics == scene::Physics::lubricated ? (", " + o.out + "/film.vtu").c_str() : "");
+  std::printf("wrote %s/result.json, %s/chip.vtu, %s/tool.vtu, %s/contact.csv%s (first draw)\n", o.out.c_str(),
+              o.out.c_str(), o.out.c_str(), o.out.c_str(), sc.physics == scene::Physics::lubricated ? (", " + o.out + "/film.vtu").c_str() : "");
   return m.completed ? 0 : 3;
 }
 
@@ -396,7 +396,7 @@ void add_micro_commands(CLI::App& app) {
   auto* run = micro->add_subcommand("run", "One high-fidelity run, dry or lubricated: mu by eq. 17 with its history and diagnostics");
   run->add_option("scene", r->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
   run->add_option("--set", r->overrides, "Override a scene value, e.g. --set load.pressure=1300MPa (repeatable)");
-  run->add_option("--out", r->out, "Directory for result.json, chip.vtu, tool.vtu (and film.vtu when lubricated)")->capture_default_str();
+  run->add_option("--out", r->out, "Directory for result.json, chip.vtu, tool.vtu, contact.csv (and film.vtu when lubricated)")->capture_default_str();
   run->add_flag("--quiet", r->quiet, "No per-step progress on stderr");
   run->footer("The scene's protocol says what mu means. press-slide (the default): the chip is pressed, then slid;\n"
               "mu is averaged over protocol.window of sliding after protocol.run_in, for protocol.phases tool\n"

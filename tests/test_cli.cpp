@@ -21,6 +21,8 @@
 
 #include <sched.h>
 
+#include <nlohmann/json.hpp>
+
 #include "corrupt_files.hpp"
 
 namespace {
@@ -558,12 +560,39 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
   EXPECT_NE(r.output.find("mu = "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(standard error"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("| 2 | 0.500 |"), std::string::npos) << r.output;  // the second tool phase's row
-  for (const char* file : {"result.json", "chip.vtu", "tool.vtu"}) {
+  for (const char* file : {"result.json", "chip.vtu", "tool.vtu", "contact.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(path("run") + "/" + file)) << file;
   }
   std::ifstream in(path("run") + "/result.json");
   std::string json, line;
   while (std::getline(in, line)) json += line;
+  // contact.csv is the first draw's final contact point by point: Σ p w n over its rows is the
+  // contact force that draw's last step recorded in result.json.
+  {
+    const nlohmann::json result = nlohmann::json::parse(json);
+    std::ifstream csv(path("run") + "/contact.csv");
+    std::getline(csv, line);
+    EXPECT_EQ(line, "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,normal_x,normal_y");
+    double force_x = 0.0, force_y = 0.0;
+    int rows = 0, searched = 0;
+    while (std::getline(csv, line)) {
+      std::vector<std::string> field;
+      std::stringstream row(line);
+      for (std::string f; std::getline(row, f, ',');) field.push_back(f);
+      ASSERT_EQ(field.size(), 8U) << line;
+      ++rows;
+      searched += !field[4].empty();
+      const double load = std::stod(field[5]) * std::stod(field[1]);  // pressure × reference length, N/m
+      force_x += load * std::stod(field[6]);
+      force_y += load * std::stod(field[7]);
+    }
+    EXPECT_GT(rows, 0);
+    EXPECT_GT(searched, 0);
+    const auto& last = result["draws"][0]["history"].back();
+    const double fx = last["force_x_n_per_m"], fy = last["force_y_n_per_m"];
+    EXPECT_NEAR(force_x, fx, 1e-9 * std::abs(fy));
+    EXPECT_NEAR(force_y, fy, 1e-9 * std::abs(fy));
+  }
   EXPECT_NE(json.find("\"history\""), std::string::npos);
   EXPECT_NE(json.find("\"mu_std_error\""), std::string::npos);
   EXPECT_NE(json.find("\"block_means\""), std::string::npos);

@@ -101,7 +101,8 @@ std::vector<std::vector<int>> MortarContact::coupled_nodes() const {
 }
 
 std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& u, int& projections,
-                                                         std::string& reason, bool& ok) const {
+                                                         std::string& reason, bool& ok,
+                                                         std::vector<Eigen::Vector2d>* positions) const {
   const size_t n = points_.size();
   std::vector<Eigen::Vector2d> x(n);
   std::vector<bool> near(n, false);
@@ -144,6 +145,7 @@ std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& 
     const double denominator = speed2 * (speed2 + g.gap * nc);
     g.hessian = denominator != 0.0 ? Eigen::Matrix2d(nc / denominator * t * t.transpose()) : Eigen::Matrix2d::Zero();
   }
+  if (positions != nullptr) *positions = std::move(x);
   return out;
 }
 
@@ -234,7 +236,8 @@ ContactState MortarContact::state(const Eigen::VectorXd& u) const {
   ContactState s;
   bool ok = true;
   std::string reason;
-  const std::vector<PointGap> g = gaps(u, s.projections, reason, ok);
+  std::vector<Eigen::Vector2d> positions;
+  const std::vector<PointGap> g = gaps(u, s.projections, reason, ok, &positions);
   if (!ok) throw Error(reason);
   const Eigen::VectorXd p = node_pressures(g);
   s.surface_length = surface_length_;
@@ -242,8 +245,11 @@ ContactState MortarContact::state(const Eigen::VectorXd& u) const {
     const auto& sp = points_[q];
     const double pq = point_pressure(q, p);
     s.point_x.push_back(sp.position.x());
+    s.point_weight.push_back(sp.weight);
+    s.point_position.push_back(positions[q]);
     s.point_pressure.push_back(std::max(pq, 0.0));
     s.point_normal.push_back(g[q].normal);
+    s.point_gap.push_back(g[q].evaluated ? std::optional<double>(g[q].gap) : std::nullopt);
     if (pq <= 0.0) continue;
     s.force += pq * sp.weight * g[q].normal;  // the tool pushes the chip along its outward normal
     s.contact_length += sp.weight;

@@ -7,6 +7,7 @@
 // point carries the pressure p_a = ε⟨g_a⟩. Integrals are over the reference surface. The tangent is
 // the exact linearisation, including the curvature of the tool.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,9 +34,12 @@ struct ContactState {
   double surface_length = 0.0;                      // reference length of the chip surface, m
   double max_pressure = 0.0;                        // Pa
   int projections = 0;                              // closest-point searches done
-  // Per surface quadrature point, for output and tests: reference x, pressure, normal.
-  std::vector<double> point_x, point_pressure;
-  std::vector<Eigen::Vector2d> point_normal;
+  // Per surface quadrature point, for output and tests: reference x, reference length dΓ, current
+  // position, pressure, the tool's normal at the closest point, and the gap (positive when the chip
+  // penetrates; none where the point is too far from the tool to be searched).
+  std::vector<double> point_x, point_weight, point_pressure;
+  std::vector<Eigen::Vector2d> point_position, point_normal;
+  std::vector<std::optional<double>> point_gap;
 };
 
 class MortarContact final : public solid::BoundaryInteraction {
@@ -65,7 +69,8 @@ class MortarContact final : public solid::BoundaryInteraction {
     Eigen::Matrix2d hessian = Eigen::Matrix2d::Zero(); // ∂²g/∂x²
   };
   // Gaps at every point whose surface node could be in contact; the rest stay unevaluated.
-  std::vector<PointGap> gaps(const Eigen::VectorXd& u, int& projections, std::string& reason, bool& ok) const;
+  std::vector<PointGap> gaps(const Eigen::VectorXd& u, int& projections, std::string& reason, bool& ok,
+                             std::vector<Eigen::Vector2d>* positions = nullptr) const;
   Eigen::VectorXd node_pressures(const std::vector<PointGap>& g) const;  // p_a per surface node
   // The mortar pressure at a point, P_q = Σ_a p_a N_a(q).
   double point_pressure(size_t q, const Eigen::VectorXd& node_pressure) const;

@@ -587,6 +587,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   if (!options.vtu_directory.empty()) {
     write_chip_vtu(options.vtu_directory + "/chip.vtu", problem, integrator.u(), recorder.last_contact());
     write_tool_vtu(options.vtu_directory + "/tool.vtu", geometry.tool_surface);
+    write_contact_csv(options.vtu_directory + "/contact.csv", recorder.last_contact());
     if (lubricant) write_film_vtu(options.vtu_directory + "/film.vtu", lubricant->fluid());
   }
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
