@@ -21,19 +21,21 @@ def main():
     separated_y = total_x = total_y = 0.0
     with open(sys.argv[1]) as f:
         for row in csv.DictReader(f):
-            load = float(row["pressure_pa"]) * float(row["weight_m"])
-            if load <= 0.0:
+            weight, pressure = float(row["weight_m"]), float(row["pressure_pa"])
+            if pressure <= 0.0:
                 continue
             nx, ny = float(row["normal_x"]), float(row["normal_y"])
+            shear = float(row.get("shear_pa") or 0.0)  # along t = (-n_y, n_x)
+            fx, fy = weight * (pressure * nx - shear * ny), weight * (pressure * ny + shear * nx)
             slope = -nx / ny  # the tool's dy/dx at the closest point
             # The sign of the leading face's slope: the tool moves toward -x relative to the chip.
             name = "leading face" if slope < -0.8 * tan_alpha else "trailing face" if slope > 0.8 * tan_alpha else "apex"
-            parts[name][0] += load * nx
-            parts[name][1] += load * ny
-            total_x += load * nx
-            total_y += load * ny
+            parts[name][0] += fx
+            parts[name][1] += fy
+            total_x += fx
+            total_y += fy
             if row["gap_m"] == "" or float(row["gap_m"]) <= 0.0:
-                separated_y += load * ny
+                separated_y += fy
     if total_y == 0.0:
         sys.exit("no contact in " + sys.argv[1])
     print(f"mu = {total_x / total_y:.5f}, tan(alpha) = {tan_alpha:.5f}, ratio {total_x / total_y / tan_alpha:.4f}")

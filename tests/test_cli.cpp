@@ -572,19 +572,21 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
     const nlohmann::json result = nlohmann::json::parse(json);
     std::ifstream csv(path("run") + "/contact.csv");
     std::getline(csv, line);
-    EXPECT_EQ(line, "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,normal_x,normal_y");
+    EXPECT_EQ(line, "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,shear_pa,normal_x,normal_y");
     double force_x = 0.0, force_y = 0.0;
     int rows = 0, searched = 0;
     while (std::getline(csv, line)) {
       std::vector<std::string> field;
       std::stringstream row(line);
       for (std::string f; std::getline(row, f, ',');) field.push_back(f);
-      ASSERT_EQ(field.size(), 8U) << line;
+      ASSERT_EQ(field.size(), 9U) << line;
       ++rows;
       searched += !field[4].empty();
-      const double load = std::stod(field[5]) * std::stod(field[1]);  // pressure × reference length, N/m
-      force_x += load * std::stod(field[6]);
-      force_y += load * std::stod(field[7]);
+      // (pressure n + shear t) × reference length, N/m, with t = (−n_y, n_x)
+      const double weight = std::stod(field[1]), pressure = std::stod(field[5]), shear = std::stod(field[6]);
+      const double nx = std::stod(field[7]), ny = std::stod(field[8]);
+      force_x += weight * (pressure * nx - shear * ny);
+      force_y += weight * (pressure * ny + shear * nx);
     }
     EXPECT_GT(rows, 0);
     EXPECT_GT(searched, 0);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <numbers>
 
 #include "micro/contact/mortar_contact.hpp"
@@ -142,6 +143,150 @@ TEST(MortarContact, HertzLineContactOfACylinderOnARigidFlat) {
   std::printf("Hertz: F %.6g a %.6g (Hertz %.6g) p0 %.6g (Hertz %.6g), %d Newton iterations, assembly %.2f s, solve %.2f s\n",
               force, a_measured, a_hertz, s.max_pressure, p0_hertz, report.newton_iterations, report.seconds_assembly,
               report.seconds_solve);
+}
+
+// ---- Coulomb's law at the contact points --------------------------------------------------------
+
+InterfaceLaw coulomb(double adhesive_coefficient, double tangential_penalty = 0.0) {
+  InterfaceLaw law;
+  law.kind = InterfaceLaw::Kind::coulomb;
+  law.adhesive_coefficient = adhesive_coefficient;
+  law.tangential_penalty = tangential_penalty;
+  return law;
+}
+
+// The patch test's flat chip pressed uniformly onto a flat tool, its state committed, then slid
+// rigidly along the tool by d: every point carries τ = −ε_t d while ε_t d ≤ μ_a p (stick) and
+// τ = −μ_a p beyond (slip), so the resultant's ratio is μ_a exactly (Coulomb's law, closed form).
+TEST(CoulombContact, AFlatChipSlidUnderUniformPressureCarriesTheLawsShear) {
+  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3;
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
+                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
+                                                 penalty, 0, coulomb(mu_a, tangential));
+  EXPECT_FALSE(contact->symmetric_tangent());
+  problem.add_interaction(contact);
+  problem.fix_side(numerics::Side::bottom, 0);
+  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  const Eigen::VectorXd pressed = solid::test::solve_static(problem);
+  contact->commit(pressed);
+  const double stick_limit = mu_a * pressure / tangential;  // the slide at which stick ends
+  for (const double fraction : {0.5, -0.5, 3.0, -3.0}) {
+    const double d = fraction * stick_limit;
+    Eigen::VectorXd slid = pressed;
+    for (Eigen::Index i = 0; i < slid.size(); i += 2) slid(i) += d;
+    const ContactState s = contact->state(slid);
+    const double expected_shear = std::abs(fraction) <= 1.0 ? -tangential * d : -std::copysign(mu_a * pressure, d);
+    for (size_t q = 0; q < s.point_shear.size(); ++q) {
+      EXPECT_NEAR(s.point_pressure[q], pressure, 1e-9 * pressure);
+      EXPECT_NEAR(s.point_shear[q], expected_shear, 1e-6 * mu_a * pressure) << "slide " << fraction << ", x " << s.point_x[q];
+    }
+    EXPECT_NEAR(s.force.x(), expected_shear * period, 1e-6 * mu_a * pressure * period) << "slide " << fraction;
+    EXPECT_NEAR(s.force.y(), -pressure * period, 1e-9 * pressure * period);
+    if (std::abs(fraction) > 1.0) {
+      EXPECT_NEAR(std::abs(s.force.x() / s.force.y()), mu_a, 1e-9);
+    }
+  }
+  // A committed slip moves the anchors: sliding back by less than twice the stick limit sticks.
+  Eigen::VectorXd slid = pressed;
+  for (Eigen::Index i = 0; i < slid.size(); i += 2) slid(i) += 3.0 * stick_limit;
+  contact->commit(slid);
+  for (Eigen::Index i = 0; i < slid.size(); i += 2) slid(i) -= stick_limit;
+  const ContactState back = contact->state(slid);
+  for (size_t q = 0; q < back.point_shear.size(); ++q) {
+    // −μ_a p + ε_t d = 0, up to the offset's first-order arc length on the unevenly parameterised tool
+    EXPECT_NEAR(back.point_shear[q], 0.0, 1e-5 * mu_a * pressure) << "x " << back.point_x[q];
+  }
+}
+
+// A rigid facet of slope α pressed uniformly onto a chip whose surface lies parallel to it (a sheared
+// periodic cell), then slid along the facet in slip: the force on the facet leans from its normal by
+// arctan μ_a against the sliding, so its ratio in the x–y axes is tan(α + arctan μ_a) (statics of
+// the inclined plane with Coulomb friction), whatever the parameterisations of tool and chip.
+TEST(CoulombContact, ARigidFacetOfSlopeAlphaInSlipLeansByArctanMu) {
+  const double period = 1.0, height = 0.5, penalty = 1e3, tangential = 400.0, mu_a = 0.3;
+  for (const double alpha_deg : {5.0, 20.0}) {
+    const double slope = std::tan(alpha_deg * std::numbers::pi / 180.0);
+    const Eigen::Vector2d shift(period, period * slope);
+    // The chip: a parallelogram cell, bottom along y = x tan α, top along y = h + x tan α.
+    const int spans = 7;
+    Points2 net(2 * spans, 2);
+    for (int i = 0; i < spans; ++i) {
+      const double x = period * i / spans;
+      net.row(i) << x, x * slope;
+      net.row(i + spans) << x, height + x * slope;
+    }
+    SplineSurface cell(SplineBasis::periodic_uniform(2, spans, 0, 1), SplineBasis::open_uniform(1, 1, 0.0, 1.0), net, {},
+                       shift);
+    cell = cell.elevated_v().subdivided(1, 3);
+    solid::SolidProblem problem(solid::IgaSpace(cell), std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+    // The facet 1e-6 (vertically) into the chip, its control points spaced unevenly.
+    const int tool_points = 11;
+    Points2 facet(tool_points, 2);
+    for (int i = 0; i < tool_points; ++i) {
+      const double x = period * (i + 0.3 * std::sin(1.7 * (i + 2))) / tool_points;
+      facet.row(i) << x, height - 1e-6 + x * slope;
+    }
+    auto contact = std::make_shared<MortarContact>(
+        problem.space(), RigidTool{SplineCurve(SplineBasis::periodic_uniform(3, tool_points, 0, 1), facet, {}, shift)},
+        penalty, 0, coulomb(mu_a, tangential));
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(problem.dof_count());
+    contact->commit(u);
+    const double pressure = penalty * 1e-6 * std::cos(std::atan(slope));  // the normal gap's penalty
+    const Eigen::Vector2d along(std::cos(std::atan(slope)), std::sin(std::atan(slope)));
+    for (const double direction : {1.0, -1.0}) {
+      const Eigen::Vector2d d = direction * 3.0 * mu_a * pressure / tangential * along;  // well into slip
+      for (Eigen::Index i = 0; i < u.size(); i += 2) u.segment<2>(i) = d;
+      const ContactState s = contact->state(u);
+      // Up the facet (+t) the friction on the chip points down it: the chip pushes the facet forward
+      // and up, F_x/F_y on the chip = −tan(α − arctan μ_a); down it, −tan(α + arctan μ_a).
+      const double expected = -std::tan(std::atan(slope) - direction * std::atan(mu_a));
+      EXPECT_NEAR(s.force.x() / s.force.y(), expected, 1e-9) << "alpha " << alpha_deg << ", direction " << direction;
+      EXPECT_NEAR(std::hypot(s.force.x(), s.force.y()),
+                  pressure * std::hypot(1.0, mu_a) * period / std::cos(std::atan(slope)), 1e-6 * pressure);
+    }
+  }
+}
+
+// The consistent (unsymmetric) tangent of the frictional contact against central differences, on
+// rough surfaces with points in stick and in slip at once (a soft chip, so that the contact's part
+// of the residual dominates what is compared).
+TEST(CoulombContact, TangentIsTheExactLinearisationInStickAndSlip) {
+  spline::RoughnessSpec spec;
+  spec.length = 1.0;
+  spec.ra = 0.02;
+  spec.correlation_length = 0.1;
+  spec.samples = 256;
+  const SplineCurve chip_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 2, 24).curve;
+  spec.seed = 9;
+  SplineCurve tool_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 3, 30).curve;
+  Points2 lowered = tool_surface.points();
+  lowered.col(1).array() += 0.03;
+  tool_surface = SplineCurve(tool_surface.basis(), lowered, {}, tool_surface.shift());
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
+                              std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
+  const double mu_a = 0.3;
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, coulomb(mu_a));
+  problem.add_interaction(contact);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::VectorXd u(problem.dof_count());
+  for (auto& x : u) x = 2e-3 * unit(rng);
+  contact->commit(u);
+  // Slide the chip along x by amounts that leave some points in stick and push others into slip.
+  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
+  const ContactState s = contact->state(u);
+  int stick = 0, slip = 0;
+  for (size_t q = 0; q < s.point_shear.size(); ++q) {
+    if (s.point_pressure[q] <= 0.0) continue;
+    const bool slipping = std::abs(std::abs(s.point_shear[q]) - mu_a * s.point_pressure[q]) < 1e-12 * s.point_pressure[q];
+    slipping ? ++slip : ++stick;
+  }
+  std::cout << "points in stick " << stick << ", in slip " << slip << "\n";
+  ASSERT_GT(stick, 3);
+  ASSERT_GT(slip, 3);
+  EXPECT_EQ(problem.tangent_storage(), numerics::MatrixStorage::full);
+  solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "coulomb contact", 1e-5);
 }
 
 }  // namespace

@@ -53,7 +53,10 @@ TEST(Scene, ErrorsNameTheKey) {
       {"lubricant.min_film=\"0um\"", "lubricant.min_film"},
       {"time.average_from=\"1s\"", "time.average_from"},
       {"time.max_step=\"0.5ns\"", "time.max_step: is shorter than time.step"},
-      {"geometry.chip_surface.flat=true", "exactly one of csv, synthetic or flat"}};
+      {"geometry.chip_surface.flat=true", "exactly one of csv, synthetic or flat"},
+      {"contact.law=\"sticky\"", "contact.law: 'sticky' is not one of: frictionless, coulomb"},
+      {"contact.law=\"coulomb\"", "contact.adhesive_coefficient: required when contact.law is coulomb"},
+      {"contact.adhesive_coefficient=-0.1", "contact.adhesive_coefficient"}};
   for (const auto& [assignment, expected] : cases) {
     nlohmann::json bad = j;
     apply_override(bad, assignment);
@@ -64,6 +67,20 @@ TEST(Scene, ErrorsNameTheKey) {
   EXPECT_NO_THROW(parse_scene(drained, "scene.json"));
   apply_override(drained, "protocol.name=\"seed-000\"");
   EXPECT_NE(error_of(drained).find("lubricant.fill"), std::string::npos) << error_of(drained);
+  // Coulomb's keys read into the law; in a frictionless scene they have no effect, and it says so.
+  nlohmann::json coulomb = j;
+  apply_override(coulomb, "contact.law=\"coulomb\"");
+  apply_override(coulomb, "contact.adhesive_coefficient=0.15");
+  const Scene with_friction = parse_scene(coulomb, "s");
+  EXPECT_EQ(with_friction.interface_law.kind, contact::InterfaceLaw::Kind::coulomb);
+  EXPECT_DOUBLE_EQ(with_friction.interface_law.adhesive_coefficient, 0.15);
+  EXPECT_DOUBLE_EQ(with_friction.interface_law.tangential_penalty, contact::kTangentialPenaltyRatio * with_friction.penalty);
+  nlohmann::json ignored = j;
+  apply_override(ignored, "contact.adhesive_coefficient=0.15");
+  const Scene frictionless = parse_scene(ignored, "s");
+  EXPECT_EQ(frictionless.interface_law.kind, contact::InterfaceLaw::Kind::frictionless);
+  ASSERT_EQ(frictionless.warnings.size(), 1U);
+  EXPECT_NE(frictionless.warnings[0].find("contact.adhesive_coefficient"), std::string::npos);
   nlohmann::json kelvin = j;
   apply_override(kelvin, "load.temperature=500K");
   EXPECT_DOUBLE_EQ(parse_scene(kelvin, "s").temperature, 500.0);

@@ -9,9 +9,13 @@ namespace mufric::contact {
 
 double RigidTool::lowest_y() const { return surface.points().col(1).minCoeff(); }
 
-MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty, int points_per_span)
-    : tool_(std::move(tool)), penalty_(penalty) {
+MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty, int points_per_span,
+                             InterfaceLaw law)
+    : tool_(std::move(tool)), law_(law), penalty_(penalty) {
   if (!(penalty_ > 0.0)) throw Error("contact: the penalty factor must be positive");
+  if (law_.tangential_penalty == 0.0) law_.tangential_penalty = kTangentialPenaltyRatio * penalty_;
+  if (!(law_.tangential_penalty > 0.0)) throw Error("contact: the tangential penalty must be positive");
+  if (!(law_.adhesive_coefficient >= 0.0)) throw Error("contact: the adhesive coefficient must be >= 0");
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
   const auto& basis = tool_.surface.basis();
@@ -57,6 +61,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
     surface_length_ += sp.weight;
     points_.push_back(std::move(sp));
   }
+  anchor_.assign(points_.size(), std::nullopt);
 }
 
 spline::ProjectionOptions MortarContact::search_window(const Eigen::Vector2d& x) const {
@@ -144,6 +149,11 @@ std::vector<MortarContact::PointGap> MortarContact::gaps(const Eigen::VectorXd& 
     const double nc = g.normal.dot(c2);
     const double denominator = speed2 * (speed2 + g.gap * nc);
     g.hessian = denominator != 0.0 ? Eigen::Matrix2d(nc / denominator * t * t.transpose()) : Eigen::Matrix2d::Zero();
+    g.parameter = p.u;
+    g.d1 = t;
+    g.d2 = c2;
+    // From the foot's condition (x − C(ξ))·C′(ξ) = 0: ∂ξ/∂x = C′ / (|C′|² + g n·C″).
+    if (speed2 + g.gap * nc != 0.0) g.parameter_gradient = t / (speed2 + g.gap * nc);
   }
   if (positions != nullptr) *positions = std::move(x);
   return out;
@@ -176,6 +186,64 @@ double MortarContact::point_pressure(size_t q, const Eigen::VectorXd& node_press
   return pq;
 }
 
+Eigen::Matrix2d MortarContact::unit_tangent_gradient(const PointGap& g) {
+  // t = C′/|C′|: ∂t/∂ξ = (C″ − t (t·C″))/|C′|, times ∂ξ/∂x.
+  const double speed = g.d1.norm();
+  const Eigen::Vector2d t = g.d1 / speed;
+  const Eigen::Vector2d dt_dxi = (g.d2 - t * t.dot(g.d2)) / speed;
+  return dt_dxi * g.parameter_gradient.transpose();
+}
+
+MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g, double pressure) const {
+  PointShear s;
+  if (law_.kind == InterfaceLaw::Kind::frictionless || pressure <= 0.0 || !g.evaluated) return s;
+  // A point without an anchor (not searched at the last commit) starts stress-free where it is.
+  if (!anchor_[q]) return s;
+  // Tangential offset from the anchor along the tool, g_t = |C′(ξ)| (ξ − ξ_a): the arc length to
+  // first order in ξ − ξ_a, which in stick stays of the order of τ/ε_t (sub-nanometre).
+  const double speed = g.d1.norm();
+  const double offset_parameter = g.parameter - *anchor_[q];
+  const double offset = speed * offset_parameter;
+  const double trial = -law_.tangential_penalty * offset;
+  const double limit = law_.adhesive_coefficient * pressure;
+  if (std::abs(trial) <= limit) {
+    s.regime = PointShear::Regime::stick;
+    s.shear = trial;
+    // ∂g_t/∂x = (|C′| + (ξ − ξ_a) t·C″) ∂ξ/∂x.
+    const double doffset_dxi = speed + offset_parameter * g.d2.dot(g.d1) / speed;
+    s.shear_gradient = -law_.tangential_penalty * doffset_dxi * g.parameter_gradient;
+  } else {
+    s.regime = PointShear::Regime::slip;
+    s.slip_sign = trial > 0.0 ? 1.0 : -1.0;
+    s.shear = s.slip_sign * limit;
+  }
+  return s;
+}
+
+void MortarContact::commit(const Eigen::VectorXd& u) {
+  if (law_.kind == InterfaceLaw::Kind::frictionless) return;
+  bool ok = true;
+  int projections = 0;
+  std::string reason;
+  const std::vector<PointGap> g = gaps(u, projections, reason, ok);
+  if (!ok) throw Error("contact: committing the accepted state: " + reason);
+  const Eigen::VectorXd p = node_pressures(g);
+  for (size_t q = 0; q < points_.size(); ++q) {
+    if (!g[q].evaluated) {
+      anchor_[q].reset();
+      continue;
+    }
+    const PointShear s = point_shear(q, g[q], point_pressure(q, p));
+    if (s.regime == PointShear::Regime::stick) continue;  // the anchor holds
+    if (s.regime == PointShear::Regime::slip) {
+      // Return map: the anchor follows so that −ε_t g_t is the slip shear.
+      anchor_[q] = g[q].parameter + s.shear / (law_.tangential_penalty * g[q].d1.norm());
+    } else {
+      anchor_[q] = g[q].parameter;  // out of contact (or just touching): stress-free where it is
+    }
+  }
+}
+
 bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
                         std::string& reason) const {
   bool ok = true;
@@ -183,50 +251,82 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
   const std::vector<PointGap> g = gaps(u, projections, reason, ok);
   if (!ok) return false;
   const Eigen::VectorXd p = node_pressures(g);
-  // Mortar pressure at each point, P_q = Σ_a p_a N_a(q); force f_b = −Σ_q P_q w_q R_b n_q.
+  // G_a = ∂g_a/∂u = (1/A_a) Σ_q N_a(q) w_q (−R_b n_q) of every active node, as (node, ∂g_a/∂u_node)
+  // over the few (p + 2) nodes of its support: a linear search in a small vector, not a hash map.
+  std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> gradients;
+  if (tangent != nullptr) {
+    gradients.resize(surface_nodes_.size());
+    for (size_t a = 0; a < surface_nodes_.size(); ++a) {
+      if (p(static_cast<Eigen::Index>(a)) <= 0.0) continue;
+      auto& gradient = gradients[a];
+      for (const auto& [q, local] : node_points_[a]) {
+        const auto& sp = points_[static_cast<size_t>(q)];
+        const double factor = sp.values(local) * sp.weight / node_area_[a];
+        for (size_t b = 0; b < sp.nodes.size(); ++b) {
+          auto it = std::find_if(gradient.begin(), gradient.end(), [&](const auto& e) { return e.first == sp.nodes[b]; });
+          if (it == gradient.end()) it = gradient.insert(gradient.end(), {sp.nodes[b], Eigen::Vector2d::Zero()});
+          it->second -= factor * sp.values(static_cast<Eigen::Index>(b)) * g[static_cast<size_t>(q)].normal;
+        }
+      }
+    }
+  }
+  auto add_block = [&](int b, int c, const Eigen::Matrix2d& k) {
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < 2; ++j) tangent->add(2 * b + i, 2 * c + j, k(i, j));
+    }
+  };
+  // Mortar pressure at each point, P_q = Σ_a p_a N_a(q), and the law's shear τ_q along the tool's
+  // unit tangent t_q: force f_b = −Σ_q w_q R_b (P_q n_q + τ_q t_q).
   for (size_t q = 0; q < points_.size(); ++q) {
     const auto& sp = points_[q];
     const double pq = point_pressure(q, p);
     if (pq <= 0.0) continue;
+    const PointShear shear = point_shear(q, g[q], pq);
+    const bool sheared = shear.regime != PointShear::Regime::none;
     for (size_t k = 0; k < sp.nodes.size(); ++k) {
       force.segment<2>(2 * sp.nodes[k]) -= pq * sp.weight * sp.values(static_cast<Eigen::Index>(k)) * g[q].normal;
+      if (sheared) {
+        force.segment<2>(2 * sp.nodes[k]) -= shear.shear * sp.weight * sp.values(static_cast<Eigen::Index>(k)) * unit_tangent(g[q]);
+      }
     }
     if (tangent == nullptr) continue;
-    // Σ_q P_q w_q R_b R_c ∂²g/∂x²: the turning of the tool's normal.
+    // Σ_q P_q w_q R_b R_c ∂²g/∂x² (the turning of the tool's normal), and for the shear
+    // −w_q R_b R_c (τ ∂t/∂x + t ⊗ ∂τ/∂x) with ∂τ/∂x of stick (slip's ∂τ/∂P comes below).
+    Eigen::Matrix2d shear_block = Eigen::Matrix2d::Zero();
+    if (sheared) {
+      shear_block = -shear.shear * unit_tangent_gradient(g[q]);
+      if (shear.regime == PointShear::Regime::stick) shear_block -= unit_tangent(g[q]) * shear.shear_gradient.transpose();
+    }
     for (size_t b = 0; b < sp.nodes.size(); ++b) {
       for (size_t c = 0; c < sp.nodes.size(); ++c) {
-        const Eigen::Matrix2d k = pq * sp.weight * sp.values(static_cast<Eigen::Index>(b)) *
-                                  sp.values(static_cast<Eigen::Index>(c)) * g[q].hessian;
-        for (int i = 0; i < 2; ++i) {
-          for (int j = 0; j < 2; ++j) tangent->add(2 * sp.nodes[b] + i, 2 * sp.nodes[c] + j, k(i, j));
+        const double rr = sp.values(static_cast<Eigen::Index>(b)) * sp.values(static_cast<Eigen::Index>(c));
+        Eigen::Matrix2d k = pq * sp.weight * sp.values(static_cast<Eigen::Index>(b)) *
+                            sp.values(static_cast<Eigen::Index>(c)) * g[q].hessian;
+        if (sheared) k += sp.weight * rr * shear_block;
+        add_block(sp.nodes[b], sp.nodes[c], k);
+      }
+    }
+    if (shear.regime != PointShear::Regime::slip) continue;
+    // Slip: τ = s μ_a P_q, ∂P_q/∂u = Σ_a N_a(q) ε G_a: −w_q R_b s μ_a ε N_a(q) t ⊗ G_a.
+    const Eigen::Vector2d t = unit_tangent(g[q]);
+    for (size_t k = 0; k < sp.nodes.size(); ++k) {
+      const auto a = static_cast<size_t>(sp.multipliers[k]);
+      if (gradients[a].empty()) continue;  // an inactive node adds nothing to P_q
+      const double scale = -sp.weight * shear.slip_sign * law_.adhesive_coefficient * penalty_ *
+                           sp.values(static_cast<Eigen::Index>(k));
+      for (size_t b = 0; b < sp.nodes.size(); ++b) {
+        for (const auto& [c, gc] : gradients[a]) {
+          add_block(sp.nodes[b], c, scale * sp.values(static_cast<Eigen::Index>(b)) * t * gc.transpose());
         }
       }
     }
   }
   if (tangent == nullptr) return true;
-  // ε A_a G_a G_aᵀ for every active node, G_a = ∂g_a/∂u = (1/A_a) Σ_q N_a(q) w_q (−R_b n_q).
-  std::vector<std::pair<int, Eigen::Vector2d>> gradient;
+  // ε A_a G_a G_aᵀ for every active node: the normal pressure's own change.
   for (size_t a = 0; a < surface_nodes_.size(); ++a) {
-    if (p(static_cast<Eigen::Index>(a)) <= 0.0) continue;
-    // node → ∂g_a/∂u_node over the few (p + 2) nodes of the support: a linear search in a small
-    // vector instead of a hash map (which allocated per node and assembly).
-    gradient.clear();
-    for (const auto& [q, local] : node_points_[a]) {
-      const auto& sp = points_[static_cast<size_t>(q)];
-      const double factor = sp.values(local) * sp.weight / node_area_[a];
-      for (size_t b = 0; b < sp.nodes.size(); ++b) {
-        auto it = std::find_if(gradient.begin(), gradient.end(), [&](const auto& e) { return e.first == sp.nodes[b]; });
-        if (it == gradient.end()) it = gradient.insert(gradient.end(), {sp.nodes[b], Eigen::Vector2d::Zero()});
-        it->second -= factor * sp.values(static_cast<Eigen::Index>(b)) * g[static_cast<size_t>(q)].normal;
-      }
-    }
     const double scale = penalty_ * node_area_[a];
-    for (const auto& [b, gb] : gradient) {
-      for (const auto& [c, gc] : gradient) {
-        for (int i = 0; i < 2; ++i) {
-          for (int j = 0; j < 2; ++j) tangent->add(2 * b + i, 2 * c + j, scale * gb(i) * gc(j));
-        }
-      }
+    for (const auto& [b, gb] : gradients[a]) {
+      for (const auto& [c, gc] : gradients[a]) add_block(b, c, scale * gb * gc.transpose());
     }
   }
   return true;
@@ -244,14 +344,17 @@ ContactState MortarContact::state(const Eigen::VectorXd& u) const {
   for (size_t q = 0; q < points_.size(); ++q) {
     const auto& sp = points_[q];
     const double pq = point_pressure(q, p);
+    const PointShear shear = pq > 0.0 ? point_shear(q, g[q], pq) : PointShear{};
     s.point_x.push_back(sp.position.x());
     s.point_weight.push_back(sp.weight);
     s.point_position.push_back(positions[q]);
     s.point_pressure.push_back(std::max(pq, 0.0));
+    s.point_shear.push_back(shear.shear);
     s.point_normal.push_back(g[q].normal);
     s.point_gap.push_back(g[q].evaluated ? std::optional<double>(g[q].gap) : std::nullopt);
     if (pq <= 0.0) continue;
     s.force += pq * sp.weight * g[q].normal;  // the tool pushes the chip along its outward normal
+    if (shear.regime != PointShear::Regime::none) s.force += shear.shear * sp.weight * unit_tangent(g[q]);
     s.contact_length += sp.weight;
     s.max_pressure = std::max(s.max_pressure, pq);
   }

@@ -19,6 +19,23 @@ namespace mufric::contact {
 // Penalty factor of seed 000 section 4, Pa/m.
 inline constexpr double kDefaultPenalty = 2e18;
 
+// The interfacial shear at the contact points (scene key contact.law). `frictionless` is seed 000's
+// model (μ from ploughing alone). `coulomb`: |τ| ≤ μ_a P at each contact point, stick regularised by
+// a tangential penalty with a return map (Wriggers, Computational Contact Mechanics, 2nd ed. 2006,
+// §5.2.2; Laursen 2002 §5.3): trial τ = −ε_t g_t from the point's tangential offset g_t to its
+// anchor on the tool, slip when |τ| > μ_a P, the anchor moved at each accepted step.
+// Stick's tangential penalty as a fraction of the normal one: a stuck point's offset τ/ε_t stays
+// sub-nanometre (0.5 nm at τ = 100 MPa, ε = 2e18), and Newton needs a third of the iterations it
+// needs at ε_t = ε (small default scene with μ_a = 0.1: 545 against 1299; μ within 0.6 %).
+inline constexpr double kTangentialPenaltyRatio = 0.1;
+
+struct InterfaceLaw {
+  enum class Kind { frictionless, coulomb };
+  Kind kind = Kind::frictionless;
+  double adhesive_coefficient = 0.0;  // μ_a (coulomb)
+  double tangential_penalty = 0.0;    // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
+};
+
 // The rigid tool: a curve whose outward normal, for a curve running in +x, points down (−y side),
 // toward the chip below it. Periodic tools repeat with their shift (the interval).
 struct RigidTool {
@@ -35,9 +52,10 @@ struct ContactState {
   double max_pressure = 0.0;                        // Pa
   int projections = 0;                              // closest-point searches done
   // Per surface quadrature point, for output and tests: reference x, reference length dΓ, current
-  // position, pressure, the tool's normal at the closest point, and the gap (positive when the chip
+  // position, pressure, shear (along the tool's unit tangent, which runs with the curve, +x for a
+  // profile), the tool's normal at the closest point, and the gap (positive when the chip
   // penetrates; none where the point is too far from the tool to be searched).
-  std::vector<double> point_x, point_weight, point_pressure;
+  std::vector<double> point_x, point_weight, point_pressure, point_shear;
   std::vector<Eigen::Vector2d> point_position, point_normal;
   std::vector<std::optional<double>> point_gap;
 };
@@ -45,14 +63,21 @@ struct ContactState {
 class MortarContact final : public solid::BoundaryInteraction {
  public:
   // The chip surface is the patch's top side; `points_per_span` Gauss points per span.
-  MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty = kDefaultPenalty, int points_per_span = 0);
+  MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty = kDefaultPenalty, int points_per_span = 0,
+                InterfaceLaw law = {});
 
   std::vector<std::vector<int>> coupled_nodes() const override;
   bool add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
            std::string& reason) const override;
+  // Slip makes the tangent unsymmetric; the frictionless one is symmetric.
+  bool symmetric_tangent() const override { return law_.kind == InterfaceLaw::Kind::frictionless; }
+  // Moves each contact point's anchor to where the accepted state leaves it (stick: kept; slip: the
+  // return map's; out of contact: its current foot, so that a new contact starts stress-free).
+  void commit(const Eigen::VectorXd& u) override;
   ContactState state(const Eigen::VectorXd& u) const;
   const RigidTool& tool() const { return tool_; }
   double penalty() const { return penalty_; }
+  const InterfaceLaw& law() const { return law_; }
 
  private:
   struct SurfacePoint {
@@ -67,7 +92,21 @@ class MortarContact final : public solid::BoundaryInteraction {
     double gap = 0.0;  // g, m
     Eigen::Vector2d normal = Eigen::Vector2d::Zero();  // tool's outward normal at the foot
     Eigen::Matrix2d hessian = Eigen::Matrix2d::Zero(); // ∂²g/∂x²
+    double parameter = 0.0;                            // ξ of the foot
+    Eigen::Vector2d d1 = Eigen::Vector2d::Zero(), d2 = Eigen::Vector2d::Zero();  // C′(ξ), C″(ξ)
+    Eigen::Vector2d parameter_gradient = Eigen::Vector2d::Zero();  // ∂ξ/∂x
   };
+  // The shear at a contact point and what its tangent needs: τ along the unit tangent t = C′/|C′|.
+  struct PointShear {
+    enum class Regime { none, stick, slip } regime = Regime::none;
+    double shear = 0.0;                                     // τ, Pa
+    Eigen::Vector2d shear_gradient = Eigen::Vector2d::Zero();  // stick: ∂τ/∂x
+    double slip_sign = 0.0;                                 // slip: τ = slip_sign μ_a P
+  };
+  PointShear point_shear(size_t q, const PointGap& g, double pressure) const;
+  // The tool's unit tangent at a point's foot and its derivative with respect to the point's position.
+  static Eigen::Vector2d unit_tangent(const PointGap& g) { return g.d1.normalized(); }
+  static Eigen::Matrix2d unit_tangent_gradient(const PointGap& g);
   // Gaps at every point whose surface node could be in contact; the rest stay unevaluated.
   std::vector<PointGap> gaps(const Eigen::VectorXd& u, int& projections, std::string& reason, bool& ok,
                              std::vector<Eigen::Vector2d>* positions = nullptr) const;
@@ -83,6 +122,10 @@ class MortarContact final : public solid::BoundaryInteraction {
   spline::ProjectionOptions search_window(const Eigen::Vector2d& x) const;
 
   RigidTool tool_;
+  InterfaceLaw law_;
+  // Per surface point, the tool parameter where its tangential offset is zero (committed state);
+  // none where the point was not searched at the last commit.
+  std::vector<std::optional<double>> anchor_;
   std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once
   double penalty_;
   std::vector<GraphSample> graph_;  // empty: the tool is not a graph over x, search globally

@@ -319,7 +319,8 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
                                                        std::make_shared<solid::J2JohnsonCook>(scene.material), initial);
   solid::SolidProblem& problem = *chip.problem;
   chip.contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
-                                                          scene.penalty, scene.contact_points_per_span);
+                                                          scene.penalty, scene.contact_points_per_span,
+                                                          scene.interface_law);
   problem.add_interaction(chip.contact);
   const double velocity = scene.velocity, ramp_time = scene.ramp;
   if (scene.protocol.name == Protocol::seed000) {

@@ -341,6 +341,21 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   {
     Section c = root.child("contact");
     s.penalty = c.number("penalty", s.penalty, 1e3, 1e30);
+    // The interfacial law: frictionless is seed 000's model (μ from ploughing alone) and the default.
+    contact::InterfaceLaw& law = s.interface_law;
+    law.kind = c.choice("law", law.kind);
+    const bool coulomb = law.kind == contact::InterfaceLaw::Kind::coulomb;
+    if (coulomb && !c.has("adhesive_coefficient")) {
+      c.fail("adhesive_coefficient", "required when contact.law is coulomb (the interfacial mu_a, e.g. 0.1)");
+    }
+    for (const char* key : {"adhesive_coefficient", "tangential_penalty"}) {
+      if (!coulomb && c.has(key)) {
+        s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is frictionless");
+      }
+    }
+    law.adhesive_coefficient = c.number("adhesive_coefficient", 0.0, 0.0, 5.0);
+    // Stick's regularisation: a tenth of the normal penalty by default (contact::kTangentialPenaltyRatio).
+    law.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
     c.finish();
   }
   {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "micro/contact/mortar_contact.hpp"
 #include "micro/coupling/lubricated_chip.hpp"
 #include "micro/fluid/navier_stokes.hpp"
 #include "micro/solid/materials.hpp"
@@ -188,6 +189,7 @@ struct Scene {
   LubricantSpec lubricant;
   // contact
   double penalty = 2e18;              // Pa/m
+  contact::InterfaceLaw interface_law;  // frictionless unless contact.law says otherwise
   // solver
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
@@ -226,6 +228,11 @@ template <>
 struct SceneChoice<numerics::LinearSolverKind> {
   static constexpr std::array<NamedChoice<numerics::LinearSolverKind>, 2> names{
       {{"lu", numerics::LinearSolverKind::lu}, {"cholesky", numerics::LinearSolverKind::cholesky}}};
+};
+template <>
+struct SceneChoice<contact::InterfaceLaw::Kind> {
+  static constexpr std::array<NamedChoice<contact::InterfaceLaw::Kind>, 2> names{
+      {{"frictionless", contact::InterfaceLaw::Kind::frictionless}, {"coulomb", contact::InterfaceLaw::Kind::coulomb}}};
 };
 template <>
 struct SceneChoice<Compressibility> {

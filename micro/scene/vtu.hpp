@@ -17,7 +17,8 @@ void write_film_vtu(const std::string& path, const fluid::NavierStokes& film);
 void write_tool_vtu(const std::string& path, const spline::SplineCurve& tool);
 // One row per surface quadrature point of the chip (SI units, named in the header): where it is,
 // what it carries and along which normal, so that the resultant and its split over the contact can
-// be read without rerunning (Σ pressure · weight · normal is eq. 17's force on the chip).
+// be read without rerunning. The traction on the chip is pressure · normal + shear · t with the
+// tool's unit tangent t = (−normal_y, normal_x); Σ weight · traction is eq. 17's force on the chip.
 void write_contact_csv(const std::string& path, const contact::ContactState& contact);
 
 }  // namespace mufric::scene

@@ -24,7 +24,11 @@ void TangentAccumulator::add(int row, int col, double value) {
   matrix_.valuePtr()[at - matrix_.innerIndexPtr()] += value;
 }
 
-void SolidProblem::add_interaction(std::shared_ptr<const BoundaryInteraction> interaction) {
+void SolidProblem::commit_interactions(const Eigen::VectorXd& u) {
+  for (const auto& interaction : interactions_) interaction->commit(u);
+}
+
+void SolidProblem::add_interaction(std::shared_ptr<BoundaryInteraction> interaction) {
   interactions_.push_back(std::move(interaction));
   mass_ = full_mass_ = SparseMatrix();
   build_pattern();

@@ -71,6 +71,9 @@ class BoundaryInteraction {
   // Whether the tangent it adds is symmetric: then it adds full symmetric blocks, of which the
   // accumulator keeps the lower triangle; otherwise every entry it adds is kept.
   virtual bool symmetric_tangent() const { return true; }
+  // Called with the displacement of every accepted step: an interaction with history (friction's
+  // anchors) commits it here, as the material commits its states; a rejected trial never reaches it.
+  virtual void commit(const Eigen::VectorXd& /*u*/) {}
 };
 
 // Adds entries to a tangent whose pattern already holds them. A tangent stored as its lower triangle
@@ -101,7 +104,7 @@ class SolidProblem {
   void fix_side(numerics::Side side, int component, double value = 0.0, TimeFunction scale = {});
   void add_load(SideLoad load);
   // Displacement-dependent boundary forces (contact). Rebuilds the sparsity pattern.
-  void add_interaction(std::shared_ptr<const BoundaryInteraction> interaction);
+  void add_interaction(std::shared_ptr<BoundaryInteraction> interaction);
   // Symmetric unless an interaction's tangent is not; then the tangent is stored full.
   numerics::Symmetry tangent_symmetry() const;
   numerics::MatrixStorage tangent_storage() const;
@@ -137,6 +140,8 @@ class SolidProblem {
 
   const std::vector<MaterialState>& states() const { return states_; }
   void commit(std::vector<MaterialState> states) { states_ = std::move(states); }
+  // The boundary interactions' history at an accepted displacement.
+  void commit_interactions(const Eigen::VectorXd& u);
   // Strain energy ½ uᵀ f_int for linear elastic problems (energy checks).
   double elastic_energy(const Eigen::VectorXd& u) const;
 
@@ -155,7 +160,7 @@ class SolidProblem {
   std::vector<bool> constrained_;
   std::vector<SideLoad> loads_;
   std::vector<std::vector<BoundaryPoint>> load_points_;  // quadrature of each load's side, computed once
-  std::vector<std::shared_ptr<const BoundaryInteraction>> interactions_;
+  std::vector<std::shared_ptr<BoundaryInteraction>> interactions_;
   SparseMatrix pattern_;                       // structure of the tangent's lower triangle, values zero
   // Per element, local dofs are numbered component-major: x of each of its nodes, then y.
   std::vector<std::vector<int>> element_slots_;  // per element: value index of each local (row, col); −1 above the diagonal

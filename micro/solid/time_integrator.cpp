@@ -65,6 +65,7 @@ void TimeIntegrator::set_initial(const Eigen::VectorXd& u, const Eigen::VectorXd
   u_ = u;
   v_ = v;
   last_dt_ = 0.0;  // a new initial state: nothing to extrapolate
+  problem_.commit_interactions(u_);
   const auto assembly = problem_.assemble(u_, options_.dt, false);
   if (!assembly.ok) throw Error("time integration: initial state: " + assembly.reason);
   f_int_ = assembly.internal;
@@ -126,6 +127,7 @@ void TimeIntegrator::accept() {
   last_increment_ = trial_.u - u_;
   last_dt_ = trial_.dt;
   u_ = trial_.u;
+  problem_.commit_interactions(u_);
   f_int_ = trial_.internal;
   reactions_.setZero(u_.size());
   const auto& constrained = problem_.constrained();
