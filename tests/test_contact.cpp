@@ -56,7 +56,12 @@ TEST(MortarContact, PatchTestTransmitsUniformPressureAndNoShear) {
   EXPECT_NEAR(s.contact_length, period, 1e-12);
 }
 
-TEST(MortarContact, TangentIsTheExactLinearisationOnARoughTool) {
+// Two rough periodic surfaces over [0, 1], the tool lowered into the chip's peaks: part of the
+// surface in contact, part not.
+struct RoughPair {
+  SplineCurve chip_surface, tool_surface;
+};
+RoughPair rough_surfaces_in_contact() {
   spline::RoughnessSpec spec;
   spec.length = 1.0;
   spec.ra = 0.02;
@@ -64,11 +69,14 @@ TEST(MortarContact, TangentIsTheExactLinearisationOnARoughTool) {
   spec.samples = 256;
   const SplineCurve chip_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 2, 24).curve;
   spec.seed = 9;
-  SplineCurve tool_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 3, 30).curve;
-  // Lower the tool into the chip's peaks: part of the surface in contact, part not.
-  Points2 lowered = tool_surface.points();
+  const SplineCurve tool = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 3, 30).curve;
+  Points2 lowered = tool.points();
   lowered.col(1).array() += 0.03;
-  tool_surface = SplineCurve(tool_surface.basis(), lowered, {}, tool_surface.shift());
+  return {chip_surface, SplineCurve(tool.basis(), lowered, {}, tool.shift())};
+}
+
+TEST(MortarContact, TangentIsTheExactLinearisationOnARoughTool) {
+  const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
                               std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
   auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0);
@@ -252,17 +260,7 @@ TEST(CoulombContact, ARigidFacetOfSlopeAlphaInSlipLeansByArctanMu) {
 // rough surfaces with points in stick and in slip at once (a soft chip, so that the contact's part
 // of the residual dominates what is compared).
 TEST(CoulombContact, TangentIsTheExactLinearisationInStickAndSlip) {
-  spline::RoughnessSpec spec;
-  spec.length = 1.0;
-  spec.ra = 0.02;
-  spec.correlation_length = 0.1;
-  spec.samples = 256;
-  const SplineCurve chip_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 2, 24).curve;
-  spec.seed = 9;
-  SplineCurve tool_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 3, 30).curve;
-  Points2 lowered = tool_surface.points();
-  lowered.col(1).array() += 0.03;
-  tool_surface = SplineCurve(tool_surface.basis(), lowered, {}, tool_surface.shift());
+  const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
                               std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
   const double mu_a = 0.3;
