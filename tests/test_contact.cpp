@@ -6,6 +6,7 @@
 #include <iostream>
 #include <numbers>
 
+#include "common/error.hpp"
 #include "micro/contact/mortar_contact.hpp"
 #include "micro/spline/profile.hpp"
 #include "solid_test_support.hpp"
@@ -207,6 +208,108 @@ TEST(CoulombContact, AFlatChipSlidUnderUniformPressureCarriesTheLawsShear) {
   }
 }
 
+InterfaceLaw yield_limited(InterfaceLaw::Kind kind, double shear_factor, double adhesive_coefficient, double tangential) {
+  InterfaceLaw law;
+  law.kind = kind;
+  law.shear_factor = shear_factor;
+  law.adhesive_coefficient = adhesive_coefficient;
+  law.tangential_penalty = tangential;
+  return law;
+}
+
+// The same slid flat chip under the shear-factor law, τ = m k in slip whatever the pressure, and
+// under Zorev's, τ = min(μ_a p, m k): the Coulomb branch below the switch, the shear branch above it
+// (closed forms).
+TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
+  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3, m = 0.5;
+  struct Case {
+    InterfaceLaw::Kind kind;
+    double k;               // the chip's shear yield stress, uniform
+    double expected_limit;  // the slip shear the law gives
+  };
+  const std::vector<Case> cases = {
+      {InterfaceLaw::Kind::shear_factor, 2e-4, m * 2e-4},
+      {InterfaceLaw::Kind::shear_factor, 2e-3, m * 2e-3},
+      {InterfaceLaw::Kind::zorev, 2e-3, mu_a * pressure},  // μ_a p = 3e-4 < m k = 1e-3: Coulomb branch
+      {InterfaceLaw::Kind::zorev, 2e-4, m * 2e-4}};        // m k = 1e-4 < μ_a p: the shear branch
+  for (const auto& c : cases) {
+    solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
+                             std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+    chip.fix_side(numerics::Side::bottom, 0);
+    chip.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+    auto contact = std::make_shared<MortarContact>(chip.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
+                                                   penalty, 0, yield_limited(c.kind, m, mu_a, tangential));
+    const size_t points = contact->surface_positions().size();
+    Eigen::VectorXd probe = Eigen::VectorXd::Zero(chip.dof_count());
+    EXPECT_THROW(contact->state(probe), Error);  // k not given yet
+    contact->set_shear_strength(std::vector<double>(points, c.k));
+    chip.add_interaction(contact);
+    const Eigen::VectorXd pressed = solid::test::solve_static(chip);
+    contact->commit(pressed);
+    for (const double fraction : {0.5, 3.0}) {
+      const double d = fraction * c.expected_limit / tangential;
+      Eigen::VectorXd slid = pressed;
+      for (Eigen::Index i = 0; i < slid.size(); i += 2) slid(i) += d;
+      const ContactState s = contact->state(slid);
+      const double expected = fraction <= 1.0 ? -tangential * d : -c.expected_limit;
+      for (size_t q = 0; q < s.point_shear.size(); ++q) {
+        // (stick: the offset's arc length is first order in ξ − ξ_a on the unevenly parameterised tool)
+        EXPECT_NEAR(s.point_shear[q], expected, 1e-5 * c.expected_limit) << "k " << c.k << ", slide " << fraction;
+      }
+    }
+  }
+}
+
+// The tangent of Zorev's law against central differences, with points on both branches and in stick
+// (k varies along the surface so that the switch falls inside the contact).
+TEST(YieldLimitedContact, ZorevTangentIsTheExactLinearisationOnBothBranches) {
+  spline::RoughnessSpec spec;
+  spec.length = 1.0;
+  spec.ra = 0.02;
+  spec.correlation_length = 0.1;
+  spec.samples = 256;
+  const SplineCurve chip_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 2, 24).curve;
+  spec.seed = 9;
+  SplineCurve tool_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 3, 30).curve;
+  Points2 lowered = tool_surface.points();
+  lowered.col(1).array() += 0.03;
+  tool_surface = SplineCurve(tool_surface.basis(), lowered, {}, tool_surface.shift());
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
+                              std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
+  const double mu_a = 0.3, m = 0.5;
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0,
+                                                 yield_limited(InterfaceLaw::Kind::zorev, m, mu_a, 50.0));
+  std::vector<double> k;
+  for (const auto& x : contact->surface_positions()) k.push_back(0.4 * (1.0 + std::sin(2 * std::numbers::pi * x.x())));
+  contact->set_shear_strength(k);
+  problem.add_interaction(contact);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::VectorXd u(problem.dof_count());
+  for (auto& x : u) x = 2e-3 * unit(rng);
+  contact->commit(u);
+  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
+  const ContactState s = contact->state(u);
+  int stick = 0, coulomb_branch = 0, shear_branch = 0;
+  for (size_t q = 0; q < s.point_shear.size(); ++q) {
+    const double p = s.point_pressure[q];
+    if (p <= 0.0) continue;
+    const double tau = std::abs(s.point_shear[q]);
+    if (std::abs(tau - mu_a * p) < 1e-12 * p && mu_a * p <= m * k[q]) {
+      ++coulomb_branch;
+    } else if (std::abs(tau - m * k[q]) < 1e-12 && m * k[q] < mu_a * p) {
+      ++shear_branch;
+    } else {
+      ++stick;
+    }
+  }
+  std::cout << "points in stick " << stick << ", slip at mu_a p " << coulomb_branch << ", at m k " << shear_branch << "\n";
+  ASSERT_GT(stick, 0);
+  ASSERT_GT(coulomb_branch, 0);
+  ASSERT_GT(shear_branch, 0);
+  solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "zorev contact", 1e-5);
+}
+
 // A rigid facet of slope α pressed uniformly onto a chip whose surface lies parallel to it (a sheared
 // periodic cell), then slid along the facet in slip: the force on the facet leans from its normal by
 // arctan μ_a against the sliding, so its ratio in the x–y axes is tan(α + arctan μ_a) (statics of
@@ -264,7 +367,7 @@ TEST(CoulombContact, TangentIsTheExactLinearisationInStickAndSlip) {
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
                               std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
   const double mu_a = 0.3;
-  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, coulomb(mu_a));
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, coulomb(mu_a, 50.0));
   problem.add_interaction(contact);
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);

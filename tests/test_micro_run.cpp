@@ -54,7 +54,9 @@ TEST(Scene, ErrorsNameTheKey) {
       {"time.average_from=\"1s\"", "time.average_from"},
       {"time.max_step=\"0.5ns\"", "time.max_step: is shorter than time.step"},
       {"geometry.chip_surface.flat=true", "exactly one of csv, synthetic or flat"},
-      {"contact.law=\"sticky\"", "contact.law: 'sticky' is not one of: frictionless, coulomb"},
+      {"contact.law=\"sticky\"", "contact.law: 'sticky' is not one of: frictionless, coulomb, shear-factor, zorev"},
+      {"contact.law=\"shear-factor\"", "contact.shear_factor: required when contact.law is shear-factor"},
+      {"contact.shear_factor=1.5", "contact.shear_factor"},
       {"contact.law=\"coulomb\"", "contact.adhesive_coefficient: required when contact.law is coulomb"},
       {"contact.adhesive_coefficient=-0.1", "contact.adhesive_coefficient"}};
   for (const auto& [assignment, expected] : cases) {
@@ -75,6 +77,16 @@ TEST(Scene, ErrorsNameTheKey) {
   EXPECT_EQ(with_friction.interface_law.kind, contact::InterfaceLaw::Kind::coulomb);
   EXPECT_DOUBLE_EQ(with_friction.interface_law.adhesive_coefficient, 0.15);
   EXPECT_DOUBLE_EQ(with_friction.interface_law.tangential_penalty, contact::kTangentialPenaltyRatio * with_friction.penalty);
+  nlohmann::json zorev = j;
+  apply_override(zorev, "contact.law=\"zorev\"");
+  apply_override(zorev, "contact.shear_factor=0.8");
+  EXPECT_NE(error_of(zorev).find("contact.adhesive_coefficient: required when contact.law is zorev"), std::string::npos)
+      << error_of(zorev);
+  apply_override(zorev, "contact.adhesive_coefficient=0.2");
+  const Scene with_zorev = parse_scene(zorev, "s");
+  EXPECT_EQ(with_zorev.interface_law.kind, contact::InterfaceLaw::Kind::zorev);
+  EXPECT_DOUBLE_EQ(with_zorev.interface_law.shear_factor, 0.8);
+  EXPECT_TRUE(with_zorev.interface_law.needs_shear_strength());
   nlohmann::json ignored = j;
   apply_override(ignored, "contact.adhesive_coefficient=0.15");
   const Scene frictionless = parse_scene(ignored, "s");

@@ -16,6 +16,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
   if (law_.tangential_penalty == 0.0) law_.tangential_penalty = kTangentialPenaltyRatio * penalty_;
   if (!(law_.tangential_penalty > 0.0)) throw Error("contact: the tangential penalty must be positive");
   if (!(law_.adhesive_coefficient >= 0.0)) throw Error("contact: the adhesive coefficient must be >= 0");
+  if (!(law_.shear_factor >= 0.0 && law_.shear_factor <= 1.0)) throw Error("contact: the shear factor must be in [0, 1]");
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
   const auto& basis = tool_.surface.basis();
@@ -197,6 +198,9 @@ Eigen::Matrix2d MortarContact::unit_tangent_gradient(const PointGap& g) {
 MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g, double pressure) const {
   PointShear s;
   if (law_.kind == InterfaceLaw::Kind::frictionless || pressure <= 0.0 || !g.evaluated) return s;
+  if (law_.needs_shear_strength() && shear_strength_.empty()) {
+    throw Error("contact: the interfacial law needs the chip's shear yield stress at the contact (set_shear_strength)");
+  }
   // A point without an anchor (not searched at the last commit) starts stress-free where it is.
   if (!anchor_[q]) return s;
   // Tangential offset from the anchor along the tool, g_t = |C′(ξ)| (ξ − ξ_a): the arc length to
@@ -205,7 +209,16 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
   const double offset_parameter = g.parameter - *anchor_[q];
   const double offset = speed * offset_parameter;
   const double trial = -law_.tangential_penalty * offset;
-  const double limit = law_.adhesive_coefficient * pressure;
+  // The slip limit: μ_a P (Coulomb), m k (shear factor) or the lower of the two (Zorev).
+  double limit = law_.adhesive_coefficient * pressure;
+  bool limit_from_pressure = true;
+  if (law_.needs_shear_strength()) {
+    const double yield_shear = law_.shear_factor * shear_strength_[q];
+    if (law_.kind == InterfaceLaw::Kind::shear_factor || yield_shear < limit) {
+      limit = yield_shear;
+      limit_from_pressure = false;
+    }
+  }
   if (std::abs(trial) <= limit) {
     s.regime = PointShear::Regime::stick;
     s.shear = trial;
@@ -216,8 +229,24 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
     s.regime = PointShear::Regime::slip;
     s.slip_sign = trial > 0.0 ? 1.0 : -1.0;
     s.shear = s.slip_sign * limit;
+    s.limit_from_pressure = limit_from_pressure;
   }
   return s;
+}
+
+void MortarContact::set_shear_strength(std::vector<double> k) {
+  if (k.size() != points_.size()) {
+    throw Error("contact: " + std::to_string(k.size()) + " shear strengths for " + std::to_string(points_.size()) +
+                " surface points");
+  }
+  shear_strength_ = std::move(k);
+}
+
+std::vector<Eigen::Vector2d> MortarContact::surface_positions() const {
+  std::vector<Eigen::Vector2d> x;
+  x.reserve(points_.size());
+  for (const auto& sp : points_) x.push_back(sp.position);
+  return x;
 }
 
 void MortarContact::commit(const Eigen::VectorXd& u) {
@@ -246,6 +275,10 @@ void MortarContact::commit(const Eigen::VectorXd& u) {
 
 bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
                         std::string& reason) const {
+  if (law_.needs_shear_strength() && shear_strength_.empty()) {
+    reason = "contact: the interfacial law needs the chip's shear yield stress at the contact (set_shear_strength)";
+    return false;
+  }
   bool ok = true;
   int projections = 0;
   const std::vector<PointGap> g = gaps(u, projections, reason, ok);
@@ -306,8 +339,8 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
         add_block(sp.nodes[b], sp.nodes[c], k);
       }
     }
-    if (shear.regime != PointShear::Regime::slip) continue;
-    // Slip: τ = s μ_a P_q, ∂P_q/∂u = Σ_a N_a(q) ε G_a: −w_q R_b s μ_a ε N_a(q) t ⊗ G_a.
+    if (shear.regime != PointShear::Regime::slip || !shear.limit_from_pressure) continue;
+    // Slip at μ_a P: τ = s μ_a P_q, ∂P_q/∂u = Σ_a N_a(q) ε G_a: −w_q R_b s μ_a ε N_a(q) t ⊗ G_a.
     const Eigen::Vector2d t = unit_tangent(g[q]);
     for (size_t k = 0; k < sp.nodes.size(); ++k) {
       const auto a = static_cast<size_t>(sp.multipliers[k]);

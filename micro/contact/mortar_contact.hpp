@@ -29,11 +29,17 @@ inline constexpr double kDefaultPenalty = 2e18;
 // needs at ε_t = ε (small default scene with μ_a = 0.1: 545 against 1299; μ within 0.6 %).
 inline constexpr double kTangentialPenaltyRatio = 0.1;
 
+// `shear-factor`: |τ| ≤ m k, k the chip's shear yield stress at the point (Johnson–Cook /√3, given by
+// the owner through set_shear_strength); `zorev`: |τ| ≤ min(μ_a P, m k), sliding where the pressure is
+// low and sticking to the yield shear where it is high (Zorev 1963, the chip–tool friction model of
+// cutting codes).
 struct InterfaceLaw {
-  enum class Kind { frictionless, coulomb };
+  enum class Kind { frictionless, coulomb, shear_factor, zorev };
   Kind kind = Kind::frictionless;
-  double adhesive_coefficient = 0.0;  // μ_a (coulomb)
+  double adhesive_coefficient = 0.0;  // μ_a (coulomb, zorev)
+  double shear_factor = 0.0;          // m (shear-factor, zorev)
   double tangential_penalty = 0.0;    // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
+  bool needs_shear_strength() const { return kind == Kind::shear_factor || kind == Kind::zorev; }
 };
 
 // The rigid tool: a curve whose outward normal, for a curve running in +x, points down (−y side),
@@ -74,6 +80,12 @@ class MortarContact final : public solid::BoundaryInteraction {
   // Moves each contact point's anchor to where the accepted state leaves it (stick: kept; slip: the
   // return map's; out of contact: its current foot, so that a new contact starts stress-free).
   void commit(const Eigen::VectorXd& u) override;
+  // The chip's shear yield stress k at each surface point (Pa, in the order of surface_positions()),
+  // for the laws that use it; held until set again (the owner refreshes it after each accepted step,
+  // so within a step k is that of the last accepted state).
+  void set_shear_strength(std::vector<double> k);
+  // Reference position of each surface quadrature point.
+  std::vector<Eigen::Vector2d> surface_positions() const;
   ContactState state(const Eigen::VectorXd& u) const;
   const RigidTool& tool() const { return tool_; }
   double penalty() const { return penalty_; }
@@ -101,7 +113,8 @@ class MortarContact final : public solid::BoundaryInteraction {
     enum class Regime { none, stick, slip } regime = Regime::none;
     double shear = 0.0;                                     // τ, Pa
     Eigen::Vector2d shear_gradient = Eigen::Vector2d::Zero();  // stick: ∂τ/∂x
-    double slip_sign = 0.0;                                 // slip: τ = slip_sign μ_a P
+    double slip_sign = 0.0;                                 // slip: τ = slip_sign × the limit
+    bool limit_from_pressure = false;                       // slip at μ_a P (else at m k, fixed in a step)
   };
   PointShear point_shear(size_t q, const PointGap& g, double pressure) const;
   // The tool's unit tangent at a point's foot and its derivative with respect to the point's position.
@@ -126,6 +139,7 @@ class MortarContact final : public solid::BoundaryInteraction {
   // Per surface point, the tool parameter where its tangential offset is zero (committed state);
   // none where the point was not searched at the last commit.
   std::vector<std::optional<double>> anchor_;
+  std::vector<double> shear_strength_;  // k per surface point (shear-factor, zorev)
   std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once
   double penalty_;
   std::vector<GraphSample> graph_;  // empty: the tool is not a graph over x, search globally

@@ -298,7 +298,45 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
 struct LoadedChip {
   std::unique_ptr<solid::SolidProblem> problem;
   std::shared_ptr<contact::MortarContact> contact;
+  // For the interfacial laws that use the chip's shear yield stress: the bulk quadrature point nearest
+  // each contact surface point (reference positions), whose state gives k there.
+  std::vector<size_t> surface_quadrature;
 };
+
+// k = σ_JC(ε̄ᵖ, ε̇ᵖ, T)/√3 (von Mises) at each contact surface point, from the committed state of its
+// nearest bulk quadrature point: the laws that use it see the last accepted state's k.
+void refresh_shear_strength(const Scene& scene, const LoadedChip& chip) {
+  if (chip.surface_quadrature.empty()) return;
+  const auto& states = chip.problem->states();
+  std::vector<double> k;
+  k.reserve(chip.surface_quadrature.size());
+  for (const size_t q : chip.surface_quadrature) {
+    const auto& st = states[q];
+    k.push_back(solid::johnson_cook_yield_stress(scene.material, st.equivalent_plastic_strain, st.plastic_strain_rate,
+                                                 st.temperature) /
+                std::sqrt(3.0));
+  }
+  chip.contact->set_shear_strength(std::move(k));
+}
+
+std::vector<size_t> nearest_quadrature_points(const solid::IgaSpace& space, const std::vector<Eigen::Vector2d>& at) {
+  std::vector<size_t> nearest;
+  nearest.reserve(at.size());
+  const auto& quadrature = space.quadrature();
+  for (const auto& x : at) {
+    size_t best = 0;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (size_t q = 0; q < quadrature.size(); ++q) {
+      const double d = (quadrature[q].position - x).squaredNorm();
+      if (d < best_distance) {
+        best_distance = d;
+        best = q;
+      }
+    }
+    nearest.push_back(best);
+  }
+  return nearest;
+}
 
 LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const BottomMotion& motion) {
   const auto fit_spans = static_cast<int>(geometry.chip_surface.basis().breakpoints().size()) - 1;
@@ -322,6 +360,10 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
                                                           scene.penalty, scene.contact_points_per_span,
                                                           scene.interface_law);
   problem.add_interaction(chip.contact);
+  if (scene.interface_law.needs_shear_strength()) {
+    chip.surface_quadrature = nearest_quadrature_points(problem.space(), chip.contact->surface_positions());
+    refresh_shear_strength(scene, chip);
+  }
   const double velocity = scene.velocity, ramp_time = scene.ramp;
   if (scene.protocol.name == Protocol::seed000) {
     problem.fix_side(numerics::Side::bottom, 0, velocity, [](double t) { return t; });
@@ -572,6 +614,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   StepRecorder recorder(scene, motion, *chip.contact, lubricant.get());
   result.solver = integrator.run([&](const solid::StepView& view) {
     const MicroStep& step = recorder.record(view);
+    refresh_shear_strength(scene, chip);  // after the step's own record: the next step's k
     if (options.on_step) options.on_step(step, scene);
     limit.check_accepted_step(step, recorder.history().size());
   });

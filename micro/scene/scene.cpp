@@ -344,16 +344,28 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     // The interfacial law: frictionless is seed 000's model (μ from ploughing alone) and the default.
     contact::InterfaceLaw& law = s.interface_law;
     law.kind = c.choice("law", law.kind);
-    const bool coulomb = law.kind == contact::InterfaceLaw::Kind::coulomb;
-    if (coulomb && !c.has("adhesive_coefficient")) {
-      c.fail("adhesive_coefficient", "required when contact.law is coulomb (the interfacial mu_a, e.g. 0.1)");
+    using Kind = contact::InterfaceLaw::Kind;
+    std::string law_name;
+    for (const auto& choice : SceneChoice<Kind>::names) {
+      if (choice.value == law.kind) law_name = choice.name;
     }
-    for (const char* key : {"adhesive_coefficient", "tangential_penalty"}) {
-      if (!coulomb && c.has(key)) {
-        s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is frictionless");
+    const bool uses_mu = law.kind == Kind::coulomb || law.kind == Kind::zorev;
+    const bool uses_m = law.kind == Kind::shear_factor || law.kind == Kind::zorev;
+    if (uses_mu && !c.has("adhesive_coefficient")) {
+      c.fail("adhesive_coefficient", "required when contact.law is " + law_name + " (the interfacial mu_a, e.g. 0.1)");
+    }
+    if (uses_m && !c.has("shear_factor")) {
+      c.fail("shear_factor", "required when contact.law is " + law_name + " (m in tau = m k, 0 to 1, e.g. 0.5)");
+    }
+    const std::vector<std::pair<const char*, bool>> used = {
+        {"adhesive_coefficient", uses_mu}, {"shear_factor", uses_m}, {"tangential_penalty", law.kind != Kind::frictionless}};
+    for (const auto& [key, in_use] : used) {
+      if (!in_use && c.has(key)) {
+        s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is " + law_name);
       }
     }
     law.adhesive_coefficient = c.number("adhesive_coefficient", 0.0, 0.0, 5.0);
+    law.shear_factor = c.number("shear_factor", 0.0, 0.0, 1.0);
     // Stick's regularisation: a tenth of the normal penalty by default (contact::kTangentialPenaltyRatio).
     law.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
     c.finish();

@@ -231,8 +231,11 @@ struct SceneChoice<numerics::LinearSolverKind> {
 };
 template <>
 struct SceneChoice<contact::InterfaceLaw::Kind> {
-  static constexpr std::array<NamedChoice<contact::InterfaceLaw::Kind>, 2> names{
-      {{"frictionless", contact::InterfaceLaw::Kind::frictionless}, {"coulomb", contact::InterfaceLaw::Kind::coulomb}}};
+  static constexpr std::array<NamedChoice<contact::InterfaceLaw::Kind>, 4> names{
+      {{"frictionless", contact::InterfaceLaw::Kind::frictionless},
+       {"coulomb", contact::InterfaceLaw::Kind::coulomb},
+       {"shear-factor", contact::InterfaceLaw::Kind::shear_factor},
+       {"zorev", contact::InterfaceLaw::Kind::zorev}}};
 };
 template <>
 struct SceneChoice<Compressibility> {
