@@ -1,6 +1,7 @@
 #include "micro/numerics/linear_solver.hpp"
 
 #include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/UmfPackSupport>
 #include <omp.h>
 
@@ -34,13 +35,45 @@ class CholmodThreadsWithinOurs {
   bool limit_;
 };
 
+using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Cholesky = Eigen::CholmodSupernodalLLT<Sparse>;
+
+// BiCGSTAB's relative residual for an unsymmetric tangent: Newton's own tolerance is 1e-9 of the
+// force scale, so 1e-12 of the right-hand side keeps its iterations those of an exact solve.
+constexpr double kKrylovTolerance = 1e-12;
+// Beyond this many iterations the skew part is not small: LU instead (a few are typical).
+constexpr int kKrylovMaxIterations = 40;
+
+// Eigen's preconditioner interface over a Cholesky factor computed elsewhere (the symmetric part's).
+class FactorPreconditioner {
+ public:
+  FactorPreconditioner() = default;
+  template <typename M>
+  explicit FactorPreconditioner(const M&) {}
+  template <typename M>
+  FactorPreconditioner& analyzePattern(const M&) { return *this; }
+  template <typename M>
+  FactorPreconditioner& factorize(const M&) { return *this; }
+  template <typename M>
+  FactorPreconditioner& compute(const M&) { return *this; }
+  template <typename Rhs>
+  Eigen::VectorXd solve(const Rhs& b) const { return factor_->solve(Eigen::VectorXd(b)); }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+  void use(const Cholesky* factor) { factor_ = factor; }
+
+ private:
+  const Cholesky* factor_ = nullptr;
+};
+
 }  // namespace
 
 struct LinearSolver::Impl {
-  Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>> lu;
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>> cholesky;
+  Eigen::UmfPackLU<Sparse> lu;
+  Cholesky cholesky;
   std::vector<int> outer, inner;  // pattern of the last analysis
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> full;  // LU of a lower-stored matrix: both triangles
+  Sparse full;  // LU of a lower-stored matrix: both triangles
+  Sparse unsymmetric;  // the unsymmetric matrix whose symmetric part `cholesky` holds
+  Eigen::BiCGSTAB<Sparse, FactorPreconditioner> krylov;
 };
 
 LinearSolver::LinearSolver(LinearSolverKind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {
@@ -84,24 +117,36 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
     ++analyses_;
   }
   reason_.clear();
-  if (factorizes_by_lu(symmetry)) return factorize_lu(a, storage);
+  if (kind_ == LinearSolverKind::lu) return factorize_lu(a, storage);
+  if (symmetry == Symmetry::unsymmetric) {
+    impl_->unsymmetric = a;
+    const Sparse symmetric_part = 0.5 * (a + Sparse(a.transpose()));
+    if (factorize_cholesky(symmetric_part)) {
+      method_ = Method::preconditioned_krylov;
+      return true;
+    }
+  } else if (factorize_cholesky(a)) {
+    method_ = Method::cholesky;
+    return true;
+  }
+  ++lu_fallbacks_;
+  if (factorize_lu(a, storage)) return true;
+  reason_ = "CHOLMOD: the tangent" + std::string(symmetry == Symmetry::unsymmetric ? "'s symmetric part" : "") +
+            " is not positive definite, and " + reason_;
+  return false;
+}
+
+bool LinearSolver::factorize_cholesky(const Sparse& a) const {
   const CholmodThreadsWithinOurs threads;
   if (!cholesky_analysed_) {
     impl_->cholesky.analyzePattern(a);
     cholesky_analysed_ = true;
   }
   impl_->cholesky.factorize(a);
-  if (impl_->cholesky.info() == Eigen::Success) {
-    last_by_lu_ = false;
-    return true;
-  }
-  ++lu_fallbacks_;
-  if (factorize_lu(a, storage)) return true;
-  reason_ = "CHOLMOD: the tangent is not positive definite, and " + reason_;
-  return false;
+  return impl_->cholesky.info() == Eigen::Success;
 }
 
-bool LinearSolver::factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, MatrixStorage storage) {
+bool LinearSolver::factorize_lu(const Sparse& a, MatrixStorage storage) const {
   if (storage == MatrixStorage::lower_symmetric) impl_->full = a.selfadjointView<Eigen::Lower>();
   const auto& m = storage == MatrixStorage::lower_symmetric ? impl_->full : a;
   if (!lu_analysed_) {
@@ -113,12 +158,33 @@ bool LinearSolver::factorize_lu(const Eigen::SparseMatrix<double, Eigen::ColMajo
     reason_ = "UMFPACK: the tangent is singular";
     return false;
   }
-  last_by_lu_ = true;
+  method_ = Method::lu;
   return true;
 }
 
-Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {
-  return last_by_lu_ ? Eigen::VectorXd(impl_->lu.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b, double relative_tolerance) const {
+  switch (method_) {
+    case Method::cholesky:
+      return impl_->cholesky.solve(b);
+    case Method::lu:
+      return impl_->lu.solve(b);
+    case Method::preconditioned_krylov:
+      break;
+  }
+  auto& krylov = impl_->krylov;
+  krylov.setTolerance(relative_tolerance > 0.0 ? relative_tolerance : kKrylovTolerance);
+  krylov.setMaxIterations(kKrylovMaxIterations);
+  krylov.compute(impl_->unsymmetric);
+  krylov.preconditioner().use(&impl_->cholesky);
+  Eigen::VectorXd x = krylov.solveWithGuess(b, Eigen::VectorXd(impl_->cholesky.solve(b)));
+  krylov_iterations_ += static_cast<int>(krylov.iterations());
+  if (krylov.info() == Eigen::Success) return x;
+  // The skew part is not small here: this matrix by LU, and its later solves too. (If even LU fails,
+  // the iteration's last iterate goes back: Newton's residual check judges it, and a step that does
+  // not converge is cut back.)
+  ++lu_fallbacks_;
+  if (!factorize_lu(impl_->unsymmetric, MatrixStorage::full)) return x;
+  return impl_->lu.solve(b);
 }
 
 }  // namespace mufric::numerics

@@ -249,8 +249,11 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     const bool expect_convergence = it > 0 && last_full_step && current.norm < 0.1 * previous_norm &&
                                     std::pow(current.norm / previous_norm, 2) * current.norm <
                                         kPredictedConvergenceMargin * tolerance;
+    double forcing = kMaxForcing;
+    if (it > 0 && previous_norm > 0.0) forcing = std::min(kMaxForcing, kForcingGamma * std::pow(current.norm / previous_norm, 2));
+    forcing = std::max(forcing, 0.5 * tolerance / current.norm);
     previous_norm = current.norm;
-    const Eigen::VectorXd delta = solver_.solve(rhs);
+    const Eigen::VectorXd delta = solver_.solve(rhs, std::min(forcing, kMaxForcing));
     report_.seconds_solve += seconds_since(start);
     // Line search on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction.
     const double phi0 = current.norm * current.norm;
@@ -327,6 +330,7 @@ double TimeIntegrator::next_step(double t, double dt, int newton_iterations) con
 void TimeIntegrator::record_solver_counts() {
   report_.symbolic_analyses = solver_.analyses();
   report_.lu_fallbacks = solver_.lu_fallbacks();
+  report_.krylov_iterations = solver_.krylov_iterations();
 }
 
 IntegrationReport TimeIntegrator::run(const std::function<void(const StepView&)>& on_step) {

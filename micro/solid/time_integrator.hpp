@@ -40,6 +40,12 @@ inline constexpr double kShortestControlledStep = 0.25;
 // A Newton trial whose quadratic-convergence prediction is below this fraction of the tolerance is
 // evaluated without its tangent (it is expected to end the step).
 inline constexpr double kPredictedConvergenceMargin = 0.1;
+// Newton's forcing term for an iteratively solved (unsymmetric) tangent: the linear residual each
+// solve may leave, η_k = γ (‖G_k‖/‖G_{k−1}‖)² (Eisenstat & Walker, SIAM J. Sci. Comput. 17, 1996,
+// choice 2, γ = 0.9), at most kMaxForcing, and never below what still reaches the tolerance,
+// 0.5 tol/‖G_k‖ (Kelley, Iterative Methods for Linear and Nonlinear Equations, 1995, eq. 6.20).
+inline constexpr double kForcingGamma = 0.9;
+inline constexpr double kMaxForcing = 1e-2;
 
 class TimeIntegrator;
 
@@ -93,6 +99,7 @@ struct IntegrationReport {
   int newton_iterations = 0;
   int symbolic_analyses = 0;  // sparse symbolic factorisations (1 per run: the pattern is fixed)
   int lu_fallbacks = 0;       // Cholesky runs: tangents CHOLMOD found not positive definite (solved by LU)
+  int krylov_iterations = 0;  // Cholesky runs with an unsymmetric tangent: BiCGSTAB iterations, all solves
   int assemblies = 0;              // residual evaluations (with or without tangent)
   int line_search_reductions = 0;
   int unpredicted_convergence = 0;  // trials expected to converge that did not (evaluated twice)
