@@ -8,6 +8,7 @@
 
 #include "common/error.hpp"
 #include "micro/contact/mortar_contact.hpp"
+#include "micro/solid/heat_conduction.hpp"
 #include "micro/spline/profile.hpp"
 #include "solid_test_support.hpp"
 
@@ -206,6 +207,61 @@ TEST(CoulombContact, AFlatChipSlidUnderUniformPressureCarriesTheLawsShear) {
     // −μ_a p + ε_t d = 0, up to the offset's first-order arc length on the unevenly parameterised tool
     EXPECT_NEAR(back.point_shear[q], 0.0, 1e-5 * mu_a * pressure) << "x " << back.point_x[q];
   }
+}
+
+// The flat chip pressed and then slid rigidly along the tool in equal steps, each committed: a
+// point sticks until its offset reaches μ_a p/ε_t and slips by every step's length after, so the
+// dissipated energy is μ_a p L (n d − μ_a p/ε_t) (closed form); a step back within the stick range
+// dissipates nothing. The chip receives β of each step's dissipation: the heat conduction's heat
+// content rises by exactly that (an energy balance to solver tolerance), all of it entering at the
+// top surface. (28 spans through the thickness: the consistent capacity matrix spreads a surface heat
+// a little through the layer, decaying ~0.4× per span; with 3 spans 6 % of it would reach the held
+// face, with 28 under 1e-9.)
+TEST(CoulombContact, SlipDissipatesMuPTimesTheSlipAndTheChipReceivesItsShare) {
+  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3;
+  const double step = 2e-6, partition = 0.7;
+  const int steps = 7;
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 28)),
+                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+  InterfaceLaw law = coulomb(mu_a, tangential);
+  law.heat_partition = partition;
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
+                                                 penalty, 0, law);
+  problem.add_interaction(contact);
+  problem.fix_side(numerics::Side::bottom, 0);
+  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  Eigen::VectorXd u = solid::test::solve_static(problem);
+  contact->commit(u);
+  EXPECT_EQ(contact->dissipated_energy(), 0.0);
+  const double stick_offset = mu_a * pressure / tangential;  // 7.5e-7: the first step slips part of its length
+  ASSERT_LT(stick_offset, step);
+
+  solid::HeatConduction heat(problem.space(), {.conductivity = 0.0, .density = 2.0, .specific_heat = 3.0,
+                                               .held_side = numerics::Side::bottom, .held_temperature = 0.0});
+  std::vector<solid::MaterialState> states(problem.space().quadrature().size());
+  for (auto& st : states) st.temperature = 0.0;  // the conduction's own start: no adiabatic heat
+  std::string reason;
+  const auto node_count = problem.space().node_count();
+  double received = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += step;
+    contact->commit(u);
+    const Eigen::VectorXd nodal = contact->frictional_heat(node_count);
+    EXPECT_NEAR(nodal.sum(), partition * contact->step_dissipated_energy(), 1e-12 * contact->step_dissipated_energy());
+    for (const int node : problem.space().side_nodes(numerics::Side::bottom)) EXPECT_EQ(nodal(node), 0.0);
+    const double before = heat.heat_content();
+    ASSERT_TRUE(heat.step(u, 1e-3, states, reason, nodal)) << reason;
+    received += heat.heat_content() - before;
+  }
+  const double expected = mu_a * pressure * period * (steps * step - stick_offset);
+  // (the offset is the arc length to first order on the unevenly parameterised flat tool: 1e-6 relative)
+  EXPECT_NEAR(contact->dissipated_energy(), expected, 1e-6 * expected);
+  EXPECT_NEAR(received, partition * contact->dissipated_energy(), 1e-9 * received);
+  // Back by half the stick range: every point sticks, nothing is dissipated.
+  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) -= 0.5 * stick_offset;
+  contact->commit(u);
+  EXPECT_EQ(contact->step_dissipated_energy(), 0.0);
+  EXPECT_NEAR(contact->dissipated_energy(), expected, 1e-6 * expected);
 }
 
 InterfaceLaw yield_limited(InterfaceLaw::Kind kind, double shear_factor, double adhesive_coefficient, double tangential) {

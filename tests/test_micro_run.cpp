@@ -87,6 +87,16 @@ TEST(Scene, ErrorsNameTheKey) {
   EXPECT_EQ(with_zorev.interface_law.kind, contact::InterfaceLaw::Kind::zorev);
   EXPECT_DOUBLE_EQ(with_zorev.interface_law.shear_factor, 0.8);
   EXPECT_TRUE(with_zorev.interface_law.needs_shear_strength());
+  EXPECT_DOUBLE_EQ(with_zorev.interface_law.heat_partition, contact::kDefaultHeatPartition);
+  apply_override(zorev, "contact.heat_partition=1.5");
+  EXPECT_NE(error_of(zorev).find("contact.heat_partition"), std::string::npos) << error_of(zorev);
+  apply_override(zorev, "contact.heat_partition=0.8");
+  EXPECT_DOUBLE_EQ(parse_scene(zorev, "s").interface_law.heat_partition, 0.8);
+  EXPECT_TRUE(parse_scene(zorev, "s").warnings.empty());
+  apply_override(zorev, "thermal.model=\"adiabatic\"");
+  const Scene adiabatic = parse_scene(zorev, "s");
+  ASSERT_EQ(adiabatic.warnings.size(), 1U);
+  EXPECT_NE(adiabatic.warnings[0].find("frictional heat"), std::string::npos) << adiabatic.warnings[0];
   nlohmann::json ignored = j;
   apply_override(ignored, "contact.adhesive_coefficient=0.15");
   const Scene frictionless = parse_scene(ignored, "s");
@@ -717,33 +727,70 @@ TEST(Pressing, SinusoidalToolOnAnElasticChipFollowsWestergaard) {
 // the pressure acting on the leading face only. The chip's C¹ surface leaves the apex over about an
 // element, so the contact must span many elements for that share to be small (bench/RESULTS.md,
 // "Friction at the asperity contacts"): at 100 MPa on 64 elements it spans ~13.
-TEST(Ploughing, AWedgeOnAPerfectlyPlasticChipWithoutInterfacialShearGivesTanAlpha) {
-  constexpr double kWaveModelTolerance = 0.10;  // the agreement issue 32 asks of the wave model
+// The slip-line wave model of Challen & Oxley (1979, Wear 53:229, the wave model's friction
+// coefficient): a rigid wedge of slope α pushing a plastic wave along a rigid–perfectly-plastic
+// surface whose interface carries the shear f k,
+//   μ = (A sin α + cos(arccos f − α)) / (A cos α + sin(arccos f − α)),
+//   A = 1 + π/2 + arccos f − 2α − 2 arcsin(sin α / √(1 − f));  f = 0 gives tan α.
+double wave_model_mu(double alpha, double f) {
+  const double eta = std::acos(f) - alpha;
+  const double a = 1.0 + std::numbers::pi / 2.0 + std::acos(f) - 2.0 * alpha - 2.0 * std::asin(std::sin(alpha) / std::sqrt(1.0 - f));
+  return (a * std::sin(alpha) + std::cos(eta)) / (a * std::cos(alpha) + std::sin(eta));
+}
+
+// A wedge asperity (one symmetric triangle per 10 µm, flanks of slope α) slid over a flat chip
+// reduced to perfect plasticity (Johnson–Cook with B = C = 0 at its transition temperature,
+// E/σ_y = 1000, no plastic heat) at 100 MPa, against the wave model for interfacial shear factors
+// f = 0 (frictionless) and 0.5 (the shear-factor law), slopes 5° and 10°, within 10 %. And the run's
+// energy books close: μ plus the normal load's work equals the interfacial dissipation plus the
+// plastic work (all per unit slide and load over the window; the elastic energy stored is small).
+// (f = 0.8 misses the wave model by 12–24 %: bench/RESULTS.md.)
+TEST(Ploughing, AWedgeOnAPerfectlyPlasticChipFollowsTheWaveModel) {
+  constexpr double kWaveModelTolerance = 0.10;   // the agreement asked of the wave model
+  constexpr double kEnergyBalanceTolerance = 0.02;  // of μ: the window's stored elastic energy and step error
   const auto dir = std::filesystem::temp_directory_path() / ("mufric_wedge_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (const double alpha_deg : {5.0, 10.0}) {
-    const double tan_alpha = std::tan(alpha_deg * std::numbers::pi / 180.0);
+    const double alpha = alpha_deg * std::numbers::pi / 180.0;
     const auto csv = dir / ("wedge_" + std::to_string(static_cast<int>(alpha_deg)) + ".csv");
     {
       std::ofstream out(csv);
       out << "x[um],height[um]\n" << std::setprecision(17);
       for (int k = 0; k < 512; ++k) {
         const double x = 10.0 * k / 512;
-        out << x << "," << std::abs(x - 5.0) * tan_alpha << "\n";
+        out << x << "," << std::abs(x - 5.0) * std::tan(alpha) << "\n";
       }
     }
-    nlohmann::json j = default_scene_json();
-    j["geometry"]["tool_surface"] = {{"csv", csv.string()}, {"fit", {{"degree", 2}, {"control_points", 256}}}};
-    j["geometry"]["chip_surface"] = {{"flat", true}};
-    for (const char* o : {"material.a=\"205MPa\"", "material.b=\"0MPa\"", "material.c=0", "material.heat_fraction=0",
-                          "load.pressure=\"100MPa\"", "load.temperature=\"20C\"", "discretisation.elements_x=64",
-                          "protocol.realisations=1", "protocol.run_in=\"1um\"", "protocol.window=\"1um\""}) {
-      apply_override(j, o);
+    for (const double f : {0.0, 0.5}) {
+      nlohmann::json j = default_scene_json();
+      j["geometry"]["tool_surface"] = {{"csv", csv.string()}, {"fit", {{"degree", 2}, {"control_points", 256}}}};
+      j["geometry"]["chip_surface"] = {{"flat", true}};
+      for (const char* o : {"material.a=\"205MPa\"", "material.b=\"0MPa\"", "material.c=0", "material.heat_fraction=0",
+                            "load.pressure=\"100MPa\"", "load.temperature=\"20C\"", "discretisation.elements_x=64",
+                            "protocol.realisations=1", "protocol.run_in=\"1um\"", "protocol.window=\"1um\""}) {
+        apply_override(j, o);
+      }
+      if (f > 0.0) {
+        j["contact"]["law"] = "shear-factor";
+        j["contact"]["shear_factor"] = f;
+      }
+      const MuMeasurement m = measure(j, "wedge");
+      ASSERT_TRUE(m.completed) << m.reason;
+      const double wave = wave_model_mu(alpha, f);
+      const MicroResult& r = m.draws.front().result;
+      ASSERT_TRUE(r.mu_interface_work && r.mu_plastic_work && r.mu_normal_work);
+      std::cout << "alpha " << alpha_deg << " deg, f " << f << ": mu " << m.mu << ", wave model " << wave << " (ratio "
+                << m.mu / wave << "); interface " << *r.mu_interface_work << ", plastic " << *r.mu_plastic_work
+                << ", normal load " << *r.mu_normal_work << "\n";
+      EXPECT_NEAR(m.mu / wave, 1.0, kWaveModelTolerance) << "alpha = " << alpha_deg << " deg, f = " << f;
+      EXPECT_NEAR(r.mu + *r.mu_normal_work, *r.mu_interface_work + *r.mu_plastic_work, kEnergyBalanceTolerance * r.mu)
+          << "alpha = " << alpha_deg << " deg, f = " << f;
+      if (f == 0.0) {
+        EXPECT_EQ(*r.mu_interface_work, 0.0);
+      } else {
+        EXPECT_GT(*r.mu_interface_work, 0.1 * r.mu);
+      }
     }
-    const MuMeasurement m = measure(j, "wedge");
-    ASSERT_TRUE(m.completed) << m.reason;
-    std::cout << "alpha " << alpha_deg << " deg: mu / tan(alpha) = " << m.mu / tan_alpha << "\n";
-    EXPECT_NEAR(m.mu / tan_alpha, 1.0, kWaveModelTolerance) << "alpha = " << alpha_deg << " deg";
   }
   std::filesystem::remove_all(dir);
 }

@@ -17,6 +17,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
   if (!(law_.tangential_penalty > 0.0)) throw Error("contact: the tangential penalty must be positive");
   if (!(law_.adhesive_coefficient >= 0.0)) throw Error("contact: the adhesive coefficient must be >= 0");
   if (!(law_.shear_factor >= 0.0 && law_.shear_factor <= 1.0)) throw Error("contact: the shear factor must be in [0, 1]");
+  if (!(law_.heat_partition >= 0.0 && law_.heat_partition <= 1.0)) throw Error("contact: the heat partition must be in [0, 1]");
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
   const auto& basis = tool_.surface.basis();
@@ -63,6 +64,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
     points_.push_back(std::move(sp));
   }
   anchor_.assign(points_.size(), std::nullopt);
+  step_dissipation_.assign(points_.size(), 0.0);
 }
 
 spline::ProjectionOptions MortarContact::search_window(const Eigen::Vector2d& x) const {
@@ -257,6 +259,8 @@ void MortarContact::commit(const Eigen::VectorXd& u) {
   const std::vector<PointGap> g = gaps(u, projections, reason, ok);
   if (!ok) throw Error("contact: committing the accepted state: " + reason);
   const Eigen::VectorXd p = node_pressures(g);
+  std::fill(step_dissipation_.begin(), step_dissipation_.end(), 0.0);
+  step_dissipated_energy_ = 0.0;
   for (size_t q = 0; q < points_.size(); ++q) {
     if (!g[q].evaluated) {
       anchor_[q].reset();
@@ -265,12 +269,31 @@ void MortarContact::commit(const Eigen::VectorXd& u) {
     const PointShear s = point_shear(q, g[q], point_pressure(q, p));
     if (s.regime == PointShear::Regime::stick) continue;  // the anchor holds
     if (s.regime == PointShear::Regime::slip) {
-      // Return map: the anchor follows so that −ε_t g_t is the slip shear.
-      anchor_[q] = g[q].parameter + s.shear / (law_.tangential_penalty * g[q].d1.norm());
+      // Return map: the anchor follows so that −ε_t g_t is the slip shear. The slip it makes,
+      // (|τ_trial| − |τ|)/ε_t, against the shear |τ| is the energy the point dissipates.
+      const double speed = g[q].d1.norm();
+      const double trial = -law_.tangential_penalty * speed * (g[q].parameter - *anchor_[q]);
+      step_dissipation_[q] = points_[q].weight * std::abs(s.shear) * (std::abs(trial) - std::abs(s.shear)) /
+                             law_.tangential_penalty;
+      step_dissipated_energy_ += step_dissipation_[q];
+      anchor_[q] = g[q].parameter + s.shear / (law_.tangential_penalty * speed);
     } else {
       anchor_[q] = g[q].parameter;  // out of contact (or just touching): stress-free where it is
     }
   }
+  dissipated_energy_ += step_dissipated_energy_;
+}
+
+Eigen::VectorXd MortarContact::frictional_heat(Eigen::Index node_count) const {
+  Eigen::VectorXd heat = Eigen::VectorXd::Zero(node_count);
+  for (size_t q = 0; q < points_.size(); ++q) {
+    if (step_dissipation_[q] == 0.0) continue;
+    const auto& sp = points_[q];
+    for (size_t k = 0; k < sp.nodes.size(); ++k) {
+      heat(sp.nodes[k]) += law_.heat_partition * step_dissipation_[q] * sp.values(static_cast<Eigen::Index>(k));
+    }
+  }
+  return heat;
 }
 
 bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,

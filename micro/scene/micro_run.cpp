@@ -117,6 +117,18 @@ nlohmann::json result_head(const Scene& scene, bool provenance, bool completed, 
   return j;
 }
 
+nlohmann::json work_split_json(std::optional<double> interface, std::optional<double> plastic,
+                               std::optional<double> normal) {
+  const auto value = [](std::optional<double> v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+  return {{"mu_interface", value(interface)},
+          {"mu_bulk_plastic", value(plastic)},
+          {"mu_normal_load", value(normal)},
+          {"means", "over mu's window, each per unit sliding distance and normal force: the interfacial law's "
+                    "frictional dissipation (mu's adhesive part), the chip's plastic work (its ploughing part), and "
+                    "the normal load's work as the chip's bottom rises toward the tool; mu + mu_normal_load = "
+                    "mu_interface + mu_bulk_plastic + the energy the window stores"}};
+}
+
 }  // namespace
 
 nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
@@ -128,6 +140,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
     j["slide_start_s"] = slide_start_time;
   }
   j["averaged_steps"] = averaged_steps;
+  if (mu_interface_work || mu_plastic_work) j["work_split"] = work_split_json(mu_interface_work, mu_plastic_work, mu_normal_work);
   j["diagnostics"] = {{"contact_area_fraction", contact_fraction},
                       {"max_contact_pressure_pa", max_contact_pressure},
                       {"max_plastic_strain", max_plastic_strain},
@@ -141,6 +154,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                       {"line_search_reductions", solver.line_search_reductions},
                       {"unpredicted_convergence", solver.unpredicted_convergence},
                       {"lu_fallbacks", solver.lu_fallbacks},
+                      {"krylov_iterations", solver.krylov_iterations},
                       {"assembly_seconds", solver.seconds_assembly},
                       {"contact_seconds", solver.seconds_contact},
                       {"solve_seconds", solver.seconds_solve},
@@ -180,6 +194,9 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"film_volume_error", film.volume_error},
                  {"contact_area_fraction", s.contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
+                 {"interface_dissipation_j_per_m", s.interface_dissipation},
+                 {"plastic_work_j_per_m", s.plastic_work},
+                 {"bottom_rise_m", s.bottom_rise},
                  {"newton_iterations", s.newton_iterations}});
   }
   return j;
@@ -443,8 +460,9 @@ class WallTimeLimit {
 
 // Heat conduction through the chip, staggered after every accepted mechanical step (the plastic work
 // and the frictional heat raise the quadrature points' temperature; conduction spreads it).
-std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, solid::SolidProblem& problem,
+std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, const LoadedChip& chip,
                                                            solid::TimeIntegrationOptions& o) {
+  solid::SolidProblem& problem = *chip.problem;
   if (!scene.heat_conduction) return nullptr;
   auto heat = std::make_unique<solid::HeatConduction>(
       problem.space(), solid::HeatConductionOptions{.conductivity = scene.conductivity,
@@ -452,9 +470,12 @@ std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, s
                                                     .specific_heat = scene.material.specific_heat,
                                                     .held_side = numerics::Side::bottom,
                                                     .held_temperature = scene.temperature});
-  o.after_step = [&problem, conduction = heat.get()](double, double dt, const Eigen::VectorXd& u, std::string& reason) {
+  const bool frictional = scene.interface_law.kind != contact::InterfaceLaw::Kind::frictionless;
+  o.after_step = [&problem, conduction = heat.get(), contact = chip.contact.get(), frictional](
+                     double, double dt, const Eigen::VectorXd& u, std::string& reason) {
     std::vector<solid::MaterialState> states = problem.states();
-    if (!conduction->step(u, dt, states, reason)) return false;
+    const Eigen::VectorXd friction_heat = frictional ? contact->frictional_heat(problem.space().node_count()) : Eigen::VectorXd();
+    if (!conduction->step(u, dt, states, reason, friction_heat)) return false;
     problem.commit(std::move(states));
     return true;
   };
@@ -476,20 +497,24 @@ std::unique_ptr<coupling::LubricatedChip> add_lubricant(const Scene& scene, soli
 
 // What every accepted step records: the contact state, the lubricant's own record of the step, μ by
 // eq. (17) over the whole chip boundary (contact and fluid traction), and μ into the window average
-// (seed 000 averages over time, press-slide over sliding distance).
+// (seed 000 averages over time, press-slide over sliding distance); and the step's interfacial
+// dissipation and plastic work per unit sliding distance and normal force into averages over the
+// same window (μ's split into its adhesive and ploughing parts).
 class StepRecorder {
  public:
   StepRecorder(const Scene& scene, const BottomMotion& motion, const contact::MortarContact& contact,
                const coupling::LubricatedChip* lubricant)
       : seed000_(scene.protocol.name == Protocol::seed000),
+        material_(scene.material),
         motion_(motion),
         contact_(contact),
         lubricant_(lubricant),
         // (Seed 000's window has no upper end: the run stops at its end, and the arithmetic stays the
         // one that gave the published figures, to the bit.)
-        average_(seed000_ ? WindowAverage(scene.average_from, std::numeric_limits<double>::infinity(), 0)
-                          : WindowAverage(scene.protocol.run_in, scene.protocol.run_in + scene.protocol.window,
-                                          scene.protocol.blocks)) {}
+        average_(window(scene)),
+        interface_average_(window(scene)),
+        plastic_average_(window(scene)),
+        normal_average_(window(scene)) {}
 
   const MicroStep& record(const solid::StepView& view) {
     last_contact_ = contact_.state(view.u);
@@ -504,23 +529,73 @@ class StepRecorder {
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last_contact_.contact_length / last_contact_.surface_length;
     step.max_pressure = last_contact_.max_pressure;
+    step.interface_dissipation = contact_.dissipated_energy();
+    step.plastic_work = plastic_work_ += step_plastic_work(view.problem);
+    step.bottom_rise = bottom_rise(view);
     if (step.mu) average_.add(position(previous_time_), position(view.time), *step.mu);
+    const double slid = step.sliding_distance - motion_.distance(previous_time_);
+    if (slid > 0.0 && step.force.y() != 0.0) {
+      const double per_slid_load = 1.0 / (slid * std::abs(step.force.y()));
+      const double previous_dissipation = history_.empty() ? 0.0 : history_.back().interface_dissipation;
+      interface_average_.add(position(previous_time_), position(view.time),
+                             (step.interface_dissipation - previous_dissipation) * per_slid_load);
+      const double previous_work = history_.empty() ? 0.0 : history_.back().plastic_work;
+      plastic_average_.add(position(previous_time_), position(view.time), (step.plastic_work - previous_work) * per_slid_load);
+      const double previous_rise = history_.empty() ? 0.0 : history_.back().bottom_rise;
+      normal_average_.add(position(previous_time_), position(view.time), (step.bottom_rise - previous_rise) / slid);
+    }
     previous_time_ = view.time;
     history_.push_back(std::move(step));
     return history_.back();
   }
   std::vector<MicroStep>& history() { return history_; }
   const WindowAverage& average() const { return average_; }
+  const WindowAverage& interface_average() const { return interface_average_; }
+  const WindowAverage& plastic_average() const { return plastic_average_; }
+  const WindowAverage& normal_average() const { return normal_average_; }
   const contact::ContactState& last_contact() const { return last_contact_; }
 
  private:
+  static WindowAverage window(const Scene& scene) {
+    if (scene.protocol.name == Protocol::seed000) {
+      return WindowAverage(scene.average_from, std::numeric_limits<double>::infinity(), 0);
+    }
+    return WindowAverage(scene.protocol.run_in, scene.protocol.run_in + scene.protocol.window, scene.protocol.blocks);
+  }
+  // Σ_q w_q σ_y Δε̄ᵖ over the step (σ_y, the Kirchhoff yield stress of the return map, at the end of
+  // the step: the backward-Euler plastic work of the J2 model).
+  double step_plastic_work(const solid::SolidProblem& problem) {
+    const auto& states = problem.states();
+    const auto& qps = problem.space().quadrature();
+    if (plastic_strain_.empty()) plastic_strain_.assign(states.size(), 0.0);
+    double work = 0.0;
+    for (size_t q = 0; q < states.size(); ++q) {
+      const auto& st = states[q];
+      const double increment = st.equivalent_plastic_strain - plastic_strain_[q];
+      if (increment <= 0.0) continue;
+      work += qps[q].weight * increment *
+              solid::johnson_cook_yield_stress(material_, st.equivalent_plastic_strain, st.plastic_strain_rate, st.temperature);
+      plastic_strain_[q] = st.equivalent_plastic_strain;
+    }
+    return work;
+  }
+  // The mean vertical displacement of Γ_B (the chip's bottom, pushed toward the tool along +y).
+  static double bottom_rise(const solid::StepView& view) {
+    const std::vector<int> nodes = view.problem.space().side_nodes(numerics::Side::bottom);
+    double sum = 0.0;
+    for (const int a : nodes) sum += view.u(2 * a + 1);
+    return nodes.empty() ? 0.0 : sum / static_cast<double>(nodes.size());
+  }
   double position(double t) const { return seed000_ ? t : motion_.distance(t); }
   bool seed000_;
+  const solid::JohnsonCookParameters& material_;
   const BottomMotion& motion_;
   const contact::MortarContact& contact_;
   const coupling::LubricatedChip* lubricant_;
-  WindowAverage average_;
+  WindowAverage average_, interface_average_, plastic_average_, normal_average_;
   contact::ContactState last_contact_;
+  std::vector<double> plastic_strain_;  // ε̄ᵖ per quadrature point at the last record
+  double plastic_work_ = 0.0;
   double previous_time_ = 0.0;
   std::vector<MicroStep> history_;
 };
@@ -569,8 +644,9 @@ void record_end_state(const Scene& scene, const solid::SolidProblem& problem, co
   }
 }
 
-// μ over the window, or why there is none.
-void record_outcome(const Scene& scene, const WindowAverage& average, MicroResult& result) {
+// μ over the window, or why there is none; and its work split.
+void record_outcome(const Scene& scene, const StepRecorder& recorder, MicroResult& result) {
+  const WindowAverage& average = recorder.average();
   if (!result.solver.completed) {
     result.reason = result.solver.reason;
   } else if (average.weight() <= 0.0) {
@@ -583,6 +659,9 @@ void record_outcome(const Scene& scene, const WindowAverage& average, MicroResul
       result.block_means = average.block_means();
       result.drift = (result.block_means.back() - result.block_means.front()) / std::max(std::abs(result.mu), 1e-300);
     }
+    if (recorder.interface_average().weight() > 0.0) result.mu_interface_work = recorder.interface_average().mean();
+    if (recorder.plastic_average().weight() > 0.0) result.mu_plastic_work = recorder.plastic_average().mean();
+    if (recorder.normal_average().weight() > 0.0) result.mu_normal_work = recorder.normal_average().mean();
   }
 }
 
@@ -602,7 +681,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   solid::TimeIntegrationOptions o = integration_options(scene, motion);
   WallTimeLimit limit(options);
   limit.watch_failed_attempts(o);
-  const auto heat = add_heat_conduction(scene, problem, o);
+  const auto heat = add_heat_conduction(scene, chip, o);
   const auto lubricant = add_lubricant(scene, problem, geometry, motion, o);
   solid::TimeIntegrator integrator(problem, o);
   if (scene.protocol.name == Protocol::seed000 && scene.scheme == solid::TimeScheme::generalized_alpha) {
@@ -627,7 +706,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   result.averaged_steps = recorder.average().steps();
   if (lubricant) result.lubricant = lubricant_record(*lubricant);
   record_end_state(scene, problem, recorder.last_contact(), result);
-  record_outcome(scene, recorder.average(), result);
+  record_outcome(scene, recorder, result);
   if (!options.vtu_directory.empty()) {
     write_chip_vtu(options.vtu_directory + "/chip.vtu", problem, integrator.u(), recorder.last_contact());
     write_tool_vtu(options.vtu_directory + "/tool.vtu", geometry.tool_surface);
@@ -846,6 +925,20 @@ nlohmann::json MuMeasurement::to_json(const Scene& scene) const {
   diagnostics["threads"] = threads;
   diagnostics["draw_seconds_sum"] = t.draw_seconds_sum;
   diagnostics["elements"] = draws.empty() ? 0 : draws.front().result.elements;
+  // The work split, averaged over the draws like μ.
+  double interface_sum = 0.0, plastic_sum = 0.0, normal_sum = 0.0;
+  int split_draws = 0;
+  for (const auto& d : draws) {
+    const MicroResult& r = d.result;
+    if (!r.mu_interface_work || !r.mu_plastic_work || !r.mu_normal_work) continue;
+    interface_sum += *r.mu_interface_work;
+    plastic_sum += *r.mu_plastic_work;
+    normal_sum += *r.mu_normal_work;
+    ++split_draws;
+  }
+  if (completed && split_draws == static_cast<int>(draws.size()) && split_draws > 0) {
+    j["work_split"] = work_split_json(interface_sum / split_draws, plastic_sum / split_draws, normal_sum / split_draws);
+  }
   auto& list = j["draws"] = nlohmann::json::array();
   for (const auto& d : draws) {
     nlohmann::json one = d.result.to_json(scene, false);

@@ -32,6 +32,10 @@ struct MicroStep {
   double contact_fraction = 0.0;                    // of the interval's surface length
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;
+  // Since the start, J per unit depth: the energy the interfacial law dissipated at the contact, and
+  // the chip's plastic work Σ w σ_y Δε̄ᵖ (0 for the frictionless law / an elastic chip).
+  double interface_dissipation = 0.0, plastic_work = 0.0;
+  double bottom_rise = 0.0;  // m: Γ_B's mean vertical displacement (toward the tool positive)
 };
 
 // A lubricated run's film record: coupling work, mesh quality, the lubricant's area and its pockets.
@@ -58,6 +62,14 @@ struct MicroResult {
   // (last block − first block) / μ; empty/0 for seed 000's protocol.
   std::vector<double> block_means;
   double drift = 0.0;
+  // μ's work split over the same window: the interface's frictional dissipation and the chip's
+  // plastic work per unit sliding distance and normal force (the adhesive and the ploughing share).
+  // Their sum differs from μ by the elastic energy stored and the kinetic energy over the window.
+  std::optional<double> mu_interface_work, mu_plastic_work;
+  // The normal load's work over the window per unit sliding distance and normal force: Γ_B's rise
+  // per unit slide (a tool settling into the chip, or riding up, converts work between the two
+  // directions: μ + this = the two parts above + the stored energy).
+  std::optional<double> mu_normal_work;
   double slide_start_time = 0.0;  // s, when Γ_B starts to move (0 for seed 000)
   std::vector<MicroStep> history;
   double contact_fraction = 0.0, max_contact_pressure = 0.0;  // at the end

@@ -358,7 +358,10 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
       c.fail("shear_factor", "required when contact.law is " + law_name + " (m in tau = m k, 0 to 1, e.g. 0.5)");
     }
     const std::vector<std::pair<const char*, bool>> used = {
-        {"adhesive_coefficient", uses_mu}, {"shear_factor", uses_m}, {"tangential_penalty", law.kind != Kind::frictionless}};
+        {"adhesive_coefficient", uses_mu},
+        {"shear_factor", uses_m},
+        {"tangential_penalty", law.kind != Kind::frictionless},
+        {"heat_partition", law.kind != Kind::frictionless}};
     for (const auto& [key, in_use] : used) {
       if (!in_use && c.has(key)) {
         s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is " + law_name);
@@ -368,6 +371,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     law.shear_factor = c.number("shear_factor", 0.0, 0.0, 1.0);
     // Stick's regularisation: a tenth of the normal penalty by default (contact::kTangentialPenaltyRatio).
     law.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
+    // The share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
+    law.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, 0.0, 1.0);
+    if (law.kind != Kind::frictionless && !s.heat_conduction) {
+      s.warnings.push_back("the frictional heat of contact.law " + law_name +
+                           " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in "
+                           "through the surface)");
+    }
     c.finish();
   }
   {

@@ -62,13 +62,19 @@ double HeatConduction::heat_content() const {
   return Eigen::VectorXd::Ones(temperature_.size()).dot(capacity_ * temperature_);
 }
 
-bool HeatConduction::step(const Eigen::VectorXd& u, double dt, std::vector<MaterialState>& states, std::string& reason) {
+bool HeatConduction::step(const Eigen::VectorXd& u, double dt, std::vector<MaterialState>& states, std::string& reason,
+                          const Eigen::VectorXd& boundary_heat) {
   const auto& qps = space_.quadrature();
   if (states.size() != qps.size()) throw Error("heat conduction: one material state per quadrature point expected");
   const double rho_c = options_.density * options_.specific_heat, k = options_.conductivity;
   const Eigen::VectorXd before = at_quadrature_points();
-  // Backward Euler, multiplied by dt: (C + dt K) T₁ = C T₀ + ∫ R ρ₀c Δθ_adiabatic dV₀.
+  if (boundary_heat.size() != 0 && boundary_heat.size() != temperature_.size()) {
+    throw Error("heat conduction: boundary heat has " + std::to_string(boundary_heat.size()) + " entries for " +
+                std::to_string(temperature_.size()) + " nodes");
+  }
+  // Backward Euler, multiplied by dt: (C + dt K) T₁ = C T₀ + ∫ R ρ₀c Δθ_adiabatic dV₀ + ∫ R q dΓ dt.
   Eigen::VectorXd rhs = capacity_ * temperature_;
+  if (boundary_heat.size() != 0) rhs += boundary_heat;
   for (size_t q = 0; q < qps.size(); ++q) {
     const double heat = qps[q].weight * rho_c * (states[q].temperature - before(static_cast<Eigen::Index>(q)));
     for (size_t a = 0; a < qps[q].nodes.size(); ++a) rhs(qps[q].nodes[a]) += heat * qps[q].values(static_cast<Eigen::Index>(a));

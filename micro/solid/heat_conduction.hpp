@@ -5,7 +5,8 @@
 // the source of one backward-Euler step of ρ₀c Ṫ = −∇₀·Q on the same spline space as the
 // displacement, with the conductivity pulled back to the reference configuration, Q = −J C⁻¹ k ∇₀T
 // (the referential heat flux of Fourier's law, Holzapfel, Nonlinear Solid Mechanics 2000, ch. 7), and
-// the quadrature points then take the temperature of the conducted field. One side is held at a
+// the quadrature points then take the temperature of the conducted field. Heat entering through the
+// boundary in the step (the contact's frictional heat) joins the source as a nodal load. One side is held at a
 // temperature (the chip's bulk beneath the micro-model); the others are insulated (the rigid tool
 // takes no heat) or periodic.
 #include <vector>
@@ -32,9 +33,11 @@ class HeatConduction {
 
   // One step of length dt after a mechanical step: `states` hold the start-of-step temperature plus
   // their adiabatic increment on entry, and the conducted temperature on return. u: the nodal
-  // displacements at the end of the step (for J C⁻¹). Returns false with a reason when the
-  // conduction matrix cannot be factorised.
-  bool step(const Eigen::VectorXd& u, double dt, std::vector<MaterialState>& states, std::string& reason);
+  // displacements at the end of the step (for J C⁻¹). boundary_heat: heat that entered through the
+  // boundary during the step, per node (J per unit depth, ∫ R_a q dΓ dt; the frictional heat of the
+  // contact), or empty. Returns false with a reason when the conduction matrix cannot be factorised.
+  bool step(const Eigen::VectorXd& u, double dt, std::vector<MaterialState>& states, std::string& reason,
+            const Eigen::VectorXd& boundary_heat = {});
 
   const Eigen::VectorXd& nodal_temperature() const { return temperature_; }
   // The temperature field at every quadrature point.
