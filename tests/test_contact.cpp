@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <numbers>
 
 #include "common/error.hpp"
+#include "micro/contact/adhesion_table.hpp"
 #include "micro/contact/mortar_contact.hpp"
 #include "micro/solid/heat_conduction.hpp"
 #include "micro/spline/profile.hpp"
@@ -444,6 +447,134 @@ TEST(CoulombContact, TangentIsTheExactLinearisationInStickAndSlip) {
   ASSERT_GT(slip, 3);
   EXPECT_EQ(problem.tangent_storage(), numerics::MatrixStorage::full);
   solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "coulomb contact", 1e-5);
+}
+
+
+// ---- The tabulated adhesive coefficient μ_a(p, v, T).
+
+// A table file in the test's temporary directory.
+std::string write_table(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("mufric_table_" + std::to_string(::getpid()) + "_" + name);
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+// μ_a = 0.1 + 2e-4 p[MPa] + 1e-4 v[m/min] − 5e-5 T[°C], tabulated on a 3 × 2 × 2 grid: trilinear
+// interpolation reproduces a law linear in each input exactly anywhere inside, with ∂μ_a/∂p; outside
+// the grid it holds the edge value (∂μ_a/∂p = 0 beyond p's range).
+TEST(AdhesionTable, InterpolatesALinearLawExactlyAndHoldsItsEdges) {
+  auto law = [](double p_mpa, double v_m_min, double t_c) { return 0.1 + 2e-4 * p_mpa + 1e-4 * v_m_min - 5e-5 * t_c; };
+  std::string text = "# a law linear in each input\ncontact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu_a\n";
+  for (const double p : {1000.0, 200.0, 600.0}) {  // rows in any order
+    for (const double v : {10.0, 110.0}) {
+      for (const double t : {20.0, 420.0}) text += std::to_string(p) + "," + std::to_string(v) + "," + std::to_string(t) + "," + std::to_string(law(p, v, t)) + "\n";
+    }
+  }
+  const AdhesionTable table = AdhesionTable::read(write_table("linear.csv", text));
+  const double mpa = 1e6, m_min = 1.0 / 60.0, kelvin = 273.15;
+  for (const auto& [p, v, t] : {std::tuple{350.0, 47.0, 133.0}, {999.0, 10.0, 20.0}, {200.0, 109.0, 400.0}}) {
+    const AdhesionTable::Value value = table.at(p * mpa, v * m_min, t + kelvin);
+    EXPECT_NEAR(value.mu, law(p, v, t), 1e-6) << p << " MPa, " << v << " m/min, " << t << " C";
+    EXPECT_NEAR(value.dmu_dpressure, 2e-4 / mpa, 1e-6 * 2e-4 / mpa);
+  }
+  const AdhesionTable::Value below = table.at(50.0 * mpa, 5.0 * m_min, 0.0 + kelvin);
+  EXPECT_NEAR(below.mu, law(200.0, 10.0, 20.0), 1e-6);
+  EXPECT_EQ(below.dmu_dpressure, 0.0);
+  EXPECT_NEAR(table.at(3000.0 * mpa, 500.0 * m_min, 900.0 + kelvin).mu, law(1000.0, 110.0, 420.0), 1e-6);
+  EXPECT_NE(table.range().find("p 200MPa to 1000MPa"), std::string::npos) << table.range();
+}
+
+TEST(AdhesionTable, ErrorsNameTheFileTheLineOrTheMissingGridPoint) {
+  const std::string header = "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu_a\n";
+  auto error_of = [](const std::string& path) {
+    try {
+      AdhesionTable::read(path);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string missing = write_table("missing.csv", header + "100,10,20,0.1\n200,10,20,0.2\n100,20,20,0.1\n");
+  EXPECT_NE(error_of(missing).find("no row for contact_pressure 200MPa, sliding_velocity 20m/min"), std::string::npos)
+      << error_of(missing);
+  const std::string negative = write_table("negative.csv", header + "100,10,20,0.1\n200,10,20,-0.2\n");
+  EXPECT_NE(error_of(negative).find("line 3: mu_a must be >= 0"), std::string::npos) << error_of(negative);
+  const std::string repeated = write_table("repeated.csv", header + "100,10,20,0.1\n100,10,20,0.2\n");
+  EXPECT_NE(error_of(repeated).find("line 3: repeats the grid point of line 2"), std::string::npos) << error_of(repeated);
+  const std::string no_unit = write_table("no_unit.csv", "contact_pressure,sliding_velocity[m/min],temperature[C],mu_a\n1,1,1,0.1\n");
+  EXPECT_NE(error_of(no_unit).find("'contact_pressure' has no unit"), std::string::npos) << error_of(no_unit);
+  const std::string no_mu = write_table("no_mu.csv", "contact_pressure[MPa],sliding_velocity[m/min],temperature[C]\n1,1,1\n");
+  EXPECT_NE(error_of(no_mu).find("mu_a"), std::string::npos) << error_of(no_mu);
+}
+
+// A table law whose μ_a rises with pressure, μ_a = 0.2 + 100 p (pressures of order 1e-3 here), at one
+// velocity and temperature.
+InterfaceLaw table_law(double tangential) {
+  InterfaceLaw law;
+  law.kind = InterfaceLaw::Kind::table;
+  law.table = std::make_shared<const AdhesionTable>(std::vector<double>{0.0, 1e-2}, std::vector<double>{1.0},
+                                                    std::vector<double>{300.0}, std::vector<double>{0.2, 1.2}, "test");
+  law.sliding_velocity = 1.0;
+  law.tangential_penalty = tangential;
+  return law;
+}
+
+// The flat chip slid beyond stick under the table law: τ = μ_a(p) p with μ_a at the point's pressure
+// (closed form); the law needs the chip's temperature at the contact before it can shear.
+TEST(TableContact, AFlatChipSlidCarriesTheTablesMuTimesP) {
+  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0;
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
+                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
+                                                 penalty, 0, table_law(tangential));
+  problem.add_interaction(contact);
+  problem.fix_side(numerics::Side::bottom, 0);
+  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  EXPECT_THROW(contact->commit(Eigen::VectorXd::Zero(problem.dof_count())), Error);  // no temperature yet
+  contact->set_surface_temperature(std::vector<double>(contact->surface_positions().size(), 300.0));
+  const Eigen::VectorXd pressed = solid::test::solve_static(problem);
+  contact->commit(pressed);
+  const double mu_a = 0.2 + 100.0 * pressure;
+  Eigen::VectorXd slid = pressed;
+  for (Eigen::Index i = 0; i < slid.size(); i += 2) slid(i) += 3.0 * mu_a * pressure / tangential;
+  const ContactState s = contact->state(slid);
+  for (size_t q = 0; q < s.point_shear.size(); ++q) {
+    EXPECT_NEAR(s.point_shear[q], -mu_a * s.point_pressure[q], 1e-9 * pressure) << "x " << s.point_x[q];
+  }
+  EXPECT_NEAR(std::abs(s.force.x() / s.force.y()), mu_a, 1e-9);
+}
+
+// The table law's tangent in slip carries ∂(μ_a(P) P)/∂P = μ_a + P μ_a′: against central differences
+// on the rough pair with points in stick and slip.
+TEST(TableContact, TangentIsTheExactLinearisationWithAPressureDependentMu) {
+  const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
+                              std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
+  InterfaceLaw law = table_law(50.0);
+  // Pressures here reach ~0.05: μ_a from 0.1 to 0.6 over them.
+  law.table = std::make_shared<const AdhesionTable>(std::vector<double>{0.0, 0.05}, std::vector<double>{1.0},
+                                                    std::vector<double>{300.0}, std::vector<double>{0.1, 0.6}, "test");
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, law);
+  contact->set_surface_temperature(std::vector<double>(contact->surface_positions().size(), 300.0));
+  problem.add_interaction(contact);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::VectorXd u(problem.dof_count());
+  for (auto& x : u) x = 2e-3 * unit(rng);
+  contact->commit(u);
+  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
+  const ContactState s = contact->state(u);
+  int stick = 0, slip = 0;
+  for (size_t q = 0; q < s.point_shear.size(); ++q) {
+    if (s.point_pressure[q] <= 0.0) continue;
+    const double mu_a = law.table->at(s.point_pressure[q], 1.0, 300.0).mu;
+    const bool slipping = std::abs(std::abs(s.point_shear[q]) - mu_a * s.point_pressure[q]) < 1e-12 * s.point_pressure[q];
+    slipping ? ++slip : ++stick;
+  }
+  std::cout << "points in stick " << stick << ", in slip " << slip << "\n";
+  ASSERT_GT(stick, 3);
+  ASSERT_GT(slip, 3);
+  solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "table contact", 1e-5);
 }
 
 }  // namespace

@@ -795,5 +795,46 @@ TEST(Ploughing, AWedgeOnAPerfectlyPlasticChipFollowsTheWaveModel) {
   std::filesystem::remove_all(dir);
 }
 
+// The table law end to end: a table that holds μ_a = 0.1 everywhere is Coulomb's law with μ_a = 0.1
+// (brute-force equivalence of the two code paths through a whole run), and one that rises with
+// pressure gives a larger μ and more interfacial work. A table that is not a full grid is refused
+// naming contact.table.
+TEST(MicroRun, AConstantTableIsCoulombsLawAndARisingOneAddsFriction) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mufric_table_run_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto table = [&](const std::string& name, double mu_low, double mu_high) {
+    const auto path = dir / name;
+    std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu_a\n0,100,20," << mu_low
+                        << "\n2000,100,20," << mu_high << "\n";
+    return path.string();
+  };
+  nlohmann::json coulomb = small_press_slide();
+  apply_override(coulomb, "contact.law=\"coulomb\"");
+  apply_override(coulomb, "contact.adhesive_coefficient=0.1");
+  nlohmann::json constant = small_press_slide(), rising = small_press_slide();
+  apply_override(constant, "contact.law=\"table\"");
+  constant["contact"]["table"] = table("constant.csv", 0.1, 0.1);
+  apply_override(rising, "contact.law=\"table\"");
+  rising["contact"]["table"] = table("rising.csv", 0.1, 0.5);
+  const MicroResult by_coulomb = run_micro(parse_scene(coulomb, "coulomb"));
+  const MicroResult by_constant = run_micro(parse_scene(constant, "constant table"));
+  const MicroResult by_rising = run_micro(parse_scene(rising, "rising table"));
+  for (const MicroResult* r : {&by_coulomb, &by_constant, &by_rising}) ASSERT_TRUE(r->completed) << r->reason;
+  EXPECT_NEAR(by_constant.mu, by_coulomb.mu, 1e-6 * std::abs(by_coulomb.mu));
+  EXPECT_GT(by_rising.mu, by_coulomb.mu + 0.01);
+  ASSERT_TRUE(by_rising.mu_interface_work && by_coulomb.mu_interface_work);
+  EXPECT_GT(*by_rising.mu_interface_work, *by_coulomb.mu_interface_work);
+  std::cout << "mu: coulomb " << by_coulomb.mu << ", constant table " << by_constant.mu << ", rising table "
+            << by_rising.mu << "\n";
+  nlohmann::json broken = small_press_slide();
+  apply_override(broken, "contact.law=\"table\"");
+  const auto path = dir / "broken.csv";
+  std::ofstream(path) << "contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu_a\n0,100,20,0.1\n100,200,20,0.1\n";
+  broken["contact"]["table"] = path.string();
+  EXPECT_NE(error_of(broken).find("contact.table: "), std::string::npos) << error_of(broken);
+  EXPECT_NE(error_of(broken).find("no row for"), std::string::npos) << error_of(broken);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace mufric::scene

@@ -18,6 +18,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
   if (!(law_.adhesive_coefficient >= 0.0)) throw Error("contact: the adhesive coefficient must be >= 0");
   if (!(law_.shear_factor >= 0.0 && law_.shear_factor <= 1.0)) throw Error("contact: the shear factor must be in [0, 1]");
   if (!(law_.heat_partition >= 0.0 && law_.heat_partition <= 1.0)) throw Error("contact: the heat partition must be in [0, 1]");
+  if (law_.kind == InterfaceLaw::Kind::table && !law_.table) throw Error("contact: the table law needs its adhesion table");
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
   const auto& basis = tool_.surface.basis();
@@ -203,6 +204,9 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
   if (law_.needs_shear_strength() && shear_strength_.empty()) {
     throw Error("contact: the interfacial law needs the chip's shear yield stress at the contact (set_shear_strength)");
   }
+  if (law_.needs_temperature() && surface_temperature_.empty()) {
+    throw Error("contact: the interfacial law needs the chip's temperature at the contact (set_surface_temperature)");
+  }
   // A point without an anchor (not searched at the last commit) starts stress-free where it is.
   if (!anchor_[q]) return s;
   // Tangential offset from the anchor along the tool, g_t = |C′(ξ)| (ξ − ξ_a): the arc length to
@@ -211,14 +215,20 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
   const double offset_parameter = g.parameter - *anchor_[q];
   const double offset = speed * offset_parameter;
   const double trial = -law_.tangential_penalty * offset;
-  // The slip limit: μ_a P (Coulomb), m k (shear factor) or the lower of the two (Zorev).
+  // The slip limit: μ_a P (Coulomb, or the table's μ_a(P, v, T)), m k (shear factor) or the lower of
+  // the first and the second (Zorev), with its slope in P for the tangent.
   double limit = law_.adhesive_coefficient * pressure;
-  bool limit_from_pressure = true;
+  double limit_slope = law_.adhesive_coefficient;
+  if (law_.kind == InterfaceLaw::Kind::table) {
+    const AdhesionTable::Value mu = law_.table->at(pressure, law_.sliding_velocity, surface_temperature_[q]);
+    limit = mu.mu * pressure;
+    limit_slope = mu.mu + pressure * mu.dmu_dpressure;
+  }
   if (law_.needs_shear_strength()) {
     const double yield_shear = law_.shear_factor * shear_strength_[q];
     if (law_.kind == InterfaceLaw::Kind::shear_factor || yield_shear < limit) {
       limit = yield_shear;
-      limit_from_pressure = false;
+      limit_slope = 0.0;
     }
   }
   if (std::abs(trial) <= limit) {
@@ -231,9 +241,17 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
     s.regime = PointShear::Regime::slip;
     s.slip_sign = trial > 0.0 ? 1.0 : -1.0;
     s.shear = s.slip_sign * limit;
-    s.limit_from_pressure = limit_from_pressure;
+    s.limit_slope = limit_slope;
   }
   return s;
+}
+
+void MortarContact::set_surface_temperature(std::vector<double> temperature) {
+  if (temperature.size() != points_.size()) {
+    throw Error("contact: " + std::to_string(temperature.size()) + " temperatures for " + std::to_string(points_.size()) +
+                " surface points");
+  }
+  surface_temperature_ = std::move(temperature);
 }
 
 void MortarContact::set_shear_strength(std::vector<double> k) {
@@ -302,6 +320,10 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
     reason = "contact: the interfacial law needs the chip's shear yield stress at the contact (set_shear_strength)";
     return false;
   }
+  if (law_.needs_temperature() && surface_temperature_.empty()) {
+    reason = "contact: the interfacial law needs the chip's temperature at the contact (set_surface_temperature)";
+    return false;
+  }
   bool ok = true;
   int projections = 0;
   const std::vector<PointGap> g = gaps(u, projections, reason, ok);
@@ -362,13 +384,14 @@ bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid:
         add_block(sp.nodes[b], sp.nodes[c], k);
       }
     }
-    if (shear.regime != PointShear::Regime::slip || !shear.limit_from_pressure) continue;
-    // Slip at μ_a P: τ = s μ_a P_q, ∂P_q/∂u = Σ_a N_a(q) ε G_a: −w_q R_b s μ_a ε N_a(q) t ⊗ G_a.
+    if (shear.regime != PointShear::Regime::slip || shear.limit_slope == 0.0) continue;
+    // Slip at a limit L(P_q) (μ_a P_q for Coulomb): τ = s L, ∂P_q/∂u = Σ_a N_a(q) ε G_a:
+    // −w_q R_b s L′ ε N_a(q) t ⊗ G_a.
     const Eigen::Vector2d t = unit_tangent(g[q]);
     for (size_t k = 0; k < sp.nodes.size(); ++k) {
       const auto a = static_cast<size_t>(sp.multipliers[k]);
       if (gradients[a].empty()) continue;  // an inactive node adds nothing to P_q
-      const double scale = -sp.weight * shear.slip_sign * law_.adhesive_coefficient * penalty_ *
+      const double scale = -sp.weight * shear.slip_sign * shear.limit_slope * penalty_ *
                            sp.values(static_cast<Eigen::Index>(k));
       for (size_t b = 0; b < sp.nodes.size(); ++b) {
         for (const auto& [c, gc] : gradients[a]) {

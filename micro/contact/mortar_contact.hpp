@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "micro/contact/adhesion_table.hpp"
 #include "micro/solid/solid_problem.hpp"
 #include "micro/spline/closest_point.hpp"
 
@@ -42,14 +43,19 @@ inline constexpr double kDefaultHeatPartition = 0.5;
 // the owner through set_shear_strength); `zorev`: |τ| ≤ min(μ_a P, m k), sliding where the pressure is
 // low and sticking to the yield shear where it is high (Zorev 1963, the chip–tool friction model of
 // cutting codes).
+// `table`: |τ| ≤ μ_a(P, v, T) P with μ_a from an AdhesionTable at the point's pressure, the scene's
+// sliding velocity and the chip's temperature there (given by the owner through set_surface_temperature).
 struct InterfaceLaw {
-  enum class Kind { frictionless, coulomb, shear_factor, zorev };
+  enum class Kind { frictionless, coulomb, shear_factor, zorev, table };
   Kind kind = Kind::frictionless;
   double adhesive_coefficient = 0.0;  // μ_a (coulomb, zorev)
+  std::shared_ptr<const AdhesionTable> table;  // table
+  double sliding_velocity = 0.0;      // m/s, the table's v (table)
   double shear_factor = 0.0;          // m (shear-factor, zorev)
   double tangential_penalty = 0.0;    // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
   double heat_partition = kDefaultHeatPartition;  // β: the share of the interface's frictional heat the chip receives
   bool needs_shear_strength() const { return kind == Kind::shear_factor || kind == Kind::zorev; }
+  bool needs_temperature() const { return kind == Kind::table; }
 };
 
 // The rigid tool: a curve whose outward normal, for a curve running in +x, points down (−y side),
@@ -103,6 +109,8 @@ class MortarContact final : public solid::BoundaryInteraction {
   // for the laws that use it; held until set again (the owner refreshes it after each accepted step,
   // so within a step k is that of the last accepted state).
   void set_shear_strength(std::vector<double> k);
+  // The chip's temperature at each surface point (K, same order), for the table law; held until set again.
+  void set_surface_temperature(std::vector<double> temperature);
   // Reference position of each surface quadrature point.
   std::vector<Eigen::Vector2d> surface_positions() const;
   ContactState state(const Eigen::VectorXd& u) const;
@@ -133,7 +141,7 @@ class MortarContact final : public solid::BoundaryInteraction {
     double shear = 0.0;                                     // τ, Pa
     Eigen::Vector2d shear_gradient = Eigen::Vector2d::Zero();  // stick: ∂τ/∂x
     double slip_sign = 0.0;                                 // slip: τ = slip_sign × the limit
-    bool limit_from_pressure = false;                       // slip at μ_a P (else at m k, fixed in a step)
+    double limit_slope = 0.0;  // slip: ∂(limit)/∂P, μ_a (+ P ∂μ_a/∂P for a table); 0 at m k (fixed in a step)
   };
   PointShear point_shear(size_t q, const PointGap& g, double pressure) const;
   // The tool's unit tangent at a point's foot and its derivative with respect to the point's position.
@@ -159,6 +167,7 @@ class MortarContact final : public solid::BoundaryInteraction {
   // none where the point was not searched at the last commit.
   std::vector<std::optional<double>> anchor_;
   std::vector<double> shear_strength_;  // k per surface point (shear-factor, zorev)
+  std::vector<double> surface_temperature_;  // T per surface point, K (table)
   std::vector<double> step_dissipation_;  // per surface point, J/m, in the last accepted step
   double step_dissipated_energy_ = 0.0, dissipated_energy_ = 0.0;
   std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once

@@ -320,20 +320,24 @@ struct LoadedChip {
   std::vector<size_t> surface_quadrature;
 };
 
-// k = σ_JC(ε̄ᵖ, ε̇ᵖ, T)/√3 (von Mises) at each contact surface point, from the committed state of its
-// nearest bulk quadrature point: the laws that use it see the last accepted state's k.
-void refresh_shear_strength(const Scene& scene, const LoadedChip& chip) {
+// The chip's state at each contact surface point, from the committed state of its nearest bulk
+// quadrature point: k = σ_JC(ε̄ᵖ, ε̇ᵖ, T)/√3 (von Mises) and T, for the laws that use them (they see
+// the last accepted state's).
+void refresh_chip_state_at_contact(const Scene& scene, const LoadedChip& chip) {
   if (chip.surface_quadrature.empty()) return;
   const auto& states = chip.problem->states();
-  std::vector<double> k;
+  std::vector<double> k, temperature;
   k.reserve(chip.surface_quadrature.size());
+  temperature.reserve(chip.surface_quadrature.size());
   for (const size_t q : chip.surface_quadrature) {
     const auto& st = states[q];
     k.push_back(solid::johnson_cook_yield_stress(scene.material, st.equivalent_plastic_strain, st.plastic_strain_rate,
                                                  st.temperature) /
                 std::sqrt(3.0));
+    temperature.push_back(st.temperature);
   }
-  chip.contact->set_shear_strength(std::move(k));
+  if (scene.interface_law.needs_shear_strength()) chip.contact->set_shear_strength(std::move(k));
+  if (scene.interface_law.needs_temperature()) chip.contact->set_surface_temperature(std::move(temperature));
 }
 
 std::vector<size_t> nearest_quadrature_points(const solid::IgaSpace& space, const std::vector<Eigen::Vector2d>& at) {
@@ -377,9 +381,9 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
                                                           scene.penalty, scene.contact_points_per_span,
                                                           scene.interface_law);
   problem.add_interaction(chip.contact);
-  if (scene.interface_law.needs_shear_strength()) {
+  if (scene.interface_law.needs_shear_strength() || scene.interface_law.needs_temperature()) {
     chip.surface_quadrature = nearest_quadrature_points(problem.space(), chip.contact->surface_positions());
-    refresh_shear_strength(scene, chip);
+    refresh_chip_state_at_contact(scene, chip);
   }
   const double velocity = scene.velocity, ramp_time = scene.ramp;
   if (scene.protocol.name == Protocol::seed000) {
@@ -693,7 +697,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   StepRecorder recorder(scene, motion, *chip.contact, lubricant.get());
   result.solver = integrator.run([&](const solid::StepView& view) {
     const MicroStep& step = recorder.record(view);
-    refresh_shear_strength(scene, chip);  // after the step's own record: the next step's k
+    refresh_chip_state_at_contact(scene, chip);  // after the step's own record: the next step's k and T
     if (options.on_step) options.on_step(step, scene);
     limit.check_accepted_step(step, recorder.history().size());
   });

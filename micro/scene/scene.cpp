@@ -354,12 +354,29 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     if (uses_mu && !c.has("adhesive_coefficient")) {
       c.fail("adhesive_coefficient", "required when contact.law is " + law_name + " (the interfacial mu_a, e.g. 0.1)");
     }
+    const bool uses_table = law.kind == Kind::table;
+    if (uses_table && !c.has("table")) {
+      c.fail("table", "required when contact.law is table (a CSV of contact_pressure, sliding_velocity, temperature "
+                      "and mu_a over a full grid)");
+    }
+    if (c.has("table")) {
+      std::string path = c.text("table", "", {});
+      if (std::filesystem::path(path).is_relative()) path = (std::filesystem::path(base_directory) / path).string();
+      if (uses_table && !std::filesystem::exists(path)) c.fail("table", "no such file '" + path + "'");
+      try {
+        if (uses_table) law.table = std::make_shared<const contact::AdhesionTable>(contact::AdhesionTable::read(path));
+      } catch (const Error& e) {
+        c.fail("table", e.what());
+      }
+    }
+    law.sliding_velocity = std::abs(s.velocity);  // the table's v: the chip slides under the tool at it
     if (uses_m && !c.has("shear_factor")) {
       c.fail("shear_factor", "required when contact.law is " + law_name + " (m in tau = m k, 0 to 1, e.g. 0.5)");
     }
     const std::vector<std::pair<const char*, bool>> used = {
         {"adhesive_coefficient", uses_mu},
         {"shear_factor", uses_m},
+        {"table", uses_table},
         {"tangential_penalty", law.kind != Kind::frictionless},
         {"heat_partition", law.kind != Kind::frictionless}};
     for (const auto& [key, in_use] : used) {

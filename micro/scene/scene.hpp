@@ -231,11 +231,12 @@ struct SceneChoice<numerics::LinearSolverKind> {
 };
 template <>
 struct SceneChoice<contact::InterfaceLaw::Kind> {
-  static constexpr std::array<NamedChoice<contact::InterfaceLaw::Kind>, 4> names{
+  static constexpr std::array<NamedChoice<contact::InterfaceLaw::Kind>, 5> names{
       {{"frictionless", contact::InterfaceLaw::Kind::frictionless},
        {"coulomb", contact::InterfaceLaw::Kind::coulomb},
        {"shear-factor", contact::InterfaceLaw::Kind::shear_factor},
-       {"zorev", contact::InterfaceLaw::Kind::zorev}}};
+       {"zorev", contact::InterfaceLaw::Kind::zorev},
+       {"table", contact::InterfaceLaw::Kind::table}}};
 };
 template <>
 struct SceneChoice<Compressibility> {
