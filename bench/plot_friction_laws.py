@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""The friction-law study's table and figure: reads OUT/<law>/p*_v*_T*/result.json as written by
+bench/friction_laws_study.sh and prints, per law and point, mu +- its standard error and mu's work
+split (interface = the adhesive part, plastic = ploughing, normal = the normal load's work), then
+draws mu against p, v and T through the box centre, one line per law (OUT/friction_laws.png).
+
+  /usr/bin/python3 bench/plot_friction_laws.py OUT
+"""
+import json
+import pathlib
+import re
+import sys
+
+
+def point_of(name):
+    m = re.match(r"p([\d.]+)MPa_v([\d.]+)m_min_T([\d.]+)C", name)
+    return tuple(float(g) for g in m.groups()) if m else None
+
+
+def main():
+    out = pathlib.Path(sys.argv[1])
+    laws = {}
+    for law_dir in sorted(p for p in out.iterdir() if p.is_dir()):
+        rows = {}
+        for run in sorted(law_dir.iterdir()):
+            point = point_of(run.name)
+            result = run / "result.json"
+            if point is None or not result.exists():
+                continue
+            rows[point] = json.load(open(result))
+        if rows:
+            laws[law_dir.name] = rows
+    if not laws:
+        sys.exit(f"{out}: no runs yet")
+    print("| law | p [MPa] | v [m/min] | T [C] | mu | interface | plastic | normal load | wetted | wall [s] |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for law, rows in laws.items():
+        for (p, v, t), r in sorted(rows.items()):
+            if not r.get("completed"):
+                print(f"| {law} | {p:g} | {v:g} | {t:g} | failed: {r.get('reason', '')[:60]} | | | | | |")
+                continue
+            mu = f"{r['mu']:.4f}" + (f" ± {r['mu_std_error']:.4f}" if r.get("mu_std_error") else "")
+            split = r.get("work_split", {})
+            parts = [split.get(k) for k in ("mu_interface", "mu_bulk_plastic", "mu_normal_load")]
+            cells = [f"{x:.4f}" if x is not None else "" for x in parts]
+            wetted = [h.get("wetted_contact_fraction", 0.0) for d in r.get("draws", []) for h in d.get("history", [])[-1:]]
+            wet = f"{sum(wetted) / len(wetted):.2f}" if wetted else ""
+            print(f"| {law} | {p:g} | {v:g} | {t:g} | {mu} | {' | '.join(cells)} | {wet} | {r['diagnostics']['wall_seconds']:.0f} |")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    all_points = sorted({pt for rows in laws.values() for pt in rows})
+    centre = tuple(sorted({pt[i] for pt in all_points})[len({pt[i] for pt in all_points}) // 2] for i in range(3))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True)
+    for axis, (ax, label) in enumerate(zip(axes, ["contact pressure [MPa]", "sliding velocity [m/min]", "temperature [°C]"])):
+        for law, rows in laws.items():
+            xs, ys, es = [], [], []
+            for pt, r in sorted(rows.items()):
+                if all(pt[i] == centre[i] for i in range(3) if i != axis) and r.get("completed"):
+                    xs.append(pt[axis]); ys.append(r["mu"]); es.append(r.get("mu_std_error") or 0.0)
+            if xs:
+                ax.errorbar(xs, ys, yerr=[1.96 * e for e in es], marker="o", capsize=3, label=law)
+        ax.set_xlabel(label)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("mu (95 % interval of the mean over the tools)")
+    axes[0].legend()
+    fig.suptitle("mu through the box centre, per interfacial law")
+    fig.tight_layout()
+    fig.savefig(out / "friction_laws.png", dpi=110)
+    print(f"figure: {out / 'friction_laws.png'}")
+
+
+if __name__ == "__main__":
+    main()
