@@ -80,6 +80,36 @@ RoughPair rough_surfaces_in_contact() {
   return {chip_surface, SplineCurve(tool.basis(), lowered, {}, tool.shift())};
 }
 
+// The rough pair's chip perturbed at random, that state committed, then slid along x by amounts
+// that leave some points in stick and push others into slip: the state the frictional tangent
+// tests compare at.
+Eigen::VectorXd committed_then_slid(const solid::SolidProblem& problem, MortarContact& contact) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::VectorXd u(problem.dof_count());
+  for (auto& x : u) x = 2e-3 * unit(rng);
+  contact.commit(u);
+  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
+  return u;
+}
+
+// Points in contact that slip at the limit limit_of(q, P) (to 1e-12 of P) and those that stick.
+struct StickSlip {
+  int stick = 0, slip = 0;
+};
+template <class Limit>
+StickSlip count_stick_slip(const ContactState& s, Limit limit_of) {
+  StickSlip n;
+  for (size_t q = 0; q < s.point_shear.size(); ++q) {
+    const double p = s.point_pressure[q];
+    if (p <= 0.0) continue;
+    const bool slipping = std::abs(std::abs(s.point_shear[q]) - limit_of(q, p)) < 1e-12 * p;
+    slipping ? ++n.slip : ++n.stick;
+  }
+  std::cout << "points in stick " << n.stick << ", in slip " << n.slip << "\n";
+  return n;
+}
+
 TEST(MortarContact, TangentIsTheExactLinearisationOnARoughTool) {
   const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
@@ -322,17 +352,7 @@ TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
 // The tangent of Zorev's law against central differences, with points on both branches and in stick
 // (k varies along the surface so that the switch falls inside the contact).
 TEST(YieldLimitedContact, ZorevTangentIsTheExactLinearisationOnBothBranches) {
-  spline::RoughnessSpec spec;
-  spec.length = 1.0;
-  spec.ra = 0.02;
-  spec.correlation_length = 0.1;
-  spec.samples = 256;
-  const SplineCurve chip_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 2, 24).curve;
-  spec.seed = 9;
-  SplineCurve tool_surface = spline::fit_periodic_profile(spline::synthetic_rough_profile(spec), 3, 30).curve;
-  Points2 lowered = tool_surface.points();
-  lowered.col(1).array() += 0.03;
-  tool_surface = SplineCurve(tool_surface.basis(), lowered, {}, tool_surface.shift());
+  const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
                               std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
   const double mu_a = 0.3, m = 0.5;
@@ -342,12 +362,7 @@ TEST(YieldLimitedContact, ZorevTangentIsTheExactLinearisationOnBothBranches) {
   for (const auto& x : contact->surface_positions()) k.push_back(0.4 * (1.0 + std::sin(2 * std::numbers::pi * x.x())));
   contact->set_shear_strength(k);
   problem.add_interaction(contact);
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Eigen::VectorXd u(problem.dof_count());
-  for (auto& x : u) x = 2e-3 * unit(rng);
-  contact->commit(u);
-  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
+  const Eigen::VectorXd u = committed_then_slid(problem, *contact);
   const ContactState s = contact->state(u);
   int stick = 0, coulomb_branch = 0, shear_branch = 0;
   for (size_t q = 0; q < s.point_shear.size(); ++q) {
@@ -428,23 +443,10 @@ TEST(CoulombContact, TangentIsTheExactLinearisationInStickAndSlip) {
   const double mu_a = 0.3;
   auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, coulomb(mu_a, 50.0));
   problem.add_interaction(contact);
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Eigen::VectorXd u(problem.dof_count());
-  for (auto& x : u) x = 2e-3 * unit(rng);
-  contact->commit(u);
-  // Slide the chip along x by amounts that leave some points in stick and push others into slip.
-  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
-  const ContactState s = contact->state(u);
-  int stick = 0, slip = 0;
-  for (size_t q = 0; q < s.point_shear.size(); ++q) {
-    if (s.point_pressure[q] <= 0.0) continue;
-    const bool slipping = std::abs(std::abs(s.point_shear[q]) - mu_a * s.point_pressure[q]) < 1e-12 * s.point_pressure[q];
-    slipping ? ++slip : ++stick;
-  }
-  std::cout << "points in stick " << stick << ", in slip " << slip << "\n";
-  ASSERT_GT(stick, 3);
-  ASSERT_GT(slip, 3);
+  const Eigen::VectorXd u = committed_then_slid(problem, *contact);
+  const StickSlip n = count_stick_slip(contact->state(u), [&](size_t, double p) { return mu_a * p; });
+  ASSERT_GT(n.stick, 3);
+  ASSERT_GT(n.slip, 3);
   EXPECT_EQ(problem.tangent_storage(), numerics::MatrixStorage::full);
   solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "coulomb contact", 1e-5);
 }
@@ -557,23 +559,11 @@ TEST(TableContact, TangentIsTheExactLinearisationWithAPressureDependentMu) {
   auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, law);
   contact->set_surface_temperature(std::vector<double>(contact->surface_positions().size(), 300.0));
   problem.add_interaction(contact);
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Eigen::VectorXd u(problem.dof_count());
-  for (auto& x : u) x = 2e-3 * unit(rng);
-  contact->commit(u);
-  for (Eigen::Index i = 0; i < u.size(); i += 2) u(i) += 2e-3 * (1.0 + unit(rng));
-  const ContactState s = contact->state(u);
-  int stick = 0, slip = 0;
-  for (size_t q = 0; q < s.point_shear.size(); ++q) {
-    if (s.point_pressure[q] <= 0.0) continue;
-    const double mu_a = law.table->at(s.point_pressure[q], 1.0, 300.0).mu;
-    const bool slipping = std::abs(std::abs(s.point_shear[q]) - mu_a * s.point_pressure[q]) < 1e-12 * s.point_pressure[q];
-    slipping ? ++slip : ++stick;
-  }
-  std::cout << "points in stick " << stick << ", in slip " << slip << "\n";
-  ASSERT_GT(stick, 3);
-  ASSERT_GT(slip, 3);
+  const Eigen::VectorXd u = committed_then_slid(problem, *contact);
+  const StickSlip n =
+      count_stick_slip(contact->state(u), [&](size_t, double p) { return law.table->at(p, 1.0, 300.0).mu * p; });
+  ASSERT_GT(n.stick, 3);
+  ASSERT_GT(n.slip, 3);
   solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "table contact", 1e-5);
 }
 
