@@ -215,6 +215,7 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
   const double offset_parameter = g.parameter - *anchor_[q];
   const double offset = speed * offset_parameter;
   const double trial = -law_.tangential_penalty * offset;
+  s.trial = trial;
   // The slip limit: μ_a P (Coulomb, or the table's μ_a(P, v, T)), m k (shear factor) or the lower of
   // the first and the second (Zorev), with its slope in P for the tangent.
   double limit = law_.adhesive_coefficient * pressure;
@@ -289,12 +290,10 @@ void MortarContact::commit(const Eigen::VectorXd& u) {
     if (s.regime == PointShear::Regime::slip) {
       // Return map: the anchor follows so that −ε_t g_t is the slip shear. The slip it makes,
       // (|τ_trial| − |τ|)/ε_t, against the shear |τ| is the energy the point dissipates.
-      const double speed = g[q].d1.norm();
-      const double trial = -law_.tangential_penalty * speed * (g[q].parameter - *anchor_[q]);
-      step_dissipation_[q] = points_[q].weight * std::abs(s.shear) * (std::abs(trial) - std::abs(s.shear)) /
+      step_dissipation_[q] = points_[q].weight * std::abs(s.shear) * (std::abs(s.trial) - std::abs(s.shear)) /
                              law_.tangential_penalty;
       step_dissipated_energy_ += step_dissipation_[q];
-      anchor_[q] = g[q].parameter + s.shear / (law_.tangential_penalty * speed);
+      anchor_[q] = g[q].parameter + s.shear / (law_.tangential_penalty * g[q].d1.norm());
     } else {
       anchor_[q] = g[q].parameter;  // out of contact (or just touching): stress-free where it is
     }

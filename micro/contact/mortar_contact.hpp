@@ -139,6 +139,7 @@ class MortarContact final : public solid::BoundaryInteraction {
   struct PointShear {
     enum class Regime { none, stick, slip } regime = Regime::none;
     double shear = 0.0;                                     // τ, Pa
+    double trial = 0.0;                                     // the trial shear −ε_t g_t, Pa (its slip: |trial| − |τ| over ε_t)
     Eigen::Vector2d shear_gradient = Eigen::Vector2d::Zero();  // stick: ∂τ/∂x
     double slip_sign = 0.0;                                 // slip: τ = slip_sign × the limit
     double limit_slope = 0.0;  // slip: ∂(limit)/∂P, μ_a (+ P ∂μ_a/∂P for a table); 0 at m k (fixed in a step)

@@ -123,6 +123,9 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
     const Sparse symmetric_part = 0.5 * (a + Sparse(a.transpose()));
     if (factorize_cholesky(symmetric_part)) {
       method_ = Method::preconditioned_krylov;
+      impl_->krylov.setMaxIterations(kKrylovMaxIterations);
+      impl_->krylov.compute(impl_->unsymmetric);
+      impl_->krylov.preconditioner().use(&impl_->cholesky);
       return true;
     }
   } else if (factorize_cholesky(a)) {
@@ -173,9 +176,6 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b, double relative_to
   }
   auto& krylov = impl_->krylov;
   krylov.setTolerance(relative_tolerance > 0.0 ? relative_tolerance : kKrylovTolerance);
-  krylov.setMaxIterations(kKrylovMaxIterations);
-  krylov.compute(impl_->unsymmetric);
-  krylov.preconditioner().use(&impl_->cholesky);
   Eigen::VectorXd x = krylov.solveWithGuess(b, Eigen::VectorXd(impl_->cholesky.solve(b)));
   krylov_iterations_ += static_cast<int>(krylov.iterations());
   if (krylov.info() == Eigen::Success) return x;
