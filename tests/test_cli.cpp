@@ -572,14 +572,15 @@ TEST_F(Cli, MicroRunWritesItsResultAndNamesBadSceneKeys) {
     const nlohmann::json result = nlohmann::json::parse(json);
     std::ifstream csv(path("run") + "/contact.csv");
     std::getline(csv, line);
-    EXPECT_EQ(line, "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,shear_pa,normal_x,normal_y");
+    EXPECT_EQ(line, "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,shear_pa,normal_x,normal_y,wetted");
     double force_x = 0.0, force_y = 0.0;
     int rows = 0, searched = 0;
     while (std::getline(csv, line)) {
       std::vector<std::string> field;
       std::stringstream row(line);
       for (std::string f; std::getline(row, f, ',');) field.push_back(f);
-      ASSERT_EQ(field.size(), 9U) << line;
+      ASSERT_EQ(field.size(), 10U) << line;
+      EXPECT_EQ(field[9], "0") << "a dry run wets no spot: " << line;
       ++rows;
       searched += !field[4].empty();
       // (pressure n + shear t) × reference length, N/m, with t = (−n_y, n_x)

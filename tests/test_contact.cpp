@@ -349,6 +349,75 @@ TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
   }
 }
 
+// The slid flat chip with half its points wetted: in slip a wetted point carries the law's wetted
+// coefficient (μ_wet p for Coulomb, m_wet k for the shear factor, μ_wet p for a table whose dry μ_a is
+// higher), a dry one the dry coefficient (closed forms); the state reports which points are wetted and
+// their length in contact; unset, every point is dry again.
+TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
+  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0;
+  const double mu_a = 0.3, m = 0.5, k = 2e-3, mu_wet = 0.05, m_wet = 0.1;
+  const auto table_path = std::filesystem::temp_directory_path() / "mufric_wetted_table.csv";
+  {
+    std::ofstream t(table_path);
+    t << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],mu_a\n";
+    for (const char* p : {"0", "1"}) {
+      for (const char* v : {"0", "10"}) {
+        for (const char* T : {"1", "2000"}) t << p << "," << v << "," << T << ",0.4\n";
+      }
+    }
+  }
+  struct Case {
+    InterfaceLaw law;
+    double dry_limit, wet_limit;  // the slip shear of a dry and of a wetted point
+  };
+  InterfaceLaw table;
+  table.kind = InterfaceLaw::Kind::table;
+  table.table = std::make_shared<const AdhesionTable>(AdhesionTable::read(table_path.string()));
+  table.tangential_penalty = tangential;
+  const std::vector<Case> cases = {
+      {coulomb(mu_a, tangential), mu_a * pressure, mu_wet * pressure},
+      {yield_limited(InterfaceLaw::Kind::shear_factor, m, 0.0, tangential), m * k, m_wet * k},
+      {table, 0.4 * pressure, mu_wet * pressure}};
+  for (Case c : cases) {
+    c.law.wetted = WettedCoefficients{.adhesive_coefficient = mu_wet, .shear_factor = m_wet};
+    solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
+                             std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+    chip.fix_side(numerics::Side::bottom, 0);
+    chip.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+    auto contact = std::make_shared<MortarContact>(chip.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
+                                                   penalty, 0, c.law);
+    const std::vector<Eigen::Vector2d> at = contact->surface_positions();
+    contact->set_shear_strength(std::vector<double>(at.size(), k));
+    contact->set_surface_temperature(std::vector<double>(at.size(), 300.0));
+    std::vector<char> wetted(at.size(), 0);
+    for (size_t q = 0; q < at.size(); ++q) wetted[q] = at[q].x() < 0.5 * period ? 1 : 0;
+    EXPECT_THROW(contact->set_wetted(std::vector<char>(at.size() + 1, 1)), Error);
+    contact->set_wetted(wetted);
+    chip.add_interaction(contact);
+    const Eigen::VectorXd pressed = solid::test::solve_static(chip);
+    contact->commit(pressed);
+    const double d = 3.0 * std::max(c.dry_limit, c.wet_limit) / tangential;  // slip everywhere
+    Eigen::VectorXd slid = pressed;
+    for (Eigen::Index i = 0; i < slid.size(); i += 2) slid(i) += d;
+    const ContactState s = contact->state(slid);
+    double wetted_length = 0.0;
+    for (size_t q = 0; q < s.point_shear.size(); ++q) {
+      EXPECT_EQ(s.point_wetted[q], wetted[q]);
+      const double expected = -(wetted[q] != 0 ? c.wet_limit : c.dry_limit);
+      EXPECT_NEAR(s.point_shear[q], expected, 1e-9 * c.dry_limit) << "x " << s.point_x[q];
+      if (wetted[q] != 0) wetted_length += s.point_weight[q];
+    }
+    EXPECT_NEAR(s.wetted_contact_length, wetted_length, 1e-12);
+    EXPECT_GT(wetted_length, 0.0);
+    EXPECT_LT(wetted_length, s.contact_length - 0.1);
+    contact->set_wetted({});
+    const ContactState dry = contact->state(slid);
+    for (size_t q = 0; q < dry.point_shear.size(); ++q) EXPECT_NEAR(dry.point_shear[q], -c.dry_limit, 1e-9 * c.dry_limit);
+    EXPECT_EQ(dry.wetted_contact_length, 0.0);
+  }
+  std::filesystem::remove(table_path);
+}
+
 // The tangent of Zorev's law against central differences, with points on both branches and in stick
 // (k varies along the surface so that the switch falls inside the contact).
 TEST(YieldLimitedContact, ZorevTangentIsTheExactLinearisationOnBothBranches) {

@@ -340,6 +340,32 @@ TEST(Pockets, RunsBetweenSpotsWrapAroundThePeriod) {
   EXPECT_EQ(runs[1], (std::vector<size_t>{6, 0, 1}));
 }
 
+// A spot run is wetted, whole, when liquid touches the wall at one of its two edges (brute force over
+// the cases): spots {2, 3} between pockets 1 and 4, spot {6} between 5 and 0 (across the period's end).
+TEST(Pockets, ASpotIsWettedWhenLiquidHoldsAtOneOfItsEdges) {
+  std::vector<FilmSample> film(7, FilmSample{1e-7, 1e-6, 1e-6, false, 0.0, 0.0});
+  film[2].spot = film[3].spot = film[6].spot = true;
+  const std::vector<char> none(7, 0);
+  EXPECT_EQ(wetted_spots(film, none), none);  // no liquid at any edge
+  for (size_t liquid = 0; liquid < 7; ++liquid) {
+    std::vector<char> at_wall(7, 0);
+    at_wall[liquid] = 1;
+    const std::vector<char> wetted = wetted_spots(film, at_wall);
+    const bool first_run = liquid == 1 || liquid == 4, second_run = liquid == 5 || liquid == 0;
+    EXPECT_EQ(wetted, (std::vector<char>{0, 0, first_run, first_run, 0, 0, second_run})) << "liquid at " << liquid;
+  }
+  // Liquid deep inside a pocket but not at its edges wets nothing: pockets of two samples each side.
+  std::vector<FilmSample> wide(8, FilmSample{1e-7, 1e-6, 1e-6, false, 0.0, 0.0});
+  wide[0].spot = wide[4].spot = true;
+  std::vector<char> inside(8, 0);
+  inside[2] = inside[6] = 1;
+  EXPECT_EQ(wetted_spots(wide, inside), std::vector<char>(8, 0));
+  // Without pockets there is no edge; and a flag per sample is required.
+  std::vector<FilmSample> all_spot(3, FilmSample{1e-9, 1e-6, 1e-6, true, 0.0, 0.0});
+  EXPECT_EQ(wetted_spots(all_spot, std::vector<char>(3, 1)), std::vector<char>(3, 0));
+  EXPECT_THROW(wetted_spots(film, std::vector<char>(6, 1)), Error);
+}
+
 TEST(CavitatingFilm, TheLiquidThatRunsPastAClosingCavityFillsTheNearestCavities) {
   // Five samples of 1 µm; samples 0 and 3 are spots, formed as cavities of 2 and 3 nm (× 1 µm). In
   // 1 ns the wall at sample 0 comes back 3 nm: its cavity closes, and 1 nm × 1 µm of liquid ran on

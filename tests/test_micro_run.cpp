@@ -103,6 +103,28 @@ TEST(Scene, ErrorsNameTheKey) {
   EXPECT_EQ(frictionless.interface_law.kind, contact::InterfaceLaw::Kind::frictionless);
   ASSERT_EQ(frictionless.warnings.size(), 1U);
   EXPECT_NE(frictionless.warnings[0].find("contact.adhesive_coefficient"), std::string::npos);
+  // Wetted spots: their coefficients (literature defaults) in a lubricated scene with a frictional
+  // law; a dry scene or the frictionless law says they have no effect.
+  nlohmann::json wet = coulomb;
+  apply_override(wet, "physics=\"lubricated\"");
+  const Scene wetted_default = parse_scene(wet, "s");
+  ASSERT_TRUE(wetted_default.interface_law.wetted.has_value());
+  EXPECT_DOUBLE_EQ(wetted_default.interface_law.wetted->adhesive_coefficient, contact::kDefaultWettedAdhesiveCoefficient);
+  EXPECT_DOUBLE_EQ(wetted_default.interface_law.wetted->shear_factor, contact::kDefaultWettedShearFactor);
+  apply_override(wet, "contact.wetted.adhesive_coefficient=0.03");
+  EXPECT_DOUBLE_EQ(parse_scene(wet, "s").interface_law.wetted->adhesive_coefficient, 0.03);
+  apply_override(wet, "contact.wetted.shear_factor=1.2");
+  EXPECT_NE(error_of(wet).find("contact.wetted.shear_factor"), std::string::npos) << error_of(wet);
+  apply_override(wet, "contact.wetted.shear_factor=0.1");
+  apply_override(wet, "contact.wetted.viscosity=0.1");
+  EXPECT_NE(error_of(wet).find("contact.wetted.viscosity: unknown key"), std::string::npos) << error_of(wet);
+  nlohmann::json dry_wetted = coulomb;
+  apply_override(dry_wetted, "contact.wetted.adhesive_coefficient=0.03");
+  const Scene dry_scene = parse_scene(dry_wetted, "s");
+  EXPECT_FALSE(dry_scene.interface_law.wetted.has_value());
+  ASSERT_EQ(dry_scene.warnings.size(), 1U);
+  EXPECT_NE(dry_scene.warnings[0].find("contact.wetted"), std::string::npos) << dry_scene.warnings[0];
+  EXPECT_FALSE(parse_scene(j, "s").interface_law.wetted.has_value());
   nlohmann::json kelvin = j;
   apply_override(kelvin, "load.temperature=500K");
   EXPECT_DOUBLE_EQ(parse_scene(kelvin, "s").temperature, 500.0);
@@ -547,6 +569,50 @@ TEST(Lubricated, ALeakingFilmKeepsItsBooks) {
       EXPECT_LT(std::abs(l.leaked_area), 1e-6 * l.exchanged_area);
     }
   }
+}
+
+// Wetted spots end to end (the small scene, one tool, the default lubricant: it fills the gap after
+// pressing): with Coulomb μ_a = 0.3 at dry spots, no spot is wetted while the chip is pressed dry,
+// spots are once the film has formed; wetted spots at μ_a = 0 (against the same run with the wetted
+// coefficient equal to the dry one, i.e. plain Coulomb) lower μ and the interface's dissipation
+// per unit slide, by about the wetted share of the contact — the adhesive part goes where the film goes.
+TEST(Lubricated, WettedSpotsTakeTheWettedLaw) {
+  nlohmann::json j = small_press_slide();
+  for (const char* s : {"protocol.phases=1", "physics=\"lubricated\"", "contact.law=\"coulomb\"",
+                        "contact.adhesive_coefficient=0.3"}) {
+    apply_override(j, s);
+  }
+  struct Run {
+    MicroResult result;
+    double mean_wetted_share = 0.0;  // over the steps with a film
+  };
+  const auto run = [&](double wetted_mu) {
+    nlohmann::json k = j;
+    apply_override(k, "contact.wetted.adhesive_coefficient=" + std::to_string(wetted_mu));
+    Run r{run_micro(parse_scene(k, "wetted mu_a " + std::to_string(wetted_mu)))};
+    EXPECT_TRUE(r.result.completed) << r.result.reason;
+    int film_steps = 0;
+    for (const auto& step : r.result.history) {
+      if (!step.lubricant) {
+        EXPECT_EQ(step.wetted_contact_fraction, 0.0) << "before the film forms, t = " << step.time;
+        continue;
+      }
+      r.mean_wetted_share += step.wetted_contact_fraction;
+      ++film_steps;
+    }
+    EXPECT_GT(film_steps, 0);
+    r.mean_wetted_share /= std::max(film_steps, 1);
+    return r;
+  };
+  const Run plain = run(0.3), wetted = run(0.0);
+  ASSERT_TRUE(plain.result.mu_interface_work && wetted.result.mu_interface_work);
+  const double share = wetted.mean_wetted_share;
+  std::cout << "mu " << plain.result.mu << " -> " << wetted.result.mu << ", interface work " << *plain.result.mu_interface_work
+            << " -> " << *wetted.result.mu_interface_work << ", wetted share of the contact " << plain.mean_wetted_share
+            << " / " << share << "\n";
+  EXPECT_GT(share, 0.2);
+  EXPECT_LT(wetted.result.mu, plain.result.mu - 0.5 * share * 0.3);
+  EXPECT_LT(*wetted.result.mu_interface_work, (1.0 - 0.5 * share) * *plain.result.mu_interface_work);
 }
 
 TEST(Lubricated, TheDefaultLubricatedSceneIsTheDryOneWithTheLubricant) {

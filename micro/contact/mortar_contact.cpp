@@ -19,6 +19,12 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
   if (!(law_.shear_factor >= 0.0 && law_.shear_factor <= 1.0)) throw Error("contact: the shear factor must be in [0, 1]");
   if (!(law_.heat_partition >= 0.0 && law_.heat_partition <= 1.0)) throw Error("contact: the heat partition must be in [0, 1]");
   if (law_.kind == InterfaceLaw::Kind::table && !law_.table) throw Error("contact: the table law needs its adhesion table");
+  if (law_.wetted && !(law_.wetted->adhesive_coefficient >= 0.0)) {
+    throw Error("contact: the wetted adhesive coefficient must be >= 0");
+  }
+  if (law_.wetted && !(law_.wetted->shear_factor >= 0.0 && law_.wetted->shear_factor <= 1.0)) {
+    throw Error("contact: the wetted shear factor must be in [0, 1]");
+  }
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
   const auto& basis = tool_.surface.basis();
@@ -217,16 +223,20 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
   const double trial = -law_.tangential_penalty * offset;
   s.trial = trial;
   // The slip limit: μ_a P (Coulomb, or the table's μ_a(P, v, T)), m k (shear factor) or the lower of
-  // the first and the second (Zorev), with its slope in P for the tangent.
-  double limit = law_.adhesive_coefficient * pressure;
-  double limit_slope = law_.adhesive_coefficient;
-  if (law_.kind == InterfaceLaw::Kind::table) {
+  // the first and the second (Zorev), with its slope in P for the tangent; a wetted spot's μ_a and m
+  // are the law's wetted coefficients.
+  const bool wet = law_.wetted && wetted(q);
+  const double adhesive_coefficient = wet ? law_.wetted->adhesive_coefficient : law_.adhesive_coefficient;
+  const double shear_factor = wet ? law_.wetted->shear_factor : law_.shear_factor;
+  double limit = adhesive_coefficient * pressure;
+  double limit_slope = adhesive_coefficient;
+  if (law_.kind == InterfaceLaw::Kind::table && !wet) {
     const AdhesionTable::Value mu = law_.table->at(pressure, law_.sliding_velocity, surface_temperature_[q]);
     limit = mu.mu * pressure;
     limit_slope = mu.mu + pressure * mu.dmu_dpressure;
   }
   if (law_.needs_shear_strength()) {
-    const double yield_shear = law_.shear_factor * shear_strength_[q];
+    const double yield_shear = shear_factor * shear_strength_[q];
     if (law_.kind == InterfaceLaw::Kind::shear_factor || yield_shear < limit) {
       limit = yield_shear;
       limit_slope = 0.0;
@@ -253,6 +263,14 @@ void MortarContact::set_surface_temperature(std::vector<double> temperature) {
                 " surface points");
   }
   surface_temperature_ = std::move(temperature);
+}
+
+void MortarContact::set_wetted(std::vector<char> wetted) {
+  if (!wetted.empty() && wetted.size() != points_.size()) {
+    throw Error("contact: " + std::to_string(wetted.size()) + " wetted flags for " + std::to_string(points_.size()) +
+                " surface points");
+  }
+  wetted_ = std::move(wetted);
 }
 
 void MortarContact::set_shear_strength(std::vector<double> k) {
@@ -430,7 +448,9 @@ ContactState MortarContact::state(const Eigen::VectorXd& u) const {
     s.point_shear.push_back(shear.shear);
     s.point_normal.push_back(g[q].normal);
     s.point_gap.push_back(g[q].evaluated ? std::optional<double>(g[q].gap) : std::nullopt);
+    s.point_wetted.push_back(wetted(q) ? 1 : 0);
     if (pq <= 0.0) continue;
+    if (wetted(q)) s.wetted_contact_length += sp.weight;
     s.force += pq * sp.weight * g[q].normal;  // the tool pushes the chip along its outward normal
     if (shear.regime != PointShear::Regime::none) s.force += shear.shear * sp.weight * unit_tangent(g[q]);
     s.contact_length += sp.weight;

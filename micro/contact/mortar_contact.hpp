@@ -45,6 +45,27 @@ inline constexpr double kDefaultHeatPartition = 0.5;
 // cutting codes).
 // `table`: |τ| ≤ μ_a(P, v, T) P with μ_a from an AdhesionTable at the point's pressure, the scene's
 // sliding velocity and the chip's temperature there (given by the owner through set_surface_temperature).
+//
+// A contact spot the lubricant reaches (wetted: set by the owner through set_wetted) shears through a
+// boundary film instead of the bare metal junction: its law keeps its kind but takes the wetted
+// coefficients — μ_a for Coulomb, Zorev and the table (a wetted spot's μ_a is the film's constant,
+// the table being the dry junction's), m for shear-factor and Zorev (Williams & Tabor 1977, Wear 43:275,
+// and Williams 1977, J. Mech. Eng. Sci. 19:202: cutting fluids act by reaching the junctions through
+// capillaries and forming boundary films on them).
+// A straight cutting oil between AISI 4140 and a TiN-coated carbide pin brings μ to about 0.1,
+// independent of the sliding velocity, at ~3 GPa (dry: falling with the velocity to about 0.2) —
+// Claudin, Mondelin, Rech & Fromentin 2010, Int. J. Mach. Tools Manuf. 50:681; the boundary-lubrication
+// range of Bowden & Tabor (The Friction and Lubrication of Solids, 1950) brackets it.
+inline constexpr double kDefaultWettedAdhesiveCoefficient = 0.1;
+// Lubricated metal forming's friction factor, m ≈ 0.05–0.3 by ring compression (Kobayashi, Oh & Altan,
+// Metal Forming and the Finite-Element Method, 1989, sec. 5.4; Male & Cockcroft 1964): 0.2 is that of
+// a lubricated steel.
+inline constexpr double kDefaultWettedShearFactor = 0.2;
+struct WettedCoefficients {
+  double adhesive_coefficient = kDefaultWettedAdhesiveCoefficient;  // μ_a at a wetted spot
+  double shear_factor = kDefaultWettedShearFactor;                  // m at a wetted spot
+};
+
 struct InterfaceLaw {
   enum class Kind { frictionless, coulomb, shear_factor, zorev, table };
   Kind kind = Kind::frictionless;
@@ -54,6 +75,8 @@ struct InterfaceLaw {
   double shear_factor = 0.0;          // m (shear-factor, zorev)
   double tangential_penalty = 0.0;    // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
   double heat_partition = kDefaultHeatPartition;  // β: the share of the interface's frictional heat the chip receives
+  // The coefficients at wetted spots (lubricated scenes); none: every spot takes the dry ones.
+  std::optional<WettedCoefficients> wetted;
   bool needs_shear_strength() const { return kind == Kind::shear_factor || kind == Kind::zorev; }
   bool needs_temperature() const { return kind == Kind::table; }
 };
@@ -80,6 +103,10 @@ struct ContactState {
   std::vector<double> point_x, point_weight, point_pressure, point_shear;
   std::vector<Eigen::Vector2d> point_position, point_normal;
   std::vector<std::optional<double>> point_gap;
+  // Per point, whether it takes the wetted law (set_wetted), and the reference length of the points
+  // in contact that do.
+  std::vector<char> point_wetted;
+  double wetted_contact_length = 0.0;
 };
 
 class MortarContact final : public solid::BoundaryInteraction {
@@ -111,6 +138,11 @@ class MortarContact final : public solid::BoundaryInteraction {
   void set_shear_strength(std::vector<double> k);
   // The chip's temperature at each surface point (K, same order), for the table law; held until set again.
   void set_surface_temperature(std::vector<double> temperature);
+  // Which surface points (same order) the lubricant reaches: those take the law's wetted
+  // coefficients. Held until set again, like k (the owner refreshes it after each accepted step);
+  // an empty vector: none is wetted.
+  void set_wetted(std::vector<char> wetted);
+  bool wetted(size_t point) const { return point < wetted_.size() && wetted_[point] != 0; }
   // Reference position of each surface quadrature point.
   std::vector<Eigen::Vector2d> surface_positions() const;
   ContactState state(const Eigen::VectorXd& u) const;
@@ -169,6 +201,7 @@ class MortarContact final : public solid::BoundaryInteraction {
   std::vector<std::optional<double>> anchor_;
   std::vector<double> shear_strength_;  // k per surface point (shear-factor, zorev)
   std::vector<double> surface_temperature_;  // T per surface point, K (table)
+  std::vector<char> wetted_;  // per surface point: takes law_.wetted (empty: none does)
   std::vector<double> step_dissipation_;  // per surface point, J/m, in the last accepted step
   double step_dissipated_energy_ = 0.0, dissipated_energy_ = 0.0;
   std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once

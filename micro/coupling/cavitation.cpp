@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "common/error.hpp"
+
 namespace mufric::coupling {
 
 std::vector<std::vector<size_t>> pocket_runs(const std::vector<FilmSample>& samples) {
@@ -34,6 +36,27 @@ std::vector<std::vector<size_t>> pocket_runs(const std::vector<FilmSample>& samp
   }
   if (!open.empty()) runs.push_back(std::move(open));
   return runs;
+}
+
+std::vector<char> wetted_spots(const std::vector<FilmSample>& samples, const std::vector<char>& liquid_at_wall) {
+  const size_t n = samples.size();
+  if (liquid_at_wall.size() != n) throw Error("wetted spots: one liquid flag per film sample is needed");
+  std::vector<char> wetted(n, 0);
+  const auto pocket_with_liquid = [&](size_t q) { return !samples[q].spot && liquid_at_wall[q] != 0; };
+  for (size_t start = 0; start < n; ++start) {
+    // A spot run starts where the sample before it (periodically) is a pocket sample.
+    const size_t before = (start + n - 1) % n;
+    if (!samples[start].spot || samples[before].spot) continue;
+    size_t end = start;  // the run's last sample
+    while (samples[(end + 1) % n].spot) end = (end + 1) % n;
+    const size_t after = (end + 1) % n;
+    if (!pocket_with_liquid(before) && !pocket_with_liquid(after)) continue;
+    for (size_t q = start;; q = (q + 1) % n) {
+      wetted[q] = 1;
+      if (q == end) break;
+    }
+  }
+  return wetted;
 }
 
 void CavitatingFilm::form(const std::vector<FilmSample>& samples) {

@@ -37,6 +37,13 @@ struct FilmSample {
 // first; without any spot, the whole row is one pocket.
 std::vector<std::vector<size_t>> pocket_runs(const std::vector<FilmSample>& samples);
 
+// The contact spots the lubricant reaches: a run of spot samples is wetted, all of it, when the
+// pocket sample at either of its ends has liquid against the wall (`liquid_at_wall`, per sample: not
+// cavitated) — the liquid at a junction's edge is drawn into it by capillarity and forms a boundary
+// film over it (Williams & Tabor 1977, Wear 43:275; Williams 1977, J. Mech. Eng. Sci. 19:202). A row
+// without pockets has no edge for liquid: no spot is wetted. Per sample, 1 where wetted.
+std::vector<char> wetted_spots(const std::vector<FilmSample>& samples, const std::vector<char>& liquid_at_wall);
+
 // The liquid's volume is the film's area less its cavities' and is kept by the books: the cavities
 // are areas (m² per unit depth) at the wall samples, grown by the wall's opening rate times the
 // sample's wall length (a thickness times a length that changes as the chip's surface stretches

@@ -72,6 +72,23 @@ size_t LubricatedChip::sample_at(double parameter) const {
   return static_cast<size_t>(std::min<std::ptrdiff_t>(it - p.begin(), static_cast<std::ptrdiff_t>(p.size()) - 1));
 }
 
+bool LubricatedChip::wetted_at(double x) const {
+  if (wetted_.empty()) return false;
+  // The film's columns stand at x = u over one period [lo, hi): the nearest sample to x wrapped into it.
+  const auto& basis = fluid_->space().patch().u_basis();
+  const double lo = basis.lo(), period = basis.hi() - basis.lo();
+  const double u = lo + std::fmod(std::fmod(x - lo, period) + period, period);
+  const auto& p = bottom_parameters_;
+  const auto right = static_cast<size_t>(std::lower_bound(p.begin(), p.end(), u) - p.begin());
+  const size_t n = p.size();
+  const size_t after = right % n, before = (right + n - 1) % n;
+  const auto distance = [&](size_t q) {
+    const double d = std::abs(p[q] - u);
+    return std::min(d, period - d);
+  };
+  return wetted_[distance(before) <= distance(after) ? before : after] != 0;
+}
+
 std::vector<FilmSample> LubricatedChip::film_samples() const {
   const fluid::FluidSpace& space = fluid_->space();
   const auto& points = space.side_points(Side::bottom);
@@ -331,6 +348,9 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
     }
   }
   current_.liquid_area = liquid_area();
+  std::vector<char> liquid_at_wall(samples.size(), 1);
+  for (size_t q = 0; q < samples.size(); ++q) liquid_at_wall[q] = cavitation_ && cavitation_->cavitated(q) ? 0 : 1;
+  wetted_ = wetted_spots(samples, liquid_at_wall);
   history_.push_back(current_);
   return true;
 }

@@ -106,6 +106,10 @@ class LubricatedChip {
   // The film's area (m² per unit depth) when it formed (0 before).
   double formed_film_area() const { return formed_film_area_; }
   double formed_liquid_area() const { return formed_liquid_area_; }  // the film's less its cavities', when formed
+  // Whether the film wets the contact spot at x (current position along the chip, any period): the
+  // film sample nearest x is a wetted spot (wetted_spots) after the last accepted step. None is before
+  // the film forms.
+  bool wetted_at(double x) const;
   // The film's traction on the chip transferred in the last accepted step, as nodal forces.
   const Eigen::VectorXd& nodal_forces() const { return load_->forces(); }
 
@@ -149,6 +153,7 @@ class LubricatedChip {
   double last_accepted_dt_ = 0.0;
   double mismatch_area_ = 0.0;  // m² per unit depth, signed: the last fluid solve's liquid through the full wall
   double volume_error_ = 0.0;  // liquid the last fluid solve's velocity mismatch makes in the step, relative
+  std::vector<char> wetted_;  // per bottom sample, wetted spots after the last accepted step (empty: none)
   bool film_formed_ = false;
   double formed_film_area_ = 0.0, formed_liquid_area_ = 0.0;
 };

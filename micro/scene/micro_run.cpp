@@ -193,6 +193,7 @@ nlohmann::json MicroResult::to_json(const Scene& scene, bool provenance) const {
                  {"leaked_area_m2_per_m", film.leaked_area},
                  {"film_volume_error", film.volume_error},
                  {"contact_area_fraction", s.contact_fraction},
+                 {"wetted_contact_fraction", s.wetted_contact_fraction},
                  {"max_contact_pressure_pa", s.max_pressure},
                  {"interface_dissipation_j_per_m", s.interface_dissipation},
                  {"plastic_work_j_per_m", s.plastic_work},
@@ -338,6 +339,17 @@ void refresh_chip_state_at_contact(const Scene& scene, const LoadedChip& chip) {
   }
   if (scene.interface_law.needs_shear_strength()) chip.contact->set_shear_strength(std::move(k));
   if (scene.interface_law.needs_temperature()) chip.contact->set_surface_temperature(std::move(temperature));
+}
+
+// The contact points the lubricant wets after the last accepted step (their current positions in
+// `contact`, that step's state), for the law's wetted coefficients in the next step — lagged a step
+// like k and T.
+void refresh_wetted_contact(const Scene& scene, const LoadedChip& chip, const coupling::LubricatedChip* lubricant,
+                            const contact::ContactState& contact) {
+  if (lubricant == nullptr || !scene.interface_law.wetted) return;
+  std::vector<char> wetted(contact.point_position.size(), 0);
+  for (size_t q = 0; q < wetted.size(); ++q) wetted[q] = lubricant->wetted_at(contact.point_position[q].x()) ? 1 : 0;
+  chip.contact->set_wetted(std::move(wetted));
 }
 
 std::vector<size_t> nearest_quadrature_points(const solid::IgaSpace& space, const std::vector<Eigen::Vector2d>& at) {
@@ -532,6 +544,9 @@ class StepRecorder {
     }
     if (step.force.y() != 0.0) step.mu = step.force.x() / step.force.y();  // eq. (17)
     step.contact_fraction = last_contact_.contact_length / last_contact_.surface_length;
+    if (last_contact_.contact_length > 0.0) {
+      step.wetted_contact_fraction = last_contact_.wetted_contact_length / last_contact_.contact_length;
+    }
     step.max_pressure = last_contact_.max_pressure;
     step.interface_dissipation = contact_.dissipated_energy();
     step.plastic_work = plastic_work_ += step_plastic_work(view.problem);
@@ -698,6 +713,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   result.solver = integrator.run([&](const solid::StepView& view) {
     const MicroStep& step = recorder.record(view);
     refresh_chip_state_at_contact(scene, chip);  // after the step's own record: the next step's k and T
+    refresh_wetted_contact(scene, chip, lubricant.get(), recorder.last_contact());  // and its wetted spots
     if (options.on_step) options.on_step(step, scene);
     limit.check_accepted_step(step, recorder.history().size());
   });

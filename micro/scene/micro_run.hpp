@@ -30,6 +30,8 @@ struct MicroStep {
   // chip, coupling work, film, pockets, cavities, liquid), as the coupled step wrote it.
   std::optional<coupling::LubricatedStep> lubricant;
   double contact_fraction = 0.0;                    // of the interval's surface length
+  // Of the length in contact, the part whose spots the lubricant wets (they take the wetted law; 0 dry).
+  double wetted_contact_fraction = 0.0;
   double max_pressure = 0.0;                        // Pa
   int newton_iterations = 0;
   // Since the start, J per unit depth: the energy the interfacial law dissipated at the contact, and

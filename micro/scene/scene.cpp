@@ -390,6 +390,22 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     law.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
     // The share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
     law.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, 0.0, 1.0);
+    // Wetted spots (lubricated scenes with a frictional law): the law's coefficients where the film
+    // reaches a contact spot; the defaults are contact::kDefaultWetted* (their sources are there).
+    const bool wets = law.kind != Kind::frictionless && s.physics == Physics::lubricated;
+    if (c.has("wetted") && !wets) {
+      s.warnings.push_back(std::string("contact.wetted is read but has no effect: ") +
+                           (law.kind == Kind::frictionless ? "contact.law is frictionless"
+                                                           : "the scene's physics is dry (no film wets a spot)"));
+    }
+    {
+      Section w = c.child("wetted");
+      contact::WettedCoefficients wetted;
+      wetted.adhesive_coefficient = w.number("adhesive_coefficient", wetted.adhesive_coefficient, 0.0, 5.0);
+      wetted.shear_factor = w.number("shear_factor", wetted.shear_factor, 0.0, 1.0);
+      w.finish();
+      if (wets) law.wetted = wetted;
+    }
     if (law.kind != Kind::frictionless && !s.heat_conduction) {
       s.warnings.push_back("the frictional heat of contact.law " + law_name +
                            " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in "

@@ -157,13 +157,14 @@ void write_tool_vtu(const std::string& path, const spline::SplineCurve& tool) {
 void write_contact_csv(const std::string& path, const contact::ContactState& contact) {
   std::ostringstream out;
   out << std::setprecision(12);
-  out << "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,shear_pa,normal_x,normal_y\n";
+  out << "reference_x_m,weight_m,x_m,y_m,gap_m,pressure_pa,shear_pa,normal_x,normal_y,wetted\n";
   for (size_t q = 0; q < contact.point_x.size(); ++q) {
     const Eigen::Vector2d& x = contact.point_position[q];
     const Eigen::Vector2d& n = contact.point_normal[q];
     out << contact.point_x[q] << "," << contact.point_weight[q] << "," << x.x() << "," << x.y() << ",";
     if (contact.point_gap[q]) out << *contact.point_gap[q];  // empty: too far from the tool to be searched
-    out << "," << contact.point_pressure[q] << "," << contact.point_shear[q] << "," << n.x() << "," << n.y() << "\n";
+    out << "," << contact.point_pressure[q] << "," << contact.point_shear[q] << "," << n.x() << "," << n.y() << ","
+        << (contact.point_wetted[q] != 0 ? 1 : 0) << "\n";
   }
   write_file_atomically(path, out.str());
 }
