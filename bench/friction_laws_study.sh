@@ -12,8 +12,9 @@
 #   zorev:contact.law=zorev,contact.adhesive_coefficient=0.3,contact.shear_factor=0.5
 # (default: frictionless and coulomb with mu_a = 0.1). Environment: PHYSICS=lubricated runs the
 # lubricated scene (default dry); SCENE=file.json another base scene; PRESSURES, VELOCITIES,
-# TEMPERATURES the sweeps (each through the others' centre value, the middle word); THREADS cores
-# per run (default 1: leave a core free).
+# TEMPERATURES the sweeps (each through the others' centre value, the middle word); CORNERS=1 also
+# the box's eight corners (the first and last words of each sweep); THREADS cores per run (default
+# 1: leave a core free).
 set -uo pipefail
 mufric=${1:?usage: friction_laws_study.sh MUFRIC OUT [LAW ...]}
 out=${2:?output directory}
@@ -53,5 +54,12 @@ for law in "${laws[@]}"; do
   for p in "${pressures[@]}"; do run_point "$name" "$overrides" "$p" "${velocities[1]}" "${temperatures[1]}"; done
   for v in "${velocities[@]}"; do run_point "$name" "$overrides" "${pressures[1]}" "$v" "${temperatures[1]}"; done
   for t in "${temperatures[@]}"; do run_point "$name" "$overrides" "${pressures[1]}" "${velocities[1]}" "$t"; done
+  if [[ ${CORNERS:-0} == 1 ]]; then
+    for p in "${pressures[0]}" "${pressures[-1]}"; do
+      for v in "${velocities[0]}" "${velocities[-1]}"; do
+        for t in "${temperatures[0]}" "${temperatures[-1]}"; do run_point "$name" "$overrides" "$p" "$v" "$t"; done
+      done
+    done
+  fi
 done
 /usr/bin/python3 "$(dirname "$0")/plot_friction_laws.py" "$out"

@@ -2,7 +2,8 @@
 """The friction-law study's table and figure: reads OUT/<law>/p*_v*_T*/result.json as written by
 bench/friction_laws_study.sh and prints, per law and point, mu +- its standard error and mu's work
 split (interface = the adhesive part, plastic = ploughing, normal = the normal load's work), then
-draws mu against p, v and T through the box centre, one line per law (OUT/friction_laws.png).
+draws mu against p, v and T through the box centre, one line per law (OUT/friction_laws.png), and
+mu at the box's corners when they were run (OUT/friction_laws_corners.png).
 
   /usr/bin/python3 bench/plot_friction_laws.py OUT
 """
@@ -68,6 +69,27 @@ def main():
     fig.tight_layout()
     fig.savefig(out / "friction_laws.png", dpi=110)
     print(f"figure: {out / 'friction_laws.png'}")
+    # The corners (CORNERS=1): every point off the three lines through the centre, μ per law side by side.
+    corners = [pt for pt in all_points if sum(pt[i] != centre[i] for i in range(3)) == 3]
+    if corners:
+        fig, ax = plt.subplots(figsize=(11, 4))
+        width = 0.8 / len(laws)
+        for k, (law, rows) in enumerate(laws.items()):
+            xs, ys, es = [], [], []
+            for c, pt in enumerate(corners):
+                r = rows.get(pt)
+                if r is not None and r.get("completed"):
+                    xs.append(c + (k - (len(laws) - 1) / 2) * width); ys.append(r["mu"]); es.append(1.96 * (r.get("mu_std_error") or 0.0))
+            ax.bar(xs, ys, width, yerr=es, capsize=2, label=law)
+        ax.set_xticks(range(len(corners)))
+        ax.set_xticklabels([f"{p:g} MPa\n{v:g} m/min\n{t:g} °C" for p, v, t in corners], fontsize=8)
+        ax.set_ylabel("mu (95 % interval)")
+        ax.legend()
+        ax.grid(alpha=0.3, axis="y")
+        fig.suptitle("mu at the corners of the box, per interfacial law")
+        fig.tight_layout()
+        fig.savefig(out / "friction_laws_corners.png", dpi=110)
+        print(f"figure: {out / 'friction_laws_corners.png'}")
 
 
 if __name__ == "__main__":
