@@ -291,10 +291,55 @@ TEST_F(Cli, PredictSaysWhyAPointHasNoAnswerAndAnswersACsv) {
   EXPECT_NE(answers.find("INVALID_INPUT,\"contact_pressure: -5MPa"), std::string::npos) << answers;
 }
 
+// Two answer CSVs of `predict` agree: the same rows and text fields, every number within
+// `relative` of the other's.
+void expect_same_answers(const std::string& expected, const std::string& actual, double relative) {
+  const auto rows = [](const std::string& text) {
+    std::vector<std::vector<std::string>> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+      std::vector<std::string> fields;
+      bool quoted = false;
+      std::string field;
+      for (const char c : line) {
+        if (c == '"') quoted = !quoted;
+        if (c == ',' && !quoted) {
+          fields.push_back(field);
+          field.clear();
+        } else {
+          field += c;
+        }
+      }
+      fields.push_back(field);
+      out.push_back(fields);
+    }
+    return out;
+  };
+  const auto a = rows(expected), b = rows(actual);
+  ASSERT_EQ(a.size(), b.size()) << actual;
+  for (size_t r = 0; r < a.size(); ++r) {
+    ASSERT_EQ(a[r].size(), b[r].size()) << "row " << r;
+    for (size_t f = 0; f < a[r].size(); ++f) {
+      char* end_a = nullptr;
+      char* end_b = nullptr;
+      const double x = std::strtod(a[r][f].c_str(), &end_a), y = std::strtod(b[r][f].c_str(), &end_b);
+      const bool numbers = !a[r][f].empty() && *end_a == '\0' && !b[r][f].empty() && *end_b == '\0';
+      if (numbers) {
+        EXPECT_NEAR(y, x, relative * std::abs(x)) << "row " << r << ", field " << f;
+      } else {
+        EXPECT_EQ(b[r][f], a[r][f]) << "row " << r << ", field " << f;
+      }
+    }
+  }
+}
+
 // The shipped model (models/dry_default.h5) is what `train` makes of the committed campaign database
 // with its defaults (campaigns/dry_default/train.sh): retrained, it gives the same answers, interval and
 // patch scatter, inside and outside the box. A bare name finds it in every command; a wrong one is
-// named with the shipped models.
+// named with the shipped models. "The same" to 1e-5: the fit's optimiser runs through vectorised
+// kernels whose rounding differs between machines (a refit on an AVX2 AMD EPYC differs from the model
+// trained on an AVX-512 Xeon by at most 1.3e-7 relative); retrained from other data or with other
+// defaults the answers move by percents.
 TEST_F(Cli, TheShippedModelIsTheCampaignsFit) {
   ::setenv("MUFRIC_MODELS_DIR", MUFRIC_SOURCE_DIR "/models", 1);
   CommandResult r = run(std::string("train --data ") + MUFRIC_SOURCE_DIR "/campaigns/dry_default/db.h5 --out " +
@@ -312,7 +357,7 @@ TEST_F(Cli, TheShippedModelIsTheCampaignsFit) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string shipped = read_text(path("shipped.csv"));
   EXPECT_NE(shipped.find("patch_std"), std::string::npos) << shipped;
-  EXPECT_EQ(shipped, read_text(path("refit.csv")));
+  expect_same_answers(shipped, read_text(path("refit.csv")), 1e-5);
   r = run("describe dry_default");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("averaged over all draws"), std::string::npos) << r.output;
