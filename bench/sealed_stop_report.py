@@ -62,6 +62,8 @@ def main():
             smallest = min(pockets) if pockets else float("nan")
             print(f"| {h['sliding_distance_m'] * 1e6:.4f} | {h['contact_area_fraction']:.3f} | {share:.3f} | {len(pockets)} | "
                   f"{smallest:.3e} | {h['liquid_area_m2_per_m']:.3e} | {h['cavitated_fraction']:.3f} |")
+        if draw["completed"]:
+            continue
         stop_time = last["time_s"]
         at_stop = [c for c in cutbacks if c["time_s"] >= stop_time * (1 - 1e-12)]
         print(f"failed attempts at the stopping step: {len(at_stop)}, dt down to {min((c['dt_failed_s'] for c in at_stop), default=float('nan')):.3e} s")
@@ -73,7 +75,7 @@ def main():
             print(f"  {n} x {reason}")
         # The smallest pocket's rate of loss over the last accepted steps, and the slot-flow pressure it needs.
         tail = [h for h in history[-6:] if h.get("pocket_areas_m2_per_m")]
-        if len(tail) >= 2 and not draw["completed"]:
+        if len(tail) >= 2:
             a0, a1 = min(tail[0]["pocket_areas_m2_per_m"]), min(tail[-1]["pocket_areas_m2_per_m"])
             dt = tail[-1]["time_s"] - tail[0]["time_s"]
             q = max(0.0, (a0 - a1) / dt)
