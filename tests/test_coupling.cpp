@@ -543,6 +543,43 @@ TEST(ChipInterface, AFoldedCurveIsSeenFromAboveByItsUpperEnvelope) {
   EXPECT_GE(folded_points, 2);  // the check went through the fold
 }
 
+TEST(ChipInterface, AFoldsTipRampsTheFilmFloorInsteadOfJumping) {
+  // A lip curled forward (x(t) turns back as above, its tip at x = 0.5526 L on top: the upper envelope
+  // steps there by 0.178 L, found by brute force over 200 000 samples), carried along x by δ — a chip
+  // sliding under a fixed column at x0. The ramped floor must not jump: between neighbouring δ it
+  // changes as a slope does, in proportion to the step.
+  const double period = kInterval, pi = std::numbers::pi, x0 = 3.0e-6;
+  const auto shape = [&](double t) {
+    return Eigen::Vector2d(t + 0.25 * period * std::sin(2 * pi * t / period),
+                           -0.1 * period * std::cos(2 * pi * t / period) + 0.05 * period * std::sin(2 * pi * t / period));
+  };
+  const int steps = 4000;
+  const double sweep = 4e-6, step = sweep / steps;  // the tip (x ≈ 5.53 µm) passes x0 at δ ≈ −2.5 µm
+  double largest_jump = 0.0, largest_ramped_change = 0.0, previous_height = 0.0, previous_ramped = 0.0;
+  for (int k = 0; k <= steps; ++k) {
+    const double delta = -4.5e-6 + k * step;
+    const PeriodicGraph g([&](double t) { return Eigen::Vector2d(shape(t) + Eigen::Vector2d(delta, 0.0)); }, 0.0, period, 256);
+    const double height = g.height_at(x0), ramped = g.ramped_height_at(x0, kFilmFloorMaxSlope);
+    EXPECT_GE(ramped, height);
+    if (k > 0) {
+      largest_jump = std::max(largest_jump, std::abs(height - previous_height));
+      largest_ramped_change = std::max(largest_ramped_change, std::abs(ramped - previous_ramped));
+    }
+    previous_height = height, previous_ramped = ramped;
+  }
+  EXPECT_GT(largest_jump, 0.15 * period);             // the envelope's cliff crossed x0
+  EXPECT_LT(largest_ramped_change, 200.0 * step);     // the floor moved as a slope, not a cliff
+}
+
+TEST(ChipInterface, AGraphGentlerThanTheRampKeepsItsHeight) {
+  const spline::SplineCurve c = periodic_curve(3, 24, kInterval, chip_height);  // slopes below 0.25
+  const PeriodicGraph g([&](double t) { return c.point(t); }, 0.0, kInterval, 256);
+  for (int k = 0; k <= 100; ++k) {
+    const double x = -2e-6 + 14e-6 * k / 100;
+    EXPECT_NEAR(g.ramped_height_at(x, kFilmFloorMaxSlope), g.height_at(x), 1e-15) << x;
+  }
+}
+
 TEST(ChipInterface, LoadsMoveToTheChipConservatively) {
   const spline::SplineCurve surface = periodic_curve(2, 32, kInterval, chip_height);
   const solid::IgaSpace chip(solid::chip_patch(surface, {.degree = 2, .spans_x = 32, .spans_y = 4, .y_bottom = -2e-6}));

@@ -14,7 +14,9 @@ PeriodicGraph::PeriodicGraph(std::function<Eigen::Vector2d(double)> point, doubl
   for (int k = 0; k <= samples; ++k) {
     const double t = lo_ + period_ * k / samples;
     t_.push_back(t);
-    x_.push_back(point_(t).x());
+    const Eigen::Vector2d at = point_(t);
+    x_.push_back(at.x());
+    y_.push_back(at.y());
   }
   interval_ = x_.back() - x_.front();
   if (!(interval_ > 0.0)) throw Error("periodic graph: the curve does not advance in x over a period");
@@ -65,6 +67,17 @@ double PeriodicGraph::parameter_at(double x) const {
     if (y > best_y) best_y = y, best_t = t;
   }
   return best_t + periods * period_;
+}
+
+double PeriodicGraph::ramped_height_at(double x, double max_slope) const {
+  const double xr = x - std::floor((x - x_.front()) / interval_) * interval_;
+  double height = height_at(x);
+  for (size_t k = 0; k + 1 < x_.size(); ++k) {  // the last sample is the first's periodic image
+    for (const double image : {-interval_, 0.0, interval_}) {
+      height = std::max(height, y_[k] - max_slope * std::abs(xr - (x_[k] + image)));
+    }
+  }
+  return height;
 }
 
 ChipSurface::ChipSurface(const solid::IgaSpace& chip)
@@ -148,7 +161,7 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> boundary_heights(const Columns& c, c
   const auto n = static_cast<Eigen::Index>(c.x.size());
   Eigen::VectorXd chip_h(n), tool_h(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    chip_h(i) = chip.height_at(c.x[static_cast<size_t>(i)]);
+    chip_h(i) = chip.ramped_height_at(c.x[static_cast<size_t>(i)], kFilmFloorMaxSlope);
     tool_h(i) = tool.height_at(c.x[static_cast<size_t>(i)]);
   }
   const Eigen::VectorXd bottom = c.collocation.solve(chip_h);

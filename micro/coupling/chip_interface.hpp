@@ -35,13 +35,21 @@ class PeriodicGraph {
   double height_at(double x) const { return point_(parameter_at(x)).y(); }
   double interval() const { return interval_; }  // the x shift per parameter period
   bool folded() const { return folded_; }        // x(t) turns back somewhere
+  // The upper envelope with its cliffs ramped: max(height_at(x), max_k y_k − s |x − x_k|) over the
+  // samples (x_k, y_k) and their periodic images, s = max_slope — the curve dilated from above by a cone
+  // of that slope (a morphological dilation, e.g. Serra, Image Analysis and Mathematical Morphology,
+  // 1982, ch. 2), sampled at the curve's own points. Where a lip folds over, height_at drops at the
+  // lip's tip by the lip's height (what lies under it is left out); as the tip crosses an x, that x's
+  // height jumps. The samples move with the curve, so their cones do not jump, and the ramp leaves
+  // no drop steeper than s. A graph no steeper than s anywhere keeps its height.
+  double ramped_height_at(double x, double max_slope) const;
 
  private:
   double root_in(size_t sample, double x) const;  // x(t) = x in [t_k, t_k+1], x within one period
   std::function<Eigen::Vector2d(double)> point_;
   double lo_, period_, interval_ = 0.0;
   bool folded_ = false;
-  std::vector<double> t_, x_;  // samples over one period in t, x_[0] the first
+  std::vector<double> t_, x_, y_;  // samples over one period in t, x_[0] the first
 };
 
 // The chip's top side (the patch's v = hi side) at a displacement and velocity.
@@ -82,6 +90,13 @@ class NodalLoad final : public solid::BoundaryInteraction {
   Eigen::VectorXd forces_;
 };
 
+// The film's floor is the chip's surface ramped at this slope (PeriodicGraph::ramped_height_at): the
+// chip's flanks gentler than 45° keep their height, and a lip's tip,
+// whose cliff jumped a column's height by the lip's height as it crossed the column (a volume the
+// incompressible film had to move within any step, however short: the default lubricated scene's
+// stops at 800 MPa), now raises a column over a slide of the lip's height (45°).
+inline constexpr double kFilmFloorMaxSlope = 1.0;
+
 struct GapMeshOptions {
   int degree = 2;
   int elements_x = 64;   // columns along the interval
@@ -94,8 +109,9 @@ struct GapMeshOptions {
 
 // The lubricant's patch over one interval [x0, x0 + L) between the chip surface (bottom, v = lo)
 // and the tool (top), columns at the Greville abscissae of a periodic uniform basis in x; the
-// bottom and top rows interpolate the chip's and the tool's heights there (the top lifted to the
-// chip + min_film where they come closer), the rows between are spaced linearly.
+// bottom and top rows interpolate the chip's ramped heights (kFilmFloorMaxSlope) and the tool's
+// there (the top lifted to the chip + min_film where they come closer), the rows between are spaced
+// linearly.
 spline::SplineSurface gap_patch(const PeriodicGraph& chip, const PeriodicGraph& tool, double x0, const GapMeshOptions& options);
 
 // The bottom and top rows of such a patch for new chip and tool heights (same columns): the

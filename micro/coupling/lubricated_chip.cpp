@@ -310,10 +310,10 @@ bool LubricatedChip::step(solid::TimeIntegrator& integrator, double t0, double d
   current_.coupling_iterations = report.iterations;
   current_.coupling_restarts = report.restarts;
   if (trace_coupling()) {
-    std::fprintf(stderr, "coupling t %.4g dt %.3g: %s after %d, %d restarts (fluid Newton %d, cavitated %.3f)\n", t0 + dt, dt,
-                 report.converged ? "converged" : "failed", current_.coupling_iterations, report.restarts,
-                 current_.fluid_newton_iterations,
-                 cavitation_ ? cavitation_->cavitated_fraction() : 0.0);
+    std::fprintf(stderr, "coupling t %.4g dt %.3g: %s after %d, %d restarts (fluid Newton %d, cavitated %.3f%s)\n", t0 + dt,
+                 dt, report.converged ? "converged" : "failed", current_.coupling_iterations, report.restarts,
+                 current_.fluid_newton_iterations, cavitation_ ? cavitation_->cavitated_fraction() : 0.0,
+                 surface_->graph().folded() ? ", chip surface folded" : "");
     for (size_t k = 0; k < report.load_residuals.size(); ++k) {
       std::fprintf(stderr, "  |dlambda| %.4e Pa  |dd| %.4e m  film volume error %.3e\n", report.load_residuals[k],
                    report.displacement_changes[k], report.kinematic_residuals[k]);
