@@ -91,10 +91,10 @@ class NodalLoad final : public solid::BoundaryInteraction {
 };
 
 // The film's floor is the chip's surface ramped at this slope (PeriodicGraph::ramped_height_at): the
-// chip's flanks gentler than 45° keep their height, and a lip's tip,
-// whose cliff jumped a column's height by the lip's height as it crossed the column (a volume the
-// incompressible film had to move within any step, however short: the default lubricated scene's
-// stops at 800 MPa), now raises a column over a slide of the lip's height (45°).
+// chip's flanks gentler than 45° keep their height, and a lip's tip, whose cliff jumped a column's
+// height by the lip's height as it crossed the column (a volume the incompressible film had to move
+// within any step, however short: the default lubricated scene's stops at 800 and 1300 MPa), now
+// raises a column over a slide of the lip's height.
 inline constexpr double kFilmFloorMaxSlope = 1.0;
 
 struct GapMeshOptions {
