@@ -17,15 +17,12 @@ The slip share is an estimate: the force is the last step's, the work the window
 import csv
 import json
 import os
-import re
 import sys
+
+from plot_friction_laws import point_of  # the study's point directory name: (p MPa, v m/min, T °C)
 
 INTERVAL_M = 10e-6  # the default scenes' period (geometry.interval)
 SLIP_LIMIT_FRACTION = 0.999  # |τ| below this share of μ_a p counts as stick
-
-
-def point_pressure_pa(name):
-    return float(re.match(r"p([\d.]+)MPa", name).group(1)) * 1e6
 
 
 def main():
@@ -36,12 +33,13 @@ def main():
     print("|---|---|---|---|---|---|---|")
     for name in sorted(os.listdir(study)):
         result_path, contact_path = os.path.join(study, name, "result.json"), os.path.join(study, name, "contact.csv")
-        if not (os.path.exists(result_path) and os.path.exists(contact_path)):
+        point = point_of(name)
+        if point is None or not (os.path.exists(result_path) and os.path.exists(contact_path)):
             continue
         result = json.load(open(result_path))
         if not result.get("completed"):
             continue
-        pressure = point_pressure_pa(name)
+        pressure = point[0] * 1e6
         shear = normal = stick = 0.0
         for row in csv.DictReader(open(contact_path)):
             p, w, tau = float(row["pressure_pa"]), float(row["weight_m"]), abs(float(row["shear_pa"]))
