@@ -902,5 +902,27 @@ TEST(MicroRun, AConstantTableIsCoulombsLawAndARisingOneAddsFriction) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Lubricated, ASealedIncompressibleFilmsStalledInterfaceNamesTheWayOut) {
+  // Seed 000's sealed liquid stalls the interface iteration on an enclosed pocket (bench/RESULTS.md):
+  // the stop says so and names the compressible liquid; other stops and other films keep their reason.
+  const std::string stalled =
+      "step at t = 691.588 ns failed after 8 cut-backs: lubricant coupling: the interface did not converge in 50 iterations";
+  const std::string newton = "step at t = 2692.43 ns failed after 8 cut-backs: lubricant coupling: structure solve failed";
+  nlohmann::json sealed = default_scene_json();
+  apply_override(sealed, "physics=\"lubricated\"");
+  apply_override(sealed, "lubricant.leak=\"none\"");
+  const std::string explained = explain_stop(parse_scene(sealed, "sealed"), stalled);
+  EXPECT_EQ(explained.rfind(stalled, 0), 0u) << explained;
+  EXPECT_NE(explained.find("lubricant.compressibility=linear"), std::string::npos) << explained;
+  EXPECT_EQ(explain_stop(parse_scene(sealed, "sealed"), newton), newton);
+  nlohmann::json compressible = sealed, drained = sealed, dry = sealed;
+  apply_override(compressible, "lubricant.compressibility=\"linear\"");
+  apply_override(drained, "lubricant.leak=\"ambient\"");
+  apply_override(dry, "physics=\"dry\"");
+  EXPECT_EQ(explain_stop(parse_scene(compressible, "compressible"), stalled), stalled);
+  EXPECT_EQ(explain_stop(parse_scene(drained, "drained"), stalled), stalled);
+  EXPECT_EQ(explain_stop(parse_scene(dry, "dry"), stalled), stalled);
+}
+
 }  // namespace
 }  // namespace mufric::scene

@@ -667,7 +667,7 @@ void record_end_state(const Scene& scene, const solid::SolidProblem& problem, co
 void record_outcome(const Scene& scene, const StepRecorder& recorder, MicroResult& result) {
   const WindowAverage& average = recorder.average();
   if (!result.solver.completed) {
-    result.reason = result.solver.reason;
+    result.reason = explain_stop(scene, result.solver.reason);
   } else if (average.weight() <= 0.0) {
     result.reason = "the chip did not touch the tool during the averaging window; raise load.pressure or lower "
                     "geometry.initial_gap";
@@ -685,6 +685,18 @@ void record_outcome(const Scene& scene, const StepRecorder& recorder, MicroResul
 }
 
 }  // namespace
+
+std::string explain_stop(const Scene& scene, const std::string& reason) {
+  const bool sealed_incompressible = scene.physics == Physics::lubricated && scene.lubricant.leak == LeakModel::none &&
+                                     scene.lubricant.compressibility == Compressibility::none;
+  if (!sealed_incompressible || reason.find("lubricant coupling: the interface") == std::string::npos) return reason;
+  // Küttler, Förster & Wall 2006 (Comput. Mech. 38:417): a Dirichlet-Neumann iteration around an
+  // enclosed incompressible fluid cannot converge, since no chip motion but one of zero volume fits it.
+  return reason +
+         " (the film is sealed and incompressible: most likely a pocket enclosed by the contact, whose liquid "
+         "admits no motion of the chip that changes its volume; --set lubricant.compressibility=linear gives the "
+         "oil its bulk modulus, --set lubricant.leak=ambient lets it drain)";
+}
 
 MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();

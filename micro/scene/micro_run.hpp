@@ -176,4 +176,9 @@ SceneGeometry build_geometry(const Scene& scene);
 
 MicroResult run_micro(const Scene& scene, const RunOptions& options = {});
 
+// A stopped run's reason with what the scene can change about it: a sealed incompressible film
+// whose interface iteration fails has most likely met an enclosed pocket (bench/RESULTS.md, "Seed
+// 000's sealed film with a compressible liquid"), which a compressible liquid lets the chip follow.
+std::string explain_stop(const Scene& scene, const std::string& reason);
+
 }  // namespace mufric::scene
