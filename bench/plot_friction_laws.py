@@ -3,9 +3,11 @@
 bench/friction_laws_study.sh and prints, per law and point, mu +- its standard error and mu's work
 split (interface = the adhesive part, plastic = ploughing, normal = the normal load's work), then
 draws mu against p, v and T through the box centre, one line per law (OUT/friction_laws.png), and
-mu at the box's corners when they were run (OUT/friction_laws_corners.png).
+mu at the box's corners when they were run (OUT/friction_laws_corners.png). With --against OTHER
+(e.g. the dry study beside a lubricated one) the other study's laws are drawn dashed in the same
+figure, so lubricated and dry can be read off one plot.
 
-  /usr/bin/python3 bench/plot_friction_laws.py OUT
+  /usr/bin/python3 bench/plot_friction_laws.py OUT [--against OTHER]
 """
 import json
 import pathlib
@@ -18,8 +20,22 @@ def point_of(name):
     return tuple(float(g) for g in m.groups()) if m else None
 
 
-def main():
-    out = pathlib.Path(sys.argv[1])
+def window_wetted_share(result):
+    """The wetted share of the contact, mean over the steps of mu's window and over the draws (a
+    contact patch switches between wetted and dry as the liquid reaches its edge, so the last step
+    alone can say 0 or 1 where the window saw either)."""
+    shares = []
+    for draw in result.get("draws", []):
+        start, end = draw.get("mu_window_sliding_distance_m", [0.0, float("inf")])
+        in_window = [h.get("wetted_contact_fraction", 0.0) for h in draw.get("history", [])
+                     if start <= h.get("sliding_distance_m", -1.0) <= end]
+        if in_window:
+            shares.append(sum(in_window) / len(in_window))
+    return f"{sum(shares) / len(shares):.2f}" if shares else ""
+
+
+def read_study(out):
+    """{law: {(p, v, T): result.json}} for every point of the study that has a result."""
     laws = {}
     for law_dir in sorted(p for p in out.iterdir() if p.is_dir()):
         rows = {}
@@ -31,9 +47,25 @@ def main():
             rows[point] = json.load(open(result))
         if rows:
             laws[law_dir.name] = rows
+    return laws
+
+
+def main():
+    usage = "usage: plot_friction_laws.py OUT [--against OTHER]"
+    args = sys.argv[1:]
+    if len(args) not in (1, 3) or (len(args) == 3 and args[1] != "--against"):
+        sys.exit(usage)
+    out = pathlib.Path(args[0])
+    laws = read_study(out)
     if not laws:
         sys.exit(f"{out}: no runs yet")
-    print("| law | p [MPa] | v [m/min] | T [C] | mu | interface | plastic | normal load | wetted | wall [s] |")
+    other = {}
+    if len(args) == 3:
+        other_dir = pathlib.Path(args[2])
+        other = {f"{law} ({other_dir.name})": rows for law, rows in read_study(other_dir).items()}
+        if not other:
+            sys.exit(f"{other_dir}: no runs to compare against")
+    print("| law | p [MPa] | v [m/min] | T [C] | mu | interface | plastic | normal load | wetted (window) | wall [s] |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for law, rows in laws.items():
         for (p, v, t), r in sorted(rows.items()):
@@ -44,8 +76,7 @@ def main():
             split = r.get("work_split", {})
             parts = [split.get(k) for k in ("mu_interface", "mu_bulk_plastic", "mu_normal_load")]
             cells = [f"{x:.4f}" if x is not None else "" for x in parts]
-            wetted = [h.get("wetted_contact_fraction", 0.0) for d in r.get("draws", []) for h in d.get("history", [])[-1:]]
-            wet = f"{sum(wetted) / len(wetted):.2f}" if wetted else ""
+            wet = window_wetted_share(r)
             print(f"| {law} | {p:g} | {v:g} | {t:g} | {mu} | {' | '.join(cells)} | {wet} | {r['diagnostics']['wall_seconds']:.0f} |")
     import matplotlib
     matplotlib.use("Agg")
@@ -54,18 +85,20 @@ def main():
     centre = tuple(sorted({pt[i] for pt in all_points})[len({pt[i] for pt in all_points}) // 2] for i in range(3))
     fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True)
     for axis, (ax, label) in enumerate(zip(axes, ["contact pressure [MPa]", "sliding velocity [m/min]", "temperature [°C]"])):
-        for law, rows in laws.items():
+        for k, (law, rows) in enumerate(list(laws.items()) + list(other.items())):
             xs, ys, es = [], [], []
             for pt, r in sorted(rows.items()):
                 if all(pt[i] == centre[i] for i in range(3) if i != axis) and r.get("completed"):
                     xs.append(pt[axis]); ys.append(r["mu"]); es.append(r.get("mu_std_error") or 0.0)
             if xs:
-                ax.errorbar(xs, ys, yerr=[1.96 * e for e in es], marker="o", capsize=3, label=law)
+                dashed = k >= len(laws)
+                ax.errorbar(xs, ys, yerr=[1.96 * e for e in es], marker="s" if dashed else "o", capsize=3,
+                            linestyle="--" if dashed else "-", alpha=0.6 if dashed else 1.0, label=law)
         ax.set_xlabel(label)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("mu (95 % interval of the mean over the tools)")
     axes[0].legend()
-    fig.suptitle("mu through the box centre, per interfacial law")
+    fig.suptitle(f"mu through the box centre, per interfacial law ({out.name}" + (f"; dashed: {pathlib.Path(args[2]).name})" if other else ")"))
     fig.tight_layout()
     fig.savefig(out / "friction_laws.png", dpi=110)
     print(f"figure: {out / 'friction_laws.png'}")
