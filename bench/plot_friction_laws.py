@@ -83,6 +83,10 @@ def main():
     import matplotlib.pyplot as plt
     all_points = sorted({pt for rows in laws.values() for pt in rows})
     centre = tuple(sorted({pt[i] for pt in all_points})[len({pt[i] for pt in all_points}) // 2] for i in range(3))
+    # One colour per law, whichever study it comes from: the other study's line is the same colour, dashed.
+    cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    bases = list(dict.fromkeys([law.split(" (")[0] for law in list(laws) + list(other)]))
+    colour = {base: cycle[i % len(cycle)] for i, base in enumerate(bases)}
     fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True)
     for axis, (ax, label) in enumerate(zip(axes, ["contact pressure [MPa]", "sliding velocity [m/min]", "temperature [°C]"])):
         for k, (law, rows) in enumerate(list(laws.items()) + list(other.items())):
@@ -93,7 +97,8 @@ def main():
             if xs:
                 dashed = k >= len(laws)
                 ax.errorbar(xs, ys, yerr=[1.96 * e for e in es], marker="s" if dashed else "o", capsize=3,
-                            linestyle="--" if dashed else "-", alpha=0.6 if dashed else 1.0, label=law)
+                            linestyle="--" if dashed else "-", alpha=0.6 if dashed else 1.0,
+                            color=colour[law.split(" (")[0]], label=law)
         ax.set_xlabel(label)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("mu (95 % interval of the mean over the tools)")
