@@ -59,10 +59,10 @@ def main():
     laws = read_study(out)
     if not laws:
         sys.exit(f"{out}: no runs yet")
-    other = {}
+    other, other_name = {}, ""
     if len(args) == 3:
         other_dir = pathlib.Path(args[2])
-        other = {f"{law} ({other_dir.name})": rows for law, rows in read_study(other_dir).items()}
+        other, other_name = read_study(other_dir), other_dir.name
         if not other:
             sys.exit(f"{other_dir}: no runs to compare against")
     print("| law | p [MPa] | v [m/min] | T [C] | mu | interface | plastic | normal load | wetted (window) | wall [s] |")
@@ -85,25 +85,25 @@ def main():
     centre = tuple(sorted({pt[i] for pt in all_points})[len({pt[i] for pt in all_points}) // 2] for i in range(3))
     # One colour per law, whichever study it comes from: the other study's line is the same colour, dashed.
     cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    bases = list(dict.fromkeys([law.split(" (")[0] for law in list(laws) + list(other)]))
-    colour = {base: cycle[i % len(cycle)] for i, base in enumerate(bases)}
+    colour = {law: cycle[i % len(cycle)] for i, law in enumerate(dict.fromkeys(list(laws) + list(other)))}
+    series = [(law, law, rows, False) for law, rows in laws.items()] + \
+             [(law, f"{law} ({other_name})", rows, True) for law, rows in other.items()]
     fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True)
     for axis, (ax, label) in enumerate(zip(axes, ["contact pressure [MPa]", "sliding velocity [m/min]", "temperature [°C]"])):
-        for k, (law, rows) in enumerate(list(laws.items()) + list(other.items())):
+        for law, legend, rows, dashed in series:
             xs, ys, es = [], [], []
             for pt, r in sorted(rows.items()):
                 if all(pt[i] == centre[i] for i in range(3) if i != axis) and r.get("completed"):
                     xs.append(pt[axis]); ys.append(r["mu"]); es.append(r.get("mu_std_error") or 0.0)
             if xs:
-                dashed = k >= len(laws)
                 ax.errorbar(xs, ys, yerr=[1.96 * e for e in es], marker="s" if dashed else "o", capsize=3,
                             linestyle="--" if dashed else "-", alpha=0.6 if dashed else 1.0,
-                            color=colour[law.split(" (")[0]], label=law)
+                            color=colour[law], label=legend)
         ax.set_xlabel(label)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("mu (95 % interval of the mean over the tools)")
     axes[0].legend()
-    fig.suptitle(f"mu through the box centre, per interfacial law ({out.name}" + (f"; dashed: {pathlib.Path(args[2]).name})" if other else ")"))
+    fig.suptitle(f"mu through the box centre, per interfacial law ({out.name}" + (f"; dashed: {other_name})" if other else ")"))
     fig.tight_layout()
     fig.savefig(out / "friction_laws.png", dpi=110)
     print(f"figure: {out / 'friction_laws.png'}")
