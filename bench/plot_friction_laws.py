@@ -5,7 +5,9 @@ split (interface = the adhesive part, plastic = ploughing, normal = the normal l
 draws mu against p, v and T through the box centre, one line per law (OUT/friction_laws.png), and
 mu at the box's corners when they were run (OUT/friction_laws_corners.png). With --against OTHER
 (e.g. the dry study beside a lubricated one) the other study's laws are drawn dashed in the same
-figure, so lubricated and dry can be read off one plot.
+figure and hatched beside each corner's bar, so lubricated and dry can be read off one plot, and a
+second table gives, per law and point both studies ran, the change of mu paired over the draws (the
+same tool and chip seeds in both: their common error cancels).
 
   /usr/bin/python3 bench/plot_friction_laws.py OUT [--against OTHER]
 """
@@ -32,6 +34,19 @@ def window_wetted_share(result):
         if in_window:
             shares.append(sum(in_window) / len(in_window))
     return f"{sum(shares) / len(shares):.2f}" if shares else ""
+
+
+def paired_change(result, other):
+    """Mean relative change of mu from `other` to `result` over the draws both ran with the same tool
+    and chip seeds, and its standard error (None when fewer than two draws pair)."""
+    theirs = {(d["tool_seed"], d["chip_seed"]): d["mu"] for d in other.get("draws", []) if d.get("completed")}
+    changes = [d["mu"] / theirs[key] - 1.0 for d in result.get("draws", []) if d.get("completed")
+               for key in [(d["tool_seed"], d["chip_seed"])] if key in theirs]
+    if len(changes) < 2:
+        return None
+    mean = sum(changes) / len(changes)
+    spread = (sum((c - mean) ** 2 for c in changes) / (len(changes) - 1)) ** 0.5
+    return mean, spread / len(changes) ** 0.5
 
 
 def read_study(out):
@@ -78,6 +93,18 @@ def main():
             cells = [f"{x:.4f}" if x is not None else "" for x in parts]
             wet = window_wetted_share(r)
             print(f"| {law} | {p:g} | {v:g} | {t:g} | {mu} | {' | '.join(cells)} | {wet} | {r['diagnostics']['wall_seconds']:.0f} |")
+    if other:
+        print(f"\n| law | p [MPa] | v [m/min] | T [C] | mu | mu ({other_name}) | change, paired over the draws | wetted (window) |")
+        print("|---|---|---|---|---|---|---|---|")
+        for law, rows in laws.items():
+            for pt, r in sorted(rows.items()):
+                o = other.get(law, {}).get(pt)
+                if o is None or not r.get("completed") or not o.get("completed"):
+                    continue
+                change = paired_change(r, o)
+                cell = f"{100 * change[0]:+.1f} % ± {100 * change[1]:.1f} %" if change else "fewer than two paired draws"
+                p, v, t = pt
+                print(f"| {law} | {p:g} | {v:g} | {t:g} | {r['mu']:.4f} | {o['mu']:.4f} | {cell} | {window_wetted_share(r)} |")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -111,20 +138,24 @@ def main():
     corners = [pt for pt in all_points if sum(pt[i] != centre[i] for i in range(3)) == 3]
     if corners:
         fig, ax = plt.subplots(figsize=(11, 4))
-        width = 0.8 / len(laws)
-        for k, (law, rows) in enumerate(laws.items()):
+        # Each law's bar beside the other study's (hatched) for the same law.
+        order = list(colour)
+        bars = sorted((item for item in series if not item[3] or item[0] in laws), key=lambda item: (order.index(item[0]), item[3]))
+        width = 0.8 / len(bars)
+        for k, (law, legend, rows, dashed) in enumerate(bars):
             xs, ys, es = [], [], []
             for c, pt in enumerate(corners):
                 r = rows.get(pt)
                 if r is not None and r.get("completed"):
-                    xs.append(c + (k - (len(laws) - 1) / 2) * width); ys.append(r["mu"]); es.append(1.96 * (r.get("mu_std_error") or 0.0))
-            ax.bar(xs, ys, width, yerr=es, capsize=2, label=law)
+                    xs.append(c + (k - (len(bars) - 1) / 2) * width); ys.append(r["mu"]); es.append(1.96 * (r.get("mu_std_error") or 0.0))
+            ax.bar(xs, ys, width, yerr=es, capsize=2, label=legend, color=colour[law],
+                   hatch="//" if dashed else None, alpha=0.45 if dashed else 1.0)
         ax.set_xticks(range(len(corners)))
         ax.set_xticklabels([f"{p:g} MPa\n{v:g} m/min\n{t:g} °C" for p, v, t in corners], fontsize=8)
         ax.set_ylabel("mu (95 % interval)")
         ax.legend()
         ax.grid(alpha=0.3, axis="y")
-        fig.suptitle("mu at the corners of the box, per interfacial law")
+        fig.suptitle("mu at the corners of the box, per interfacial law" + (f" (hatched: {other_name})" if other else ""))
         fig.tight_layout()
         fig.savefig(out / "friction_laws_corners.png", dpi=110)
         print(f"figure: {out / 'friction_laws_corners.png'}")
