@@ -771,8 +771,11 @@ TEST(CoupledStep, AStalledIterationFailsEarlyAndASlowOneConverges) {
   EXPECT_FALSE(stalled.converged);
   EXPECT_EQ(stalled.iterations, 1 + scalar.options.stall_iterations);  // the best is the first; six more without a better one
   EXPECT_NE(stalled.reason.find("stalled"), std::string::npos) << stalled.reason;
+  EXPECT_TRUE(is_interface_failure(stalled.reason)) << stalled.reason;
   scalar.options.stall_iterations = 0;  // off: the oscillation runs to max_iterations
-  EXPECT_EQ(run(1.0).iterations, scalar.options.max_iterations);
+  const CouplingStepReport exhausted = run(1.0);
+  EXPECT_EQ(exhausted.iterations, scalar.options.max_iterations);
+  EXPECT_TRUE(is_interface_failure(exhausted.reason)) << exhausted.reason;
 }
 
 // n independent copies of λ̃ = 1 + λ/2 from λ = 0 by plain relaxation: each component's change is
@@ -851,6 +854,7 @@ TEST(CoupledStep, ASolverFailureRestartsFromTheLastSolvedIterate) {
   EXPECT_EQ(failed.restarts, 0);
   EXPECT_NE(failed.reason.find("structure solve failed at coupling iteration 4: load out of reach"), std::string::npos)
       << failed.reason;
+  EXPECT_FALSE(is_interface_failure(failed.reason)) << failed.reason;  // a solver's failure, not the iteration's
   scalar.options.max_restarts = 1;
   const CouplingStepReport restarted = scalar.run();
   ASSERT_TRUE(restarted.converged) << restarted.reason;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "micro/coupling/partitioned.hpp"
 #include "micro/scene/dataset_sample.hpp"
 #include "micro/scene/micro_run.hpp"
 
@@ -905,8 +906,27 @@ TEST(MicroRun, AConstantTableIsCoulombsLawAndARisingOneAddsFriction) {
 TEST(Lubricated, ASealedIncompressibleFilmsStalledInterfaceNamesTheWayOut) {
   // Seed 000's sealed liquid stalls the interface iteration on an enclosed pocket (bench/RESULTS.md):
   // the stop says so and names the compressible liquid; other stops and other films keep their reason.
-  const std::string stalled =
-      "step at t = 691.588 ns failed after 8 cut-backs: lubricant coupling: the interface did not converge in 50 iterations";
+  // The stalled reason is composed as a stopped run composes it, around what coupled_step says when
+  // its iteration runs out of exchanges (a scalar iteration that oscillates for ever: λ̃ = 1 − λ).
+  coupling::CouplingOptions options;
+  options.acceleration = coupling::Acceleration::constant_relaxation;
+  options.relaxation = 1.0;
+  options.max_iterations = 5;
+  const coupling::PartitionedSolvers oscillating{
+      [](const Eigen::VectorXd& load, Eigen::VectorXd& d, std::string&) {
+        d = load;
+        return true;
+      },
+      [](const Eigen::VectorXd& d, const Eigen::VectorXd&, Eigen::VectorXd& next, std::string&) {
+        next = Eigen::VectorXd::Ones(1) - d;
+        return true;
+      },
+      {}, {}};
+  coupling::InterfaceAccelerator accelerator(options);
+  Eigen::VectorXd load = Eigen::VectorXd::Zero(1), displacement = Eigen::VectorXd::Zero(1);
+  const coupling::CouplingStepReport report = coupling::coupled_step(oscillating, load, displacement, accelerator, options);
+  ASSERT_FALSE(report.converged);
+  const std::string stalled = "step at t = 691.588 ns failed after 8 cut-backs: lubricant coupling: " + report.reason;
   const std::string newton = "step at t = 2692.43 ns failed after 8 cut-backs: lubricant coupling: structure solve failed";
   nlohmann::json sealed = default_scene_json();
   apply_override(sealed, "physics=\"lubricated\"");

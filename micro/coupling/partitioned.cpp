@@ -163,7 +163,7 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
     report.load_residuals.push_back(load_residual);
     report.displacement_changes.push_back(displacement_change);
     if (!std::isfinite(load_residual) || !std::isfinite(displacement_change)) {
-      report.reason = "the interface iteration diverged (non-finite) at iteration " + std::to_string(it);
+      report.reason = std::string(kInterfaceIterationFailed) + " diverged (non-finite) at exchange " + std::to_string(it);
       break;
     }
     const double components = static_cast<double>(std::max<Eigen::Index>(lambda_tilde.size(), 1));
@@ -187,7 +187,7 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
     }
     if (load_residual < best_load_residual) best_load_residual = load_residual, best_iteration = it;
     if (options.stall_iterations > 0 && it - best_iteration >= options.stall_iterations) {
-      report.reason = "the interface iteration stalled: |load change| has stayed above its best of the step (" +
+      report.reason = std::string(kInterfaceIterationFailed) + " stalled: |load change| has stayed above its best of the step (" +
                       std::to_string(best_load_residual) + " Pa at exchange " + std::to_string(best_iteration) + ") for " +
                       std::to_string(options.stall_iterations) + " exchanges";
       break;
@@ -196,11 +196,14 @@ CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::Vector
     lambda = accelerator.next(lambda, lambda_tilde);
   }
   if (report.reason.empty()) {
-    report.reason = "the interface did not converge in " + std::to_string(options.max_iterations) + " iterations";
+    report.reason = std::string(kInterfaceIterationFailed) + " did not converge in " + std::to_string(options.max_iterations) +
+                    " exchanges";
   }
   load = start_load;
   displacement = start;
   return report;
 }
+
+bool is_interface_failure(std::string_view reason) { return reason.find(kInterfaceIterationFailed) != std::string_view::npos; }
 
 }  // namespace mufric::coupling

@@ -15,6 +15,7 @@
 #include <deque>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -105,5 +106,12 @@ struct CouplingStepReport {
 // displacement on return. Both are left as on entry when the step does not converge.
 CouplingStepReport coupled_step(const PartitionedSolvers& solvers, Eigen::VectorXd& load, Eigen::VectorXd& displacement,
                                 InterfaceAccelerator& accelerator, const CouplingOptions& options);
+
+// Every reason coupled_step gives when the interface iteration itself fails (it runs out of
+// exchanges, stalls or diverges) begins with this; a solver failing inside it does not. Callers that
+// explain a stop (e.g. scene::explain_stop: a sealed pocket stalls the iteration) recognise it with
+// is_interface_failure, anywhere in a reason that later layers have prefixed, so the wording lives here.
+inline constexpr std::string_view kInterfaceIterationFailed = "the interface iteration";
+bool is_interface_failure(std::string_view reason);
 
 }  // namespace mufric::coupling

@@ -15,6 +15,7 @@
 #include "common/version.hpp"
 #include "common/work_pool.hpp"
 #include "micro/coupling/lubricated_chip.hpp"
+#include "micro/coupling/partitioned.hpp"
 #include "micro/scene/vtu.hpp"
 #include "micro/solid/heat_conduction.hpp"
 
@@ -689,7 +690,7 @@ void record_outcome(const Scene& scene, const StepRecorder& recorder, MicroResul
 std::string explain_stop(const Scene& scene, const std::string& reason) {
   const bool sealed_incompressible = scene.physics == Physics::lubricated && scene.lubricant.leak == LeakModel::none &&
                                      scene.lubricant.compressibility == Compressibility::none;
-  if (!sealed_incompressible || reason.find("lubricant coupling: the interface") == std::string::npos) return reason;
+  if (!sealed_incompressible || !coupling::is_interface_failure(reason)) return reason;
   // Küttler, Förster & Wall 2006 (Comput. Mech. 38:417): a Dirichlet-Neumann iteration around an
   // enclosed incompressible fluid cannot converge, since no chip motion but one of zero volume fits it.
   return reason +
