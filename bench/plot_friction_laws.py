@@ -140,7 +140,11 @@ def main():
         fig, ax = plt.subplots(figsize=(11, 4))
         # Each law's bar beside the other study's (hatched) for the same law.
         order = list(colour)
-        bars = sorted((item for item in series if not item[3] or item[0] in laws), key=lambda item: (order.index(item[0]), item[3]))
+        # A law this study ran only through the centre has no bar here, nor its hatched twin.
+        def has_corners(rows):
+            return any(rows.get(pt, {}).get("completed") for pt in corners)
+        bars = sorted((item for item in series if has_corners(laws.get(item[0], {})) and has_corners(item[2])),
+                      key=lambda item: (order.index(item[0]), item[3]))
         width = 0.8 / len(bars)
         for k, (law, legend, rows, dashed) in enumerate(bars):
             xs, ys, es = [], [], []
