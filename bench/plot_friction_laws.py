@@ -14,6 +14,7 @@ same tool and chip seeds in both: their common error cancels).
 import json
 import pathlib
 import re
+import statistics
 import sys
 
 
@@ -44,9 +45,7 @@ def paired_change(result, other):
                for key in [(d["tool_seed"], d["chip_seed"])] if key in theirs]
     if len(changes) < 2:
         return None
-    mean = sum(changes) / len(changes)
-    spread = (sum((c - mean) ** 2 for c in changes) / (len(changes) - 1)) ** 0.5
-    return mean, spread / len(changes) ** 0.5
+    return statistics.mean(changes), statistics.stdev(changes) / len(changes) ** 0.5
 
 
 def read_study(out):
@@ -138,9 +137,9 @@ def main():
     corners = [pt for pt in all_points if sum(pt[i] != centre[i] for i in range(3)) == 3]
     if corners:
         fig, ax = plt.subplots(figsize=(11, 4))
-        # Each law's bar beside the other study's (hatched) for the same law.
+        # Each law's bar beside the other study's (hatched) for the same law; a law this study ran only
+        # through the centre has no bar here, nor its hatched twin.
         order = list(colour)
-        # A law this study ran only through the centre has no bar here, nor its hatched twin.
         def has_corners(rows):
             return any(rows.get(pt, {}).get("completed") for pt in corners)
         bars = sorted((item for item in series if has_corners(laws.get(item[0], {})) and has_corners(item[2])),
