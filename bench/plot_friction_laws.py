@@ -23,26 +23,34 @@ def point_of(name):
     return tuple(float(g) for g in m.groups()) if m else None
 
 
+def draw_wetted_share(draw):
+    """One draw's wetted share of the contact, mean over the steps of mu's window (None without any)."""
+    start, end = draw.get("mu_window_sliding_distance_m", [0.0, float("inf")])
+    in_window = [h.get("wetted_contact_fraction", 0.0) for h in draw.get("history", [])
+                 if start <= h.get("sliding_distance_m", -1.0) <= end]
+    return sum(in_window) / len(in_window) if in_window else None
+
+
 def window_wetted_share(result):
     """The wetted share of the contact, mean over the steps of mu's window and over the draws (a
     contact patch switches between wetted and dry as the liquid reaches its edge, so the last step
     alone can say 0 or 1 where the window saw either)."""
-    shares = []
-    for draw in result.get("draws", []):
-        start, end = draw.get("mu_window_sliding_distance_m", [0.0, float("inf")])
-        in_window = [h.get("wetted_contact_fraction", 0.0) for h in draw.get("history", [])
-                     if start <= h.get("sliding_distance_m", -1.0) <= end]
-        if in_window:
-            shares.append(sum(in_window) / len(in_window))
+    shares = [x for x in map(draw_wetted_share, result.get("draws", [])) if x is not None]
     return f"{sum(shares) / len(shares):.2f}" if shares else ""
+
+
+def paired_changes_and_shares(result, other):
+    """Per draw that pairs (same tool and chip seeds): (the draw's window wetted share, its relative
+    change of mu from `other`)."""
+    theirs = {(d["tool_seed"], d["chip_seed"]): d["mu"] for d in other.get("draws", []) if d.get("completed")}
+    return [(draw_wetted_share(d), d["mu"] / theirs[key] - 1.0) for d in result.get("draws", []) if d.get("completed")
+            for key in [(d["tool_seed"], d["chip_seed"])] if key in theirs]
 
 
 def paired_change(result, other):
     """Mean relative change of mu from `other` to `result` over the draws both ran with the same tool
     and chip seeds, and its standard error (None when fewer than two draws pair)."""
-    theirs = {(d["tool_seed"], d["chip_seed"]): d["mu"] for d in other.get("draws", []) if d.get("completed")}
-    changes = [d["mu"] / theirs[key] - 1.0 for d in result.get("draws", []) if d.get("completed")
-               for key in [(d["tool_seed"], d["chip_seed"])] if key in theirs]
+    changes = [change for _, change in paired_changes_and_shares(result, other)]
     if len(changes) < 2:
         return None
     return statistics.mean(changes), statistics.stdev(changes) / len(changes) ** 0.5
@@ -104,6 +112,16 @@ def main():
                 cell = f"{100 * change[0]:+.1f} % ± {100 * change[1]:.1f} %" if change else "fewer than two paired draws"
                 p, v, t = pt
                 print(f"| {law} | {p:g} | {v:g} | {t:g} | {r['mu']:.4f} | {o['mu']:.4f} | {cell} | {window_wetted_share(r)} |")
+        # Does the change follow how much of the contact the liquid reaches? Least squares through the
+        # origin of the per-draw change on the per-draw window wetted share, per law, over every paired point.
+        for law, rows in laws.items():
+            pairs = [(share, change) for pt, r in rows.items() if r.get("completed") and other.get(law, {}).get(pt, {}).get("completed")
+                     for share, change in paired_changes_and_shares(r, other[law][pt]) if share is not None]
+            shares, changes = [x for x, _ in pairs], [y for _, y in pairs]
+            if len(pairs) >= 3 and statistics.pstdev(shares) > 0 and statistics.pstdev(changes) > 0:
+                slope = sum(x * y for x, y in pairs) / sum(x * x for x in shares)
+                print(f"{law}: change of mu = {slope:+.3f} x the window's wetted share over {len(pairs)} draws "
+                      f"(least squares through the origin; correlation {statistics.correlation(shares, changes):+.2f})")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
