@@ -59,12 +59,17 @@ TEST(Scene, ErrorsNameTheKey) {
       {"contact.law=\"shear-factor\"", "contact.shear_factor: required when contact.law is shear-factor"},
       {"contact.shear_factor=1.5", "contact.shear_factor"},
       {"contact.law=\"coulomb\"", "contact.adhesive_coefficient: required when contact.law is coulomb"},
-      {"contact.adhesive_coefficient=-0.1", "contact.adhesive_coefficient"}};
+      {"contact.adhesive_coefficient=-0.1", "contact.adhesive_coefficient"},
+      {"discretisation.volumetric=\"reduced\"", "discretisation.volumetric: 'reduced' is not one of: full, mean-dilatation"}};
   for (const auto& [assignment, expected] : cases) {
     nlohmann::json bad = j;
     apply_override(bad, assignment);
     EXPECT_NE(error_of(bad).find(expected), std::string::npos) << assignment << ": " << error_of(bad);
   }
+  EXPECT_EQ(parse_scene(j, "s").volumetric, solid::VolumetricTreatment::full);  // seed 000's element by default
+  nlohmann::json f_bar = j;
+  apply_override(f_bar, "discretisation.volumetric=\"mean-dilatation\"");
+  EXPECT_EQ(parse_scene(f_bar, "s").volumetric, solid::VolumetricTreatment::mean_dilatation);
   nlohmann::json drained = j;
   apply_override(drained, "lubricant.fill=\"after-pressing\"");
   EXPECT_NO_THROW(parse_scene(drained, "scene.json"));

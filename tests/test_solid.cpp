@@ -173,9 +173,13 @@ TEST(JohnsonCook, ResidualOnlyUpdateGivesTheSameStressAndState) {
 }
 
 // ---- Consistent tangent: K w against central differences of f_int, elastic and plastic states.
-TEST(SolidTangent, ConsistentTangentMatchesFiniteDifferencesElasticAndPlastic) {
+// The tangent of the displacement formulation and of the mean-dilatation (F-bar) element: each the
+// central difference of its own residual. The check multiplies by the stored lower triangle, so an
+// element tangent that were not symmetric would fail it too.
+void expect_consistent_tangent(VolumetricTreatment volumetric) {
   const auto material = std::make_shared<J2JohnsonCook>(JohnsonCookParameters());
-  SolidProblem problem(IgaSpace(quad_patch({0, 0}, {1e-5, 0.1e-5}, {0, 1e-5}, {1.2e-5, 1.1e-5}, 2, 2, 2)), material);
+  SolidProblem problem(IgaSpace(quad_patch({0, 0}, {1e-5, 0.1e-5}, {0, 1e-5}, {1.2e-5, 1.1e-5}, 2, 2, 2)), material,
+                       MaterialState(), volumetric);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   Eigen::VectorXd u(problem.dof_count());
@@ -191,6 +195,14 @@ TEST(SolidTangent, ConsistentTangentMatchesFiniteDifferencesElasticAndPlastic) {
   // And from a committed plastic history (Cp ≠ I, ε̄p > 0), loading on.
   problem.commit(at.states);
   expect_tangent_matches_finite_differences(problem, 1.1 * u, 1e-8, "plastic with history");
+}
+
+TEST(SolidTangent, ConsistentTangentMatchesFiniteDifferencesElasticAndPlastic) {
+  expect_consistent_tangent(VolumetricTreatment::full);
+}
+
+TEST(SolidTangent, MeanDilatationTangentMatchesFiniteDifferencesElasticAndPlastic) {
+  expect_consistent_tangent(VolumetricTreatment::mean_dilatation);
 }
 
 // ---- Patch tests: a distorted parameterisation reproduces a uniform state exactly.
@@ -247,9 +259,12 @@ TEST(PatchTest, DistortedPatchUnderUniformTractionHasUniformStress) {
   }
 }
 
-TEST(PatchTest, FiniteStrainPatchReproducesAHomogeneousDeformation) {
+// Both volume treatments: with a uniform J, F̄ = F and the mean-dilatation element is exact too.
+class FiniteStrainPatch : public ::testing::TestWithParam<VolumetricTreatment> {};
+
+TEST_P(FiniteStrainPatch, ReproducesAHomogeneousDeformation) {
   const auto material = std::make_shared<J2JohnsonCook>(JohnsonCookParameters());
-  SolidProblem problem(IgaSpace(distorted_square(8)), material);
+  SolidProblem problem(IgaSpace(distorted_square(8)), material, MaterialState(), GetParam());
   Eigen::Matrix2d h;
   h << 8e-4, 3e-4, -1e-4, -5e-4;  // elastic, with rotation
   for (const Side side : {Side::bottom, Side::top, Side::left, Side::right}) {
@@ -267,6 +282,67 @@ TEST(PatchTest, FiniteStrainPatchReproducesAHomogeneousDeformation) {
   ASSERT_TRUE(integrator.run().completed);
   for (const auto& q : problem.space().quadrature()) {
     EXPECT_LT((IgaSpace::gradient(q, integrator.u()) - h).norm(), 1e-12);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(PatchTest, FiniteStrainPatch,
+                         ::testing::Values(VolumetricTreatment::full, VolumetricTreatment::mean_dilatation));
+
+// ---- A thick-walled cylinder (inner radius a, outer b) under internal pressure, plane strain,
+// perfectly plastic and nearly incompressible (ν = 0.4999): Hill, The Mathematical Theory of
+// Plasticity (1950), ch. V §3. The plastic zone a ≤ r ≤ c holds p = k (1 − c²/b² + 2 ln(c/a)), and
+// an incompressible cylinder moves as u = C/r with C = k c²/(2G) (the elastic zone's σθ − σr =
+// 4GC/r² reaches 2k at c), so u(b) = k c²/(2 G b). The quarter annulus is an exact NURBS patch.
+// A displacement element with a full quadrature meets one volume constraint per quadrature point
+// and locks (Elguedj et al., CMAME 197:2732, 2008, §6); the mean-dilatation element follows Hill.
+double cylinder_outer_displacement(VolumetricTreatment volumetric, double pressure_over_k) {
+  constexpr double a = 1.0, b = 2.0;
+  JohnsonCookParameters jc;
+  jc.poisson_ratio = 0.4999;
+  jc.b = 0.0;  // perfectly plastic: σy = A
+  jc.c = 0.0;
+  jc.heat_fraction = 0.0;
+  const double k = jc.a / std::sqrt(3.0);
+  MaterialState initial;
+  initial.temperature = jc.transition_temperature;
+  // u: the angle, clockwise from the y axis (a 90° arc, weights 1, √2/2, 1), v: the radius (linear,
+  // then elevated); clockwise so that the parameterisation keeps its orientation.
+  Points2 p(6, 2);
+  p << 0, a, a, a, a, 0, 0, b, b, b, b, 0;
+  Eigen::VectorXd w(6);
+  w << 1, std::sqrt(0.5), 1, 1, std::sqrt(0.5), 1;
+  const SplineSurface quarter =
+      SplineSurface(SplineBasis::open_uniform(2, 1, 0, 1), SplineBasis::open_uniform(1, 1, 0, 1), p, w)
+          .elevated_v()
+          .subdivided(8, 8);
+  SolidProblem problem(IgaSpace(quarter), std::make_shared<J2JohnsonCook>(jc), initial, volumetric);
+  problem.fix_side(Side::left, 0);   // the y axis
+  problem.fix_side(Side::right, 1);  // the x axis
+  problem.add_load({Side::bottom, Eigen::Vector2d::Zero(), pressure_over_k * k, [](double t) { return t; }});
+  TimeIntegrationOptions options;
+  options.scheme = TimeScheme::quasi_static;
+  options.dt = 0.1;
+  options.end_time = 1.0;
+  options.relative_tolerance = 1e-10;
+  TimeIntegrator integrator(problem, options);
+  const IntegrationReport report = integrator.run();
+  EXPECT_TRUE(report.completed) << report.reason;
+  return problem.space().displacement(integrator.u(), 0.5, 1.0).norm();  // u = ½: 45°; v = 1: r = b
+}
+
+TEST(ThickCylinder, MeanDilatationFollowsHillsElasticPlasticSolutionWhereTheFullQuadratureLocks) {
+  JohnsonCookParameters jc;
+  const double k = jc.a / std::sqrt(3.0), shear = jc.youngs_modulus / (2.0 * 1.4999);
+  for (const double c : {1.5, 1.8}) {  // plastic radius; a = 1, b = 2
+    const double pressure_over_k = 1.0 - c * c / 4.0 + 2.0 * std::log(c);
+    const double hill = k * c * c / (2.0 * shear * 2.0);
+    const double mean_dilatation = cylinder_outer_displacement(VolumetricTreatment::mean_dilatation, pressure_over_k);
+    const double full = cylinder_outer_displacement(VolumetricTreatment::full, pressure_over_k);
+    std::printf("c/a = %.1f, p/k = %.4f: u(b) Hill %.6e, mean dilatation %.6e (%+.2f %%), full %.6e (%+.2f %%)\n", c,
+                pressure_over_k, hill, mean_dilatation, 100 * (mean_dilatation / hill - 1), full, 100 * (full / hill - 1));
+    EXPECT_NEAR(mean_dilatation / hill, 1.0, 0.01) << "c/a = " << c;
+    // The case discriminates: the displacement element is measurably stiffer (−2 % and −6 % here).
+    EXPECT_GT(std::abs(full / hill - 1.0), 2.0 * std::abs(mean_dilatation / hill - 1.0)) << "c/a = " << c;
   }
 }
 

@@ -388,7 +388,8 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
   initial.temperature = scene.temperature;
   LoadedChip chip;
   chip.problem = std::make_unique<solid::SolidProblem>(solid::IgaSpace(patch),
-                                                       std::make_shared<solid::J2JohnsonCook>(scene.material), initial);
+                                                       std::make_shared<solid::J2JohnsonCook>(scene.material), initial,
+                                                       scene.volumetric);
   solid::SolidProblem& problem = *chip.problem;
   chip.contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
                                                           scene.penalty, scene.contact_points_per_span,

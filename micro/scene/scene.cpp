@@ -211,6 +211,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     s.elements_x = d.integer("elements_x", s.elements_x, 4, 100000);
     s.elements_y = d.integer("elements_y", s.elements_y, 1, 100000);
     s.grading = d.number("grading", s.grading, 1.0, 6.0);
+    s.volumetric = d.choice("volumetric", s.volumetric);
     s.contact_points_per_span = d.integer("contact_points_per_span", s.contact_points_per_span, 0, 20);
     d.finish();
   }

@@ -161,6 +161,8 @@ struct Scene {
   int elements_x = 64;
   int elements_y = 12;
   double grading = 2.0;          // spans across the height shrink toward the surface: v_k = 1 − (1 − k/n)^grading
+  // full: the displacement formulation (seed 000's); mean-dilatation: F-bar (solid_problem.hpp)
+  solid::VolumetricTreatment volumetric = solid::VolumetricTreatment::full;
   int contact_points_per_span = 0;  // 0: degree + 3
   // material (seed 000 Table 1)
   solid::JohnsonCookParameters material;
@@ -223,6 +225,11 @@ template <>
 struct SceneChoice<solid::TimeScheme> {
   static constexpr std::array<NamedChoice<solid::TimeScheme>, 2> names{
       {{"generalized-alpha", solid::TimeScheme::generalized_alpha}, {"quasi-static", solid::TimeScheme::quasi_static}}};
+};
+template <>
+struct SceneChoice<solid::VolumetricTreatment> {
+  static constexpr std::array<NamedChoice<solid::VolumetricTreatment>, 2> names{
+      {{"full", solid::VolumetricTreatment::full}, {"mean-dilatation", solid::VolumetricTreatment::mean_dilatation}}};
 };
 template <>
 struct SceneChoice<numerics::LinearSolverKind> {

@@ -1,17 +1,37 @@
 #include "micro/solid/solid_problem.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <tuple>
 
 #include "common/error.hpp"
 
 namespace mufric::solid {
+namespace {
 
-SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> material, MaterialState initial_state)
-    : space_(std::move(space)), material_(std::move(material)),
+// Per-quadrature-point scratch of an element: a fixed array when the node count is a compile-time
+// constant (an element has at most as many points as nodes), else a vector.
+template <class T, int N>
+struct PointArray : std::array<T, static_cast<size_t>(N)> {
+  explicit PointArray(size_t /*points*/) {}
+};
+template <class T>
+struct PointArray<T, Eigen::Dynamic> : std::vector<T> {
+  explicit PointArray(size_t points) : std::vector<T>(points) {}
+};
+
+}  // namespace
+
+SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> material, MaterialState initial_state,
+                           VolumetricTreatment volumetric)
+    : space_(std::move(space)), material_(std::move(material)), volumetric_(volumetric),
       states_(space_.quadrature().size(), initial_state),
       constrained_(static_cast<size_t>(space_.dof_count()), false) {
+  if (volumetric_ == VolumetricTreatment::mean_dilatation && !material_->finite_strain()) {
+    throw Error("solid problem: the mean-dilatation (F-bar) element needs a finite-strain material");
+  }
   build_pattern();
 }
 
@@ -302,6 +322,152 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
   }
 }
 
+template <int Nen>
+void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen::VectorXd& u, double dt,
+                                                    bool with_tangent, const std::vector<MaterialState>* iterate,
+                                                    Assembly& out, std::string& failure) const {
+  // Flattened 2 × 2 tensors follow the material's order: (0,0), (0,1), (1,0), (1,1).
+  // With F̄ = s F, s = (J̄/J)^{1/2}, the virtual work Σ w P̄ : δF̄ becomes Σ w S* : δF with
+  // S* = s P̄ + (M̄/J̄ − m/J) cof F, m = ½ P̄ : F̄ and M̄ its element mean (δJ = cof F : δF, and
+  // δJ̄ = mean of δJ); the tangent is the derivative of S* (cof is linear in 2D).
+  constexpr int kDofs = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
+  using Gradient = Eigen::Matrix<double, 4, kDofs>;  // ∂F/∂u_e or ∂(·)/∂u_e of a flattened tensor
+  using DofRow = Eigen::Matrix<double, 1, kDofs>;
+  const int nen = Nen == Eigen::Dynamic ? element_nodes_count_ : Nen;
+  const int n = 2 * nen;
+  const int* nodes = element_nodes_.data() + element * static_cast<size_t>(nen);
+  const int first = element_first_point_[element], points = element_first_point_[element + 1] - first;
+  const auto cofactor = [](const Eigen::Vector4d& f) { return Eigen::Vector4d(f(3), -f(2), -f(1), f(0)); };
+  // Per-point scratch on the stack when the node count is fixed (points ≤ nodes: build_pattern).
+  const auto scratch = [points]<class T>(T) { return PointArray<T, Nen>(static_cast<size_t>(points)); };
+  auto f = scratch(Eigen::Vector4d());
+  auto h = scratch(Eigen::Vector4d());  // H = F − I
+  auto jac = scratch(0.0), jac_minus_one = scratch(0.0), weight = scratch(0.0);
+  double volume = 0.0, mean_j_minus_one = 0.0;
+  for (int q = 0; q < points; ++q) {
+    const auto uk = static_cast<size_t>(first + q);
+    const double* g = point_gradients_.data() + uk * 2 * static_cast<size_t>(nen);
+    const auto qk = static_cast<size_t>(q);
+    h[qk].setZero();
+    for (int a = 0; a < nen; ++a) {
+      const double ux = u(2 * nodes[a]), uy = u(2 * nodes[a] + 1);
+      h[qk](0) += ux * g[a];
+      h[qk](1) += ux * g[nen + a];
+      h[qk](2) += uy * g[a];
+      h[qk](3) += uy * g[nen + a];
+    }
+    f[qk] = h[qk] + Eigen::Vector4d(1.0, 0.0, 0.0, 1.0);
+    // J − 1 from H, not from F = I + H: at small strains 1 + H would round H's digits away.
+    jac_minus_one[qk] = h[qk](0) + h[qk](3) + h[qk](0) * h[qk](3) - h[qk](1) * h[qk](2);
+    jac[qk] = 1.0 + jac_minus_one[qk];
+    if (!(jac[qk] > 0.0)) {
+      const auto& point = space_.quadrature()[uk];
+      failure = "the chip's deformation inverts an element (det F = " + std::to_string(jac[qk]) + ") at X = (" +
+                std::to_string(point.position.x()) + ", " + std::to_string(point.position.y()) + ")";
+      return;
+    }
+    weight[qk] = point_weights_[uk];
+    volume += weight[qk];
+    mean_j_minus_one += weight[qk] * jac_minus_one[qk];
+  }
+  mean_j_minus_one /= volume;
+  const double mean_j = 1.0 + mean_j_minus_one;
+  auto p_bar = scratch(Eigen::Vector4d());
+  auto a_bar = scratch(Eigen::Matrix4d());
+  auto m = scratch(0.0), s = scratch(0.0);
+  double mean_m = 0.0;
+  for (int q = 0; q < points; ++q) {
+    const auto uk = static_cast<size_t>(first + q);
+    const auto qk = static_cast<size_t>(q);
+    // s − 1 and H̄ = s H + (s − 1) I written so that no digit of a small H is lost.
+    const double ratio_minus_one = (mean_j_minus_one - jac_minus_one[qk]) / jac[qk];
+    const double s_minus_one = ratio_minus_one / (std::sqrt(1.0 + ratio_minus_one) + 1.0);
+    s[qk] = 1.0 + s_minus_one;
+    const Eigen::Vector4d f_bar = s[qk] * f[qk];
+    Eigen::Matrix2d h_bar;
+    h_bar << s[qk] * h[qk](0) + s_minus_one, s[qk] * h[qk](1), s[qk] * h[qk](2), s[qk] * h[qk](3) + s_minus_one;
+    StressResponse r = material_->update(h_bar, states_[uk], dt, with_tangent, iterate != nullptr ? &(*iterate)[uk] : nullptr);
+    if (!r.ok) {
+      const auto& point = space_.quadrature()[uk];
+      failure = r.reason + " at X = (" + std::to_string(point.position.x()) + ", " + std::to_string(point.position.y()) + ")";
+      return;
+    }
+    p_bar[qk] << r.stress(0, 0), r.stress(0, 1), r.stress(1, 0), r.stress(1, 1);
+    if (with_tangent) a_bar[qk] = r.tangent;
+    m[qk] = 0.5 * p_bar[qk].dot(f_bar);
+    mean_m += weight[qk] * m[qk];
+    out.states[uk] = std::move(r.state);
+  }
+  mean_m /= volume;
+  // ∂F/∂u_e at a point: x dofs move the first row of F, y dofs the second.
+  const auto f_gradient = [&](int q) {
+    const double* g = point_gradients_.data() + static_cast<size_t>(first + q) * 2 * static_cast<size_t>(nen);
+    Gradient b = Gradient::Zero(4, n);
+    for (int a = 0; a < nen; ++a) {
+      b(0, a) = b(2, nen + a) = g[a];
+      b(1, a) = b(3, nen + a) = g[nen + a];
+    }
+    return b;
+  };
+  for (int q = 0; q < points; ++q) {
+    const auto uk = static_cast<size_t>(first + q);
+    const auto qk = static_cast<size_t>(q);
+    const Eigen::Vector4d effective = s[qk] * p_bar[qk] + (mean_m / mean_j - m[qk] / jac[qk]) * cofactor(f[qk]);
+    const DofRow force = weight[qk] * effective.transpose() * f_gradient(q);
+    for (int a = 0; a < nen; ++a) {
+      out.internal(2 * nodes[a]) += force(a);
+      out.internal(2 * nodes[a] + 1) += force(nen + a);
+    }
+    out.stresses[uk] << effective(0), effective(1), effective(2), effective(3);
+  }
+  if (!with_tangent) return;
+  auto b = scratch(Gradient()), d_f_bar = scratch(Gradient()), d_p_bar = scratch(Gradient());
+  auto d_j = scratch(DofRow()), d_m = scratch(DofRow()), d_log_s = scratch(DofRow());
+  DofRow d_mean_j = DofRow::Zero(n);
+  for (int q = 0; q < points; ++q) {
+    const auto qk = static_cast<size_t>(q);
+    b[qk] = f_gradient(q);
+    d_j[qk] = cofactor(f[qk]).transpose() * b[qk];
+    d_mean_j += weight[qk] / volume * d_j[qk];
+  }
+  DofRow d_mean_m = DofRow::Zero(n);
+  for (int q = 0; q < points; ++q) {
+    const auto qk = static_cast<size_t>(q);
+    d_log_s[qk] = 0.5 * (d_mean_j / mean_j - d_j[qk] / jac[qk]);
+    d_f_bar[qk] = s[qk] * (b[qk] + f[qk] * d_log_s[qk]);
+    d_p_bar[qk] = a_bar[qk] * d_f_bar[qk];
+    d_m[qk] = 0.5 * ((s[qk] * f[qk]).transpose() * d_p_bar[qk] + p_bar[qk].transpose() * d_f_bar[qk]);
+    d_mean_m += weight[qk] / volume * d_m[qk];
+  }
+  Eigen::Matrix<double, kDofs, kDofs> k = Eigen::Matrix<double, kDofs, kDofs>::Zero(n, n);
+  for (int q = 0; q < points; ++q) {
+    const auto qk = static_cast<size_t>(q);
+    const Gradient& bq = b[qk];
+    Gradient cof_b(4, n);  // cof(δF) for each dof
+    cof_b.row(0) = bq.row(3);
+    cof_b.row(1) = -bq.row(2);
+    cof_b.row(2) = -bq.row(1);
+    cof_b.row(3) = bq.row(0);
+    const DofRow d_coefficient = d_mean_m / mean_j - mean_m / (mean_j * mean_j) * d_mean_j - d_m[qk] / jac[qk] +
+                                 m[qk] / (jac[qk] * jac[qk]) * d_j[qk];
+    const Gradient d_effective = s[qk] * p_bar[qk] * d_log_s[qk] + s[qk] * d_p_bar[qk] +
+                                 cofactor(f[qk]) * d_coefficient + (mean_m / mean_j - m[qk] / jac[qk]) * cof_b;
+    k.noalias() += weight[qk] * bq.transpose() * d_effective;
+  }
+  scatter_element_tangent(element, k.data(), n, out);
+}
+
+void SolidProblem::scatter_element_tangent(size_t element, const double* k, int n, Assembly& out) const {
+  double* values = out.tangent.valuePtr();
+  const int* slots = element_slots_[element].data();
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r < n; ++r) {
+      const int slot = slots[r + n * c];
+      if (slot >= 0) values[slot] += k[r + n * c];  // −1: above the diagonal, the lower triangle is stored
+    }
+  }
+}
+
 SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double dt, bool with_tangent,
                                               const std::vector<MaterialState>* iterate) const {
   if (iterate != nullptr && iterate->size() != states_.size()) iterate = nullptr;  // not this problem's
@@ -313,6 +479,12 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
   const size_t elements = element_first_point_.size() - 1;
   std::vector<std::string> failure(elements);
   const auto kernel = [&](size_t e) {
+    if (volumetric_ == VolumetricTreatment::mean_dilatation) {
+      switch (element_nodes_count_) {
+        case 9: return assemble_element_mean_dilatation<9>(e, u, dt, with_tangent, iterate, out, failure[e]);
+        default: return assemble_element_mean_dilatation<Eigen::Dynamic>(e, u, dt, with_tangent, iterate, out, failure[e]);
+      }
+    }
     switch (element_nodes_count_) {
       case 4: return assemble_element<4>(e, u, dt, with_tangent, iterate, out, failure[e]);
       case 9: return assemble_element<9>(e, u, dt, with_tangent, iterate, out, failure[e]);

@@ -42,6 +42,16 @@ class MovableSparseMatrix : public SparseMatrix {
 };
 using TimeFunction = std::function<double(double)>;  // scale of a boundary condition at time t
 
+// How the element treats the volume change. `full`: every quadrature point takes its own F (the
+// displacement formulation; seed 000's). `mean_dilatation`: the F-bar method with the element's mean
+// dilatation (de Souza Neto, Perić, Dutko & Owen, Int. J. Solids Struct. 33:3277, 1996): each point's
+// F is replaced by F̄ = (J̄/J)^{1/2} F (plane strain), J̄ the element's reference-volume average of
+// det F, so that an isochoric plastic flow meets one volume constraint per element instead of one per
+// quadrature point (a C¹ quadratic patch has two displacement dofs per element against nine points:
+// the displacement formulation locks in fully plastic flow; Elguedj, Bazilevs, Calo & Hughes, CMAME
+// 197:2732, 2008, who project J onto a lower-order spline space instead of the element mean).
+enum class VolumetricTreatment { full, mean_dilatation };
+
 struct DirichletCondition {
   int node = 0, component = 0;  // component 0: x, 1: y
   double value = 0.0;           // m, multiplied by scale(t)
@@ -93,10 +103,12 @@ class TangentAccumulator {
 class SolidProblem {
  public:
   SolidProblem(IgaSpace space, std::shared_ptr<const Material> material,
-               MaterialState initial_state = MaterialState());
+               MaterialState initial_state = MaterialState(),
+               VolumetricTreatment volumetric = VolumetricTreatment::full);
 
   const IgaSpace& space() const { return space_; }
   const Material& material() const { return *material_; }
+  VolumetricTreatment volumetric() const { return volumetric_; }
   int dof_count() const { return space_.dof_count(); }
 
   void add_dirichlet(DirichletCondition condition);
@@ -153,8 +165,17 @@ class SolidProblem {
   template <int Nen>
   void assemble_element(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent,
                         const std::vector<MaterialState>* iterate, Assembly& out, std::string& failure) const;
+  // The same with F̄ (VolumetricTreatment::mean_dilatation): forces and tangent are the exact
+  // derivatives of Σ_q w_q W(F̄_q), so the tangent stays symmetric.
+  template <int Nen>
+  void assemble_element_mean_dilatation(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent,
+                                        const std::vector<MaterialState>* iterate, Assembly& out,
+                                        std::string& failure) const;
+  // Scatters an element's n × n tangent (column-major, local dofs component-major) into the lower triangle.
+  void scatter_element_tangent(size_t element, const double* k, int n, Assembly& out) const;
   IgaSpace space_;
   std::shared_ptr<const Material> material_;
+  VolumetricTreatment volumetric_ = VolumetricTreatment::full;
   std::vector<MaterialState> states_;  // one per quadrature point, committed
   std::vector<DirichletCondition> dirichlet_;
   std::vector<bool> constrained_;
