@@ -399,21 +399,23 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
     out.states[uk] = std::move(r.state);
   }
   mean_m /= volume;
-  // ∂F/∂u_e at a point: x dofs move the first row of F, y dofs the second.
-  const auto f_gradient = [&](int q) {
+  // ∂F/∂u_e at each point (x dofs move the first row of F, y dofs the second): built once, used by
+  // the forces and the tangent.
+  auto b = scratch(Gradient());
+  for (int q = 0; q < points; ++q) {
     const double* g = point_gradients_.data() + static_cast<size_t>(first + q) * 2 * static_cast<size_t>(nen);
-    Gradient b = Gradient::Zero(4, n);
+    Gradient& bq = b[static_cast<size_t>(q)];
+    bq = Gradient::Zero(4, n);
     for (int a = 0; a < nen; ++a) {
-      b(0, a) = b(2, nen + a) = g[a];
-      b(1, a) = b(3, nen + a) = g[nen + a];
+      bq(0, a) = bq(2, nen + a) = g[a];
+      bq(1, a) = bq(3, nen + a) = g[nen + a];
     }
-    return b;
-  };
+  }
   for (int q = 0; q < points; ++q) {
     const auto uk = static_cast<size_t>(first + q);
     const auto qk = static_cast<size_t>(q);
     const Eigen::Vector4d effective = s[qk] * p_bar[qk] + (mean_m / mean_j - m[qk] / jac[qk]) * cofactor(f[qk]);
-    const DofRow force = weight[qk] * effective.transpose() * f_gradient(q);
+    const DofRow force = weight[qk] * effective.transpose() * b[qk];
     for (int a = 0; a < nen; ++a) {
       out.internal(2 * nodes[a]) += force(a);
       out.internal(2 * nodes[a] + 1) += force(nen + a);
@@ -421,12 +423,11 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
     out.stresses[uk] << effective(0), effective(1), effective(2), effective(3);
   }
   if (!with_tangent) return;
-  auto b = scratch(Gradient()), d_f_bar = scratch(Gradient()), d_p_bar = scratch(Gradient());
+  auto d_f_bar = scratch(Gradient()), d_p_bar = scratch(Gradient());
   auto d_j = scratch(DofRow()), d_m = scratch(DofRow()), d_log_s = scratch(DofRow());
   DofRow d_mean_j = DofRow::Zero(n);
   for (int q = 0; q < points; ++q) {
     const auto qk = static_cast<size_t>(q);
-    b[qk] = f_gradient(q);
     d_j[qk] = cofactor(f[qk]).transpose() * b[qk];
     d_mean_j += weight[qk] / volume * d_j[qk];
   }
