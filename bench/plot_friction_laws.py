@@ -7,7 +7,10 @@ mu at the box's corners when they were run (OUT/friction_laws_corners.png). With
 (e.g. the dry study beside a lubricated one) the other study's laws are drawn dashed in the same
 figure and hatched beside each corner's bar, so lubricated and dry can be read off one plot, and a
 second table gives, per law and point both studies ran, the change of mu paired over the draws (the
-same tool and chip seeds in both: their common error cancels).
+same tool and chip seeds in both: their common error cancels); where the box's corners were run, a
+corner table (the other study's final contact fraction, mu, the paired change, the wetted share and
+the work split side by side) and an edge table (mu's change along each edge of the box that joins two
+corners both studies ran, in each study) follow.
 
   /usr/bin/python3 bench/plot_friction_laws.py OUT [--against OTHER]
 """
@@ -54,6 +57,72 @@ def paired_change(result, other):
     if len(changes) < 2:
         return None
     return statistics.mean(changes), statistics.stdev(changes) / len(changes) ** 0.5
+
+
+def final_contact_fraction(result):
+    """The contact fraction of each draw's last step, mean over the draws ("" without any)."""
+    shares = [d["history"][-1]["contact_area_fraction"] for d in result.get("draws", []) if d.get("history")]
+    return f"{sum(shares) / len(shares):.2f}" if shares else ""
+
+
+def edge_change(start, end):
+    """mu's change from the point `start` to the point `end` of one study: the ratio of the means over
+    the draws, and the standard error of the per-draw changes (the draws at both points share their tool
+    and chip seeds, so the change is paired; None when fewer than two draws pair)."""
+    changes = [change for _, change in paired_changes_and_shares(end, start)]
+    if len(changes) < 2:
+        return None
+    return end["mu"] / start["mu"] - 1.0, statistics.stdev(changes) / len(changes) ** 0.5
+
+
+def corner_points(points, centre):
+    """The points that differ from the box's centre in all three coordinates."""
+    return [pt for pt in points if sum(pt[i] != centre[i] for i in range(3)) == 3]
+
+
+def box_centre(points):
+    """The middle value of each coordinate over the points run."""
+    return tuple(sorted({pt[i] for pt in points})[len({pt[i] for pt in points}) // 2] for i in range(3))
+
+
+def print_corner_tables(laws, name, other, other_name, corners):
+    """Per law, the corners both studies completed side by side, then mu's change along each edge of
+    the box between two such corners, in this study and in the other."""
+    def both_completed(law, pt):
+        return laws[law].get(pt, {}).get("completed") and other.get(law, {}).get(pt, {}).get("completed")
+    def split(result, key):
+        return result.get("work_split", {}).get(key, float("nan"))
+    def cell(change):
+        return f"{100 * change[0]:+.1f} % ± {100 * change[1]:.1f} %" if change else "fewer than two paired draws"
+    for law in laws:
+        done = [pt for pt in corners if both_completed(law, pt)]
+        if not done:
+            continue
+        print(f"\n{law} at the corners (contact: {other_name}'s final contact fraction, mean over the draws)\n")
+        print(f"| p [MPa] | v [m/min] | T [C] | contact ({other_name}) | mu | mu ({other_name}) | change, paired over the draws "
+              f"| wetted (window) | interface / {other_name} | plastic / {other_name} |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for pt in done:
+            r, o = laws[law][pt], other[law][pt]
+            p, v, t = pt
+            print(f"| {p:g} | {v:g} | {t:g} | {final_contact_fraction(o)} | {r['mu']:.4f} ± {r.get('mu_std_error') or 0:.4f} "
+                  f"| {o['mu']:.4f} ± {o.get('mu_std_error') or 0:.4f} | {cell(paired_change(r, o))} | {window_wetted_share(r)} "
+                  f"| {split(r, 'mu_interface'):.4f} / {split(o, 'mu_interface'):.4f} "
+                  f"| {split(r, 'mu_bulk_plastic'):.4f} / {split(o, 'mu_bulk_plastic'):.4f} |")
+        names = ("p", "v", "T")
+        units = ("MPa", "m/min", "C")
+        print(f"\n{law} along the box's edges (ratio of the mean mu over the draws ± the standard error of the per-draw changes)\n")
+        print(f"| change | {name} | {other_name} |")
+        print("|---|---|---|")
+        for a in done:
+            for b in done:
+                moved = [i for i in range(3) if a[i] != b[i]]
+                if len(moved) != 1 or a[moved[0]] > b[moved[0]]:
+                    continue
+                i = moved[0]
+                fixed = ", ".join(f"{a[j]:g} {units[j]}" for j in range(3) if j != i)
+                print(f"| {names[i]} {a[i]:g} → {b[i]:g} {units[i]} at {fixed} "
+                      f"| {cell(edge_change(laws[law][a], laws[law][b]))} | {cell(edge_change(other[law][a], other[law][b]))} |")
 
 
 def read_study(out):
@@ -122,11 +191,14 @@ def main():
                 slope = sum(x * y for x, y in pairs) / sum(x * x for x in shares)
                 print(f"{law}: change of mu = {slope:+.3f} x the window's wetted share over {len(pairs)} draws "
                       f"(least squares through the origin; correlation {statistics.correlation(shares, changes):+.2f})")
+    all_points = sorted({pt for rows in laws.values() for pt in rows})
+    centre = box_centre(all_points)
+    corners = corner_points(all_points, centre)
+    if other and corners:
+        print_corner_tables(laws, out.name, other, other_name, corners)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    all_points = sorted({pt for rows in laws.values() for pt in rows})
-    centre = tuple(sorted({pt[i] for pt in all_points})[len({pt[i] for pt in all_points}) // 2] for i in range(3))
     # One colour per law, whichever study it comes from: the other study's line is the same colour, dashed.
     cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     colour = {law: cycle[i % len(cycle)] for i, law in enumerate(dict.fromkeys(list(laws) + list(other)))}
@@ -152,7 +224,6 @@ def main():
     fig.savefig(out / "friction_laws.png", dpi=110)
     print(f"figure: {out / 'friction_laws.png'}")
     # The corners (CORNERS=1): every point off the three lines through the centre, μ per law side by side.
-    corners = [pt for pt in all_points if sum(pt[i] != centre[i] for i in range(3)) == 3]
     if corners:
         fig, ax = plt.subplots(figsize=(11, 4))
         # Each law's bar beside the other study's (hatched) for the same law; a law this study ran only
