@@ -331,7 +331,6 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
   // S* = s P̄ + (M̄/J̄ − m/J) cof F, m = ½ P̄ : F̄ and M̄ its element mean (δJ = cof F : δF, and
   // δJ̄ = mean of δJ); the tangent is the derivative of S* (cof is linear in 2D).
   constexpr int kDofs = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
-  using Gradient = Eigen::Matrix<double, 4, kDofs>;  // ∂F/∂u_e or ∂(·)/∂u_e of a flattened tensor
   using DofRow = Eigen::Matrix<double, 1, kDofs>;
   const int nen = Nen == Eigen::Dynamic ? element_nodes_count_ : Nen;
   const int n = 2 * nen;
@@ -399,23 +398,22 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
     out.states[uk] = std::move(r.state);
   }
   mean_m /= volume;
-  // ∂F/∂u_e at each point (x dofs move the first row of F, y dofs the second): built once, used by
-  // the forces and the tangent.
-  auto b = scratch(Gradient());
-  for (int q = 0; q < points; ++q) {
+  // bᵀv for a flattened tensor v, b = ∂F/∂u_e: x dofs move F's first row, y dofs its second, so each
+  // column of b has two non-zeros (∂R_a/∂X, ∂R_a/∂Y) and bᵀv costs two passes over the nodes.
+  const auto b_transpose = [&](int q, const Eigen::Vector4d& v) {
     const double* g = point_gradients_.data() + static_cast<size_t>(first + q) * 2 * static_cast<size_t>(nen);
-    Gradient& bq = b[static_cast<size_t>(q)];
-    bq = Gradient::Zero(4, n);
+    DofRow r(n);
     for (int a = 0; a < nen; ++a) {
-      bq(0, a) = bq(2, nen + a) = g[a];
-      bq(1, a) = bq(3, nen + a) = g[nen + a];
+      r(a) = v(0) * g[a] + v(1) * g[nen + a];
+      r(nen + a) = v(2) * g[a] + v(3) * g[nen + a];
     }
-  }
+    return r;
+  };
   for (int q = 0; q < points; ++q) {
     const auto uk = static_cast<size_t>(first + q);
     const auto qk = static_cast<size_t>(q);
     const Eigen::Vector4d effective = s[qk] * p_bar[qk] + (mean_m / mean_j - m[qk] / jac[qk]) * cofactor(f[qk]);
-    const DofRow force = weight[qk] * effective.transpose() * b[qk];
+    const DofRow force = weight[qk] * b_transpose(q, effective);
     for (int a = 0; a < nen; ++a) {
       out.internal(2 * nodes[a]) += force(a);
       out.internal(2 * nodes[a] + 1) += force(nen + a);
@@ -423,38 +421,75 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
     out.stresses[uk] << effective(0), effective(1), effective(2), effective(3);
   }
   if (!with_tangent) return;
-  auto d_f_bar = scratch(Gradient()), d_p_bar = scratch(Gradient());
-  auto d_j = scratch(DofRow()), d_m = scratch(DofRow()), d_log_s = scratch(DofRow());
+  // The tangent Σ_q w bᵀ ∂S*/∂u_e, expanded (A = ∂P̄/∂F̄, symmetric; c = M̄/J̄ − m/J; Cof the 4 × 4
+  // matrix of cof(·), linear in 2D; δ ln s = ½(δJ̄/J̄ − δJ/J)):
+  //   ∂S*/∂u_e = (s²A + c Cof) b + (s p̄ + s² A F) ⊗ δ ln s + cof F ⊗ δc,
+  // so k = Σ w bᵀ(s²A + c Cof) b — the displacement element's form with a modified A — plus rank-one
+  // terms, summed as one product of stacked rows below. Nothing 4 × n is formed per point.
   DofRow d_mean_j = DofRow::Zero(n);
+  auto d_j = scratch(DofRow());  // δJ = cof F : δF
   for (int q = 0; q < points; ++q) {
     const auto qk = static_cast<size_t>(q);
-    d_j[qk] = cofactor(f[qk]).transpose() * b[qk];
+    d_j[qk] = b_transpose(q, cofactor(f[qk]));
     d_mean_j += weight[qk] / volume * d_j[qk];
   }
-  DofRow d_mean_m = DofRow::Zero(n);
+  auto u_vec = scratch(DofRow()), d_m = scratch(DofRow()), d_log_s = scratch(DofRow());
+  DofRow d_mean_m = DofRow::Zero(n), weighted_u_sum = DofRow::Zero(n);
   for (int q = 0; q < points; ++q) {
     const auto qk = static_cast<size_t>(q);
+    const Eigen::Vector4d a_f = a_bar[qk] * f[qk];
     d_log_s[qk] = 0.5 * (d_mean_j / mean_j - d_j[qk] / jac[qk]);
-    d_f_bar[qk] = s[qk] * (b[qk] + f[qk] * d_log_s[qk]);
-    d_p_bar[qk] = a_bar[qk] * d_f_bar[qk];
-    d_m[qk] = 0.5 * ((s[qk] * f[qk]).transpose() * d_p_bar[qk] + p_bar[qk].transpose() * d_f_bar[qk]);
+    u_vec[qk] = s[qk] * b_transpose(q, p_bar[qk] + s[qk] * a_f);  // bᵀ(s p̄ + s² A F)
+    // δm = ½ δ(P̄ : F̄) = ½ [bᵀ(s p̄ + s² A F) + s (s F·A F + p̄·F) δ ln s] (A symmetric)
+    d_m[qk] = 0.5 * (u_vec[qk] + s[qk] * (s[qk] * f[qk].dot(a_f) + p_bar[qk].dot(f[qk])) * d_log_s[qk]);
     d_mean_m += weight[qk] / volume * d_m[qk];
+    weighted_u_sum += weight[qk] * u_vec[qk];
   }
-  Eigen::Matrix<double, kDofs, kDofs> k = Eigen::Matrix<double, kDofs, kDofs>::Zero(n, n);
+  // Rank-one terms Σ w u ⊗ δ ln s + Σ w δJ ⊗ δc as left/right rows: per point −½ w/J u ⊗ δJ and
+  // w δJ ⊗ (m/J² δJ − δm/J); for the element ½/J̄ (Σ w u) ⊗ δJ̄ and V δJ̄ ⊗ (δM̄/J̄ − M̄/J̄² δJ̄).
+  constexpr int kMaxRankRows = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen + 2;
+  using StackedRows = Eigen::Matrix<double, Eigen::Dynamic, kDofs, Eigen::RowMajor, kMaxRankRows, kDofs>;
+  StackedRows left(2 * points + 2, n), right(2 * points + 2, n);
   for (int q = 0; q < points; ++q) {
     const auto qk = static_cast<size_t>(q);
-    const Gradient& bq = b[qk];
-    Gradient cof_b(4, n);  // cof(δF) for each dof
-    cof_b.row(0) = bq.row(3);
-    cof_b.row(1) = -bq.row(2);
-    cof_b.row(2) = -bq.row(1);
-    cof_b.row(3) = bq.row(0);
-    const DofRow d_coefficient = d_mean_m / mean_j - mean_m / (mean_j * mean_j) * d_mean_j - d_m[qk] / jac[qk] +
-                                 m[qk] / (jac[qk] * jac[qk]) * d_j[qk];
-    const Gradient d_effective = s[qk] * p_bar[qk] * d_log_s[qk] + s[qk] * d_p_bar[qk] +
-                                 cofactor(f[qk]) * d_coefficient + (mean_m / mean_j - m[qk] / jac[qk]) * cof_b;
-    k.noalias() += weight[qk] * bq.transpose() * d_effective;
+    left.row(2 * q) = -0.5 * weight[qk] / jac[qk] * u_vec[qk];
+    right.row(2 * q) = d_j[qk];
+    left.row(2 * q + 1) = weight[qk] * d_j[qk];
+    right.row(2 * q + 1) = m[qk] / (jac[qk] * jac[qk]) * d_j[qk] - d_m[qk] / jac[qk];
   }
+  left.row(2 * points) = 0.5 / mean_j * weighted_u_sum;
+  right.row(2 * points) = d_mean_j;
+  left.row(2 * points + 1) = volume * d_mean_j;
+  right.row(2 * points + 1) = d_mean_m / mean_j - mean_m / (mean_j * mean_j) * d_mean_j;
+  // Lazy (coefficient-wise) products here and below: at these sizes Eigen's GEMM path spent more time
+  // packing its operands than multiplying (perf, bench/RESULTS.md).
+  Eigen::Matrix<double, kDofs, kDofs> k(n, n);
+  k.noalias() = left.transpose().lazyProduct(right);
+  // Σ w bᵀ Ã b, Ã = s²A + c Cof, in 2 × 2 blocks of nen × nen: block (i, k) = Gᵀ C_ik with G the points'
+  // shape-function gradients stacked (rows 2q, 2q + 1: ∂R/∂X, ∂R/∂Y) and C_ik the rows of w Ã_ik g.
+  constexpr int kMaxGradientRows = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
+  using GradientRows = Eigen::Matrix<double, Eigen::Dynamic, Nen, Eigen::RowMajor, kMaxGradientRows, Nen>;
+  GradientRows g_rows(2 * points, nen), cxx(2 * points, nen), cxy(2 * points, nen), cyy(2 * points, nen);
+  Eigen::Matrix4d cofactor_matrix;
+  cofactor_matrix << 0, 0, 0, 1, 0, 0, -1, 0, 0, -1, 0, 0, 1, 0, 0, 0;
+  for (int q = 0; q < points; ++q) {
+    const auto qk = static_cast<size_t>(q);
+    const double* g = point_gradients_.data() + static_cast<size_t>(first + q) * 2 * static_cast<size_t>(nen);
+    g_rows.row(2 * q) = Eigen::Map<const Eigen::Matrix<double, 1, Nen>>(g, nen);
+    g_rows.row(2 * q + 1) = Eigen::Map<const Eigen::Matrix<double, 1, Nen>>(g + nen, nen);
+    const Eigen::Matrix4d a_tilde =
+        weight[qk] * (s[qk] * s[qk] * a_bar[qk] + (mean_m / mean_j - m[qk] / jac[qk]) * cofactor_matrix);
+    for (const auto& [c, row, col] : {std::tuple{&cxx, 0, 0}, std::tuple{&cxy, 0, 2}, std::tuple{&cyy, 2, 2}}) {
+      const Eigen::Matrix2d a_ik = a_tilde.block<2, 2>(row, col);
+      c->row(2 * q) = a_ik(0, 0) * g_rows.row(2 * q) + a_ik(0, 1) * g_rows.row(2 * q + 1);
+      c->row(2 * q + 1) = a_ik(1, 0) * g_rows.row(2 * q) + a_ik(1, 1) * g_rows.row(2 * q + 1);
+    }
+  }
+  k.topLeftCorner(nen, nen).noalias() += g_rows.transpose().lazyProduct(cxx);
+  const auto kxy = g_rows.transpose().lazyProduct(cxy).eval();
+  k.topRightCorner(nen, nen) += kxy;
+  k.bottomLeftCorner(nen, nen) += kxy.transpose();  // Ã symmetric: block (y, x) = (x, y)ᵀ
+  k.bottomRightCorner(nen, nen).noalias() += g_rows.transpose().lazyProduct(cyy);
   scatter_element_tangent(element, k.data(), n, out);
 }
 
