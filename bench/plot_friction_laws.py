@@ -91,7 +91,8 @@ def print_corner_tables(laws, name, other, other_name, corners):
     def both_completed(law, pt):
         return laws[law].get(pt, {}).get("completed") and other.get(law, {}).get(pt, {}).get("completed")
     def split(result, key):
-        return result.get("work_split", {}).get(key, float("nan"))
+        value = result.get("work_split", {}).get(key)
+        return f"{value:.4f}" if value is not None else ""
     def cell(change):
         return f"{100 * change[0]:+.1f} % ± {100 * change[1]:.1f} %" if change else "fewer than two paired draws"
     for law in laws:
@@ -107,8 +108,8 @@ def print_corner_tables(laws, name, other, other_name, corners):
             p, v, t = pt
             print(f"| {p:g} | {v:g} | {t:g} | {final_contact_fraction(o)} | {r['mu']:.4f} ± {r.get('mu_std_error') or 0:.4f} "
                   f"| {o['mu']:.4f} ± {o.get('mu_std_error') or 0:.4f} | {cell(paired_change(r, o))} | {window_wetted_share(r)} "
-                  f"| {split(r, 'mu_interface'):.4f} / {split(o, 'mu_interface'):.4f} "
-                  f"| {split(r, 'mu_bulk_plastic'):.4f} / {split(o, 'mu_bulk_plastic'):.4f} |")
+                  f"| {split(r, 'mu_interface')} / {split(o, 'mu_interface')} "
+                  f"| {split(r, 'mu_bulk_plastic')} / {split(o, 'mu_bulk_plastic')} |")
         names = ("p", "v", "T")
         units = ("MPa", "m/min", "C")
         print(f"\n{law} along the box's edges (ratio of the mean mu over the draws ± the standard error of the per-draw changes)\n")
