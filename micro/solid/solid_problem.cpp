@@ -22,6 +22,65 @@ struct PointArray<T, Eigen::Dynamic> : std::vector<T> {
   explicit PointArray(size_t points) : std::vector<T>(points) {}
 };
 
+// Σ_q bᵀ A_q b for b = ∂F/∂u_e (x dofs move F's first row, y dofs its second) and A_q a symmetric
+// 4 × 4 material matrix already weighted, in 2 × 2 blocks of nen × nen: block (i, k) = Gᵀ C_ik with G
+// the points' shape-function gradients stacked (rows 2q, 2q + 1: ∂R/∂X, ∂R/∂Y) and C_ik the rows of
+// A_ik g. A's major symmetry makes block (y, x) = (x, y)ᵀ, so three blocks are computed, summed over
+// all points at once at the end so that each row of a block accumulates in registers instead of being
+// read and written back once per point. Rows are padded with zeros to a multiple of 4 (9 → 12): whole
+// AVX2 vectors, which Eigen's fixed-size expressions use (at width 9 the compiler kept 27 scalar
+// accumulators). The displacement element and the F-bar element (with its modified A) share it.
+template <int Nen>
+class MaterialTangentBlocks {
+ public:
+  using Block = Eigen::Matrix<double, Nen, Nen>;
+
+  MaterialTangentBlocks(int nen, int points, bool with_tangent)
+      : nen_(nen), padded_(kPadded == Eigen::Dynamic ? nen : kPadded), g_rows_(PaddedRows::Zero(2 * points, padded_)) {
+    if (with_tangent) cxx_ = cxy_ = cyy_ = PaddedRows::Zero(2 * points, padded_);
+  }
+  // Point q's gradients (2 × nen, row-major) into G.
+  void set_gradients(int q, const double* gradients) {
+    std::copy_n(gradients, nen_, g_rows_.row(2 * q).data());
+    std::copy_n(gradients + nen_, nen_, g_rows_.row(2 * q + 1).data());
+  }
+  const double* gradient_x(int q) const { return g_rows_.row(2 * q).data(); }
+  const double* gradient_y(int q) const { return g_rows_.row(2 * q + 1).data(); }
+  void add_point(int q, const Eigen::Matrix4d& weighted_tangent) {
+    for (const auto& [c, row, col] : {std::tuple{&cxx_, 0, 0}, std::tuple{&cxy_, 0, 2}, std::tuple{&cyy_, 2, 2}}) {
+      const Eigen::Matrix2d a_ik = weighted_tangent.block<2, 2>(row, col);
+      c->row(2 * q) = a_ik(0, 0) * g_rows_.row(2 * q) + a_ik(0, 1) * g_rows_.row(2 * q + 1);
+      c->row(2 * q + 1) = a_ik(1, 0) * g_rows_.row(2 * q) + a_ik(1, 1) * g_rows_.row(2 * q + 1);
+    }
+  }
+  // Blocks (x, x), (x, y) and (y, y) of Σ bᵀ A b.
+  void blocks(Block& kxx, Block& kxy, Block& kyy) const {
+    kxx.resize(nen_, nen_);
+    kxy.resize(nen_, nen_);
+    kyy.resize(nen_, nen_);
+    for (int a = 0; a < nen_; ++a) {
+      PaddedRow xx = PaddedRow::Zero(padded_), xy = PaddedRow::Zero(padded_), yy = PaddedRow::Zero(padded_);
+      for (int r = 0; r < g_rows_.rows(); ++r) {
+        const double g = g_rows_(r, a);
+        xx.noalias() += g * cxx_.row(r);
+        xy.noalias() += g * cxy_.row(r);
+        yy.noalias() += g * cyy_.row(r);
+      }
+      kxx.row(a) = xx.head(nen_);
+      kxy.row(a) = xy.head(nen_);
+      kyy.row(a) = yy.head(nen_);
+    }
+  }
+
+ private:
+  static constexpr int kMaxRows = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
+  static constexpr int kPadded = Nen == Eigen::Dynamic ? Eigen::Dynamic : (Nen + 3) / 4 * 4;
+  using PaddedRows = Eigen::Matrix<double, Eigen::Dynamic, kPadded, Eigen::RowMajor, kMaxRows, kPadded>;
+  using PaddedRow = Eigen::Matrix<double, 1, kPadded>;
+  int nen_, padded_;
+  PaddedRows g_rows_, cxx_, cxy_, cyy_;
+};
+
 }  // namespace
 
 SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> material, MaterialState initial_state,
@@ -231,29 +290,14 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
   }
   Row fx = Row::Zero(nen), fy = Row::Zero(nen);
   // The tangent in 2 × 2 blocks of nen × nen, block (i, k) = Σ w gᵀ A_ik g with A_ik(j, l) = ∂S_ij/∂H_kl
-  // (δH_kl = δu_k ∂R/∂X_l). Block (y, x) is the transpose of (x, y): the material tangent has major
-  // symmetry, so three blocks are computed.
-  // Per quadrature point q, rows 2q and 2q + 1 hold ∂R/∂X and ∂R/∂Y (G) and, for each block, the rows of
-  // w A_ik g (C): block = Gᵀ C, summed over all points at once after the loop, so that each row of a
-  // block accumulates in registers instead of being read and written back once per point.
-  // G's and C's rows are padded with zeros to a multiple of 4 (9 → 12): whole AVX2 vectors, which
-  // Eigen's fixed-size expressions use (at width 9 the compiler kept 27 scalar accumulators).
-  constexpr int kMaxRows = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
-  constexpr int kPadded = Nen == Eigen::Dynamic ? Eigen::Dynamic : (Nen + 3) / 4 * 4;
-  using PaddedRows = Eigen::Matrix<double, Eigen::Dynamic, kPadded, Eigen::RowMajor, kMaxRows, kPadded>;
-  using PaddedRow = Eigen::Matrix<double, 1, kPadded>;
-  const int padded = kPadded == Eigen::Dynamic ? nen : kPadded;
+  // (δH_kl = δu_k ∂R/∂X_l).
   const int first = element_first_point_[element], points = element_first_point_[element + 1] - first;
-  PaddedRows g_rows = PaddedRows::Zero(2 * points, padded);
-  PaddedRows cxx, cxy, cyy;
-  if (with_tangent) cxx = cxy = cyy = PaddedRows::Zero(2 * points, padded);
+  MaterialTangentBlocks<Nen> tangent(nen, points, with_tangent);
   for (int q = 0; q < points; ++q) {
     const auto uk = static_cast<size_t>(first + q);
-    const double* gradients = point_gradients_.data() + uk * 2 * static_cast<size_t>(nen);
-    std::copy_n(gradients, nen, g_rows.row(2 * q).data());
-    std::copy_n(gradients + nen, nen, g_rows.row(2 * q + 1).data());
-    const double* g0 = g_rows.row(2 * q).data();
-    const double* g1 = g_rows.row(2 * q + 1).data();
+    tangent.set_gradients(q, point_gradients(uk));
+    const double* g0 = tangent.gradient_x(q);
+    const double* g1 = tangent.gradient_y(q);
     Eigen::Matrix2d h = Eigen::Matrix2d::Zero();
     for (int a = 0; a < nen; ++a) {
       h(0, 0) += ux(a) * g0[a];
@@ -275,31 +319,10 @@ void SolidProblem::assemble_element(size_t element, const Eigen::VectorXd& u, do
     }
     out.states[uk] = std::move(r.state);
     out.stresses[uk] = r.stress;
-    if (!with_tangent) continue;
-    for (const auto& [c, row, col] : {std::tuple{&cxx, 0, 0}, std::tuple{&cxy, 0, 2}, std::tuple{&cyy, 2, 2}}) {
-      const Eigen::Matrix2d a_ik = w * r.tangent.block<2, 2>(row, col);
-      c->row(2 * q) = a_ik(0, 0) * g_rows.row(2 * q) + a_ik(0, 1) * g_rows.row(2 * q + 1);
-      c->row(2 * q + 1) = a_ik(1, 0) * g_rows.row(2 * q) + a_ik(1, 1) * g_rows.row(2 * q + 1);
-    }
+    if (with_tangent) tangent.add_point(q, w * r.tangent);
   }
   Block kxx, kxy, kyy;
-  if (with_tangent) {
-    kxx.resize(nen, nen);
-    kxy.resize(nen, nen);
-    kyy.resize(nen, nen);
-    for (int a = 0; a < nen; ++a) {
-      PaddedRow xx = PaddedRow::Zero(padded), xy = PaddedRow::Zero(padded), yy = PaddedRow::Zero(padded);
-      for (int r = 0; r < 2 * points; ++r) {
-        const double g = g_rows(r, a);
-        xx.noalias() += g * cxx.row(r);
-        xy.noalias() += g * cxy.row(r);
-        yy.noalias() += g * cyy.row(r);
-      }
-      kxx.row(a) = xx.head(nen);
-      kxy.row(a) = xy.head(nen);
-      kyy.row(a) = yy.head(nen);
-    }
-  }
+  if (with_tangent) tangent.blocks(kxx, kxy, kyy);
   for (int a = 0; a < nen; ++a) {
     out.internal(2 * nodes[a]) += fx(a);
     out.internal(2 * nodes[a] + 1) += fy(a);
@@ -345,7 +368,7 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
   double volume = 0.0, mean_j_minus_one = 0.0;
   for (int q = 0; q < points; ++q) {
     const auto uk = static_cast<size_t>(first + q);
-    const double* g = point_gradients_.data() + uk * 2 * static_cast<size_t>(nen);
+    const double* g = point_gradients(uk);
     const auto qk = static_cast<size_t>(q);
     h[qk].setZero();
     for (int a = 0; a < nen; ++a) {
@@ -401,7 +424,7 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
   // bᵀv for a flattened tensor v, b = ∂F/∂u_e: x dofs move F's first row, y dofs its second, so each
   // column of b has two non-zeros (∂R_a/∂X, ∂R_a/∂Y) and bᵀv costs two passes over the nodes.
   const auto b_transpose = [&](int q, const Eigen::Vector4d& v) {
-    const double* g = point_gradients_.data() + static_cast<size_t>(first + q) * 2 * static_cast<size_t>(nen);
+    const double* g = point_gradients(static_cast<size_t>(first + q));
     DofRow r(n);
     for (int a = 0; a < nen; ++a) {
       r(a) = v(0) * g[a] + v(1) * g[nen + a];
@@ -465,31 +488,21 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
   // packing its operands than multiplying (perf, bench/RESULTS.md).
   Eigen::Matrix<double, kDofs, kDofs> k(n, n);
   k.noalias() = left.transpose().lazyProduct(right);
-  // Σ w bᵀ Ã b, Ã = s²A + c Cof, in 2 × 2 blocks of nen × nen: block (i, k) = Gᵀ C_ik with G the points'
-  // shape-function gradients stacked (rows 2q, 2q + 1: ∂R/∂X, ∂R/∂Y) and C_ik the rows of w Ã_ik g.
-  constexpr int kMaxGradientRows = Nen == Eigen::Dynamic ? Eigen::Dynamic : 2 * Nen;
-  using GradientRows = Eigen::Matrix<double, Eigen::Dynamic, Nen, Eigen::RowMajor, kMaxGradientRows, Nen>;
-  GradientRows g_rows(2 * points, nen), cxx(2 * points, nen), cxy(2 * points, nen), cyy(2 * points, nen);
+  // Σ w bᵀ Ã b, Ã = s²A + c Cof: the displacement element's blocks with a modified material matrix.
+  MaterialTangentBlocks<Nen> tangent(nen, points, true);
   Eigen::Matrix4d cofactor_matrix;
   cofactor_matrix << 0, 0, 0, 1, 0, 0, -1, 0, 0, -1, 0, 0, 1, 0, 0, 0;
   for (int q = 0; q < points; ++q) {
     const auto qk = static_cast<size_t>(q);
-    const double* g = point_gradients_.data() + static_cast<size_t>(first + q) * 2 * static_cast<size_t>(nen);
-    g_rows.row(2 * q) = Eigen::Map<const Eigen::Matrix<double, 1, Nen>>(g, nen);
-    g_rows.row(2 * q + 1) = Eigen::Map<const Eigen::Matrix<double, 1, Nen>>(g + nen, nen);
-    const Eigen::Matrix4d a_tilde =
-        weight[qk] * (s[qk] * s[qk] * a_bar[qk] + (mean_m / mean_j - m[qk] / jac[qk]) * cofactor_matrix);
-    for (const auto& [c, row, col] : {std::tuple{&cxx, 0, 0}, std::tuple{&cxy, 0, 2}, std::tuple{&cyy, 2, 2}}) {
-      const Eigen::Matrix2d a_ik = a_tilde.block<2, 2>(row, col);
-      c->row(2 * q) = a_ik(0, 0) * g_rows.row(2 * q) + a_ik(0, 1) * g_rows.row(2 * q + 1);
-      c->row(2 * q + 1) = a_ik(1, 0) * g_rows.row(2 * q) + a_ik(1, 1) * g_rows.row(2 * q + 1);
-    }
+    tangent.set_gradients(q, point_gradients(static_cast<size_t>(first + q)));
+    tangent.add_point(q, weight[qk] * (s[qk] * s[qk] * a_bar[qk] + (mean_m / mean_j - m[qk] / jac[qk]) * cofactor_matrix));
   }
-  k.topLeftCorner(nen, nen).noalias() += g_rows.transpose().lazyProduct(cxx);
-  const auto kxy = g_rows.transpose().lazyProduct(cxy).eval();
+  typename MaterialTangentBlocks<Nen>::Block kxx, kxy, kyy;
+  tangent.blocks(kxx, kxy, kyy);
+  k.topLeftCorner(nen, nen) += kxx;
   k.topRightCorner(nen, nen) += kxy;
   k.bottomLeftCorner(nen, nen) += kxy.transpose();  // Ã symmetric: block (y, x) = (x, y)ᵀ
-  k.bottomRightCorner(nen, nen).noalias() += g_rows.transpose().lazyProduct(cyy);
+  k.bottomRightCorner(nen, nen) += kyy;
   scatter_element_tangent(element, k.data(), n, out);
 }
 

@@ -171,6 +171,8 @@ class SolidProblem {
   void assemble_element_mean_dilatation(size_t element, const Eigen::VectorXd& u, double dt, bool with_tangent,
                                         const std::vector<MaterialState>* iterate, Assembly& out,
                                         std::string& failure) const;
+  // Quadrature point k's ∂R/∂X and ∂R/∂Y, a 2 × element_nodes_count_ row-major block.
+  const double* point_gradients(size_t k) const { return point_gradients_.data() + k * 2 * static_cast<size_t>(element_nodes_count_); }
   // Scatters an element's n × n tangent (column-major, local dofs component-major) into the lower triangle.
   void scatter_element_tangent(size_t element, const double* k, int n, Assembly& out) const;
   IgaSpace space_;
