@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/sanitizers.hpp"
 
 namespace mufric {
 namespace {
@@ -35,7 +36,7 @@ constexpr double kStalledSeconds = 2.0;
 constexpr int kForkAttempts = 3;
 constexpr int kActivityCheckMs = 250;
 
-#if defined(__SANITIZE_ADDRESS__)
+#if MUFRIC_ADDRESS_SANITIZER
 constexpr bool kAddressSpaceLimitAllowed = false;  // ASan reserves terabytes of shadow address space
 #else
 constexpr bool kAddressSpaceLimitAllowed = true;

@@ -11,10 +11,6 @@
 #include "surrogate/sampling.hpp"
 
 namespace mufric {
-namespace {
-constexpr double kRelativeErrorFloor = 1e-12;
-}
-
 QueryBatch align_inputs(const Eigen::MatrixXd& x, const InputSpace& from, const InputSpace& to, const std::string& where) {
   QueryBatch aligned(x.rows(), static_cast<Eigen::Index>(to.size()));
   for (size_t j = 0; j < to.size(); ++j) {
@@ -43,7 +39,7 @@ AccuracyReport held_out_accuracy(const FrictionModel& model, const TrainingSet& 
     if (status == PointStatus::extrapolated) ++report.extrapolated;
     ++answered;
     const double error = e.mu(i) - test.mu(i);
-    const double rel = std::abs(error) / std::max(std::abs(test.mu(i)), kRelativeErrorFloor);
+    const double rel = relative_error(error, test.mu(i));
     sum_rel += rel;
     report.max_relative_error = std::max(report.max_relative_error, rel);
     sum_sq += error * error;

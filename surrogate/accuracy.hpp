@@ -1,5 +1,7 @@
 #pragma once
 // Held-out accuracy of a model on a dataset: relative errors and interval coverage.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -18,6 +20,12 @@ struct AccuracyReport {
   double level = 0.95;
   double seconds_per_point = 0.0;     // mean+CI evaluation time
 };
+
+// |error| relative to |reference|, with the reference floored so that μ = 0 gives a finite figure.
+inline double relative_error(double error, double reference) {
+  constexpr double kRelativeErrorFloor = 1e-12;
+  return std::abs(error) / std::max(std::abs(reference), kRelativeErrorFloor);
+}
 
 // Inputs are matched by name, so a test file may order its columns differently; a missing input
 // throws Error naming it.

@@ -3,9 +3,12 @@
 # offline with mmdebstrap (no registry is reachable here; Debian's archive is), runs `mufric serve`
 # in it with a model directory mounted read-only, and from the host asks grpc.health.v1 and an
 # Evaluate (mufric predict) over loopback. Exit 77 (skipped) with the reason where podman cannot run.
-# Usage: tests/container_test.sh SOURCE_DIR MUFRIC
+# Usage: tests/container_test.sh SOURCE_DIR MUFRIC [prebuilt|source]
+#   prebuilt (default): the image takes MUFRIC, this build's portable executable (the test command);
+#   source: the Dockerfile compiles mufric from SOURCE_DIR inside the image (~8 min; the long tests).
 set -uo pipefail
-source_dir=$(realpath "$1") mufric=$(realpath "$2")
+source_dir=$(realpath "$1") mufric=$(realpath "$2") binary=${3:-prebuilt}
+[[ $binary == prebuilt || $binary == source ]] || { echo "container_test: third argument '$binary' is neither prebuilt nor source" >&2; exit 2; }
 skip() { echo "SKIPPED: $*"; exit 77; }
 command -v podman >/dev/null || skip "podman is not installed (deploy/install-deps.sh installs it)"
 command -v mmdebstrap >/dev/null || skip "mmdebstrap is not installed"
@@ -23,12 +26,20 @@ if ! podman image exists "$base"; then
   podman import --quiet "$work/bookworm.tar" "$base" >/dev/null
   rm -f "$work/bookworm.tar"
 fi
-echo "building deploy/Dockerfile (a portable release build of mufric, then its runtime image)"
 start=$(date +%s)
-# Only what the image build reads: no build directories, no git history.
-tar -C "$source_dir" --exclude='./build*' --exclude=./.git --exclude='./mufric-out' -cf - . | tar -C "$work" -xf - --one-top-level=context
-podman build --quiet --network host --build-arg BASE=$base -t localhost/mufric:test -f "$work/context/deploy/Dockerfile" \
-  "$work/context" > "$work/build.log" 2>&1 || { tail -30 "$work/build.log"; exit 1; }
+mkdir -p "$work/context"
+if [[ $binary == source ]]; then
+  echo "building deploy/Dockerfile (a portable release build of mufric, then its runtime image)"
+  # Only what the image build reads: no build directories, no git history.
+  tar -C "$source_dir" --exclude='./build*' --exclude=./.git --exclude='./mufric-out' -cf - . | tar -C "$work/context" -xf -
+else
+  echo "building deploy/Dockerfile's runtime image around $mufric (BINARY=prebuilt)"
+  if ldd "$mufric" | grep -q 'libasan\|libtsan\|libubsan'; then echo "$mufric is a sanitizer build, not a release one"; exit 1; fi
+  cp "$mufric" "$work/context/mufric"
+fi
+podman build --quiet --network host --build-arg BASE=$base --build-arg BINARY=$([[ $binary == source ]] && echo build || echo prebuilt) \
+  -t localhost/mufric:test -f "$source_dir/deploy/Dockerfile" "$work/context" > "$work/build.log" 2>&1 ||
+  { tail -30 "$work/build.log"; exit 1; }
 echo "image built in $(( $(date +%s) - start )) s: $(podman image inspect localhost/mufric:test --format '{{.Size}}' | awk '{ printf "%.0f MB", $1 / 1e6 }')"
 mkdir -p "$work/models"
 "$mufric" law seward --table 4 --out "$work/models/law.h5" >/dev/null

@@ -8,13 +8,12 @@
 
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
+#include "temp_path.hpp"
 
 namespace mufric {
 namespace {
 
-std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("mufric_ds_" + std::to_string(::getpid()) + "_" + name)).string();
-}
+using test::temp_path;
 
 Eigen::VectorXd values(std::initializer_list<double> list) {
   Eigen::VectorXd v(static_cast<Eigen::Index>(list.size()));

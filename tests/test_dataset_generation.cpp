@@ -13,6 +13,7 @@
 #include "campaign/refine.hpp"
 #include "common/error.hpp"
 #include "common/work_pool.hpp"
+#include "temp_path.hpp"
 
 namespace mufric {
 namespace {
@@ -49,11 +50,7 @@ TEST(WorkPool, FalseStopsTheTakingOfIndices) {
   EXPECT_LT(taken.load(), 100);  // the others stop after the job they hold
 }
 
-std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mufric_gen_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
-}
+using test::temp_path;
 
 Dataset small_plan(Eigen::Index rows, const std::string& scene = "{\"scene\": 1}") {
   Dataset p;

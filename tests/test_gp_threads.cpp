@@ -13,7 +13,7 @@
 namespace mufric {
 namespace {
 
-GaussianProcess small_gp() { return test::fixed_hyper_gp(400, 4, 2.0, {0.5, 0.5, 0.5}, 1e-4); }
+GaussianProcess shared_gp() { return test::fixed_hyper_gp(400, 4, 2.0, {0.5, 0.5, 0.5}, 1e-4); }
 
 // Threads of this process right now (Linux: the "Threads:" line of /proc/self/status).
 int process_threads() {
@@ -46,7 +46,7 @@ TEST(GpThreads, InsideAParallelRegionOneEvaluationUsesItsCallingThreadOnly) {
 // at once, nested parallelism switched on as a hybrid meso code may have it: the answers are those
 // of one thread to the last bit, and the process never holds more threads than the caller's team.
 TEST(GpThreads, TwoCallerThreadsAtOnceGetTheSerialAnswersAndStartNoTeam) {
-  const GaussianProcess gp = small_gp();
+  const GaussianProcess gp = shared_gp();
   const TrainingSet queries = test::smooth_training_set(2000, 9);
   const EvaluationRequest what{.std = true, .ci_level = 0.95};
   const Evaluation serial = gp.evaluate(queries.x, {.std = true, .ci_level = 0.95, .max_threads = 1});

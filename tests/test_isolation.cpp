@@ -17,6 +17,7 @@
 
 #include "common/error.hpp"
 #include "common/isolation.hpp"
+#include "common/sanitizers.hpp"
 
 namespace mufric {
 namespace {
@@ -135,7 +136,7 @@ TEST(Isolation, ExceptionMessagePassesThrough) {
   EXPECT_EQ(message, "model 'x': /gp/alpha: bad");
 }
 
-#if !defined(__SANITIZE_ADDRESS__)
+#if !MUFRIC_ADDRESS_SANITIZER
 TEST(Isolation, HugeAllocationHitsTheMemoryLimit) {
   IsolationLimits limits;
   limits.memory_bytes = 256ULL << 20;

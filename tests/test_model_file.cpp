@@ -12,13 +12,12 @@
 #include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
+#include "temp_path.hpp"
 
 namespace mufric {
 namespace {
 
-std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("mufric_test_" + std::to_string(::getpid()) + "_" + name)).string();
-}
+using test::temp_path;
 
 bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() &&
@@ -296,6 +295,19 @@ TEST(ModelFile, ABareNameIsAShippedModel) {
   EXPECT_EQ(model_path_from_uri("file://dry_default"), shipped);
   EXPECT_EQ(model_path_from_uri("elsewhere/dry_default"), "elsewhere/dry_default");
   EXPECT_EQ(model_path_from_uri("missing.h5"), "missing.h5");
+  {
+    // Regression: a folder or file named like a shipped model in the working directory shadowed it.
+    const fs::path here = fs::current_path(), work = dir / "work";
+    fs::create_directories(work / "dry_default");
+    std::ofstream(work / "wet") << "x";
+    std::ofstream(work / "mine") << "x";
+    fs::current_path(work);
+    EXPECT_EQ(model_path_from_uri("dry_default"), shipped);
+    EXPECT_EQ(model_path_from_uri("wet"), (dir / "wet.h5").string());
+    EXPECT_EQ(model_path_from_uri("./wet"), "./wet");  // the local one, asked for by path
+    EXPECT_EQ(model_path_from_uri("mine"), "mine");    // no shipped model of that name
+    fs::current_path(here);
+  }
   try {
     model_path_from_uri("dry_defualt");
     ADD_FAILURE() << "an unknown name was accepted";

@@ -9,7 +9,7 @@
 # scene, unit-annotated CSV tables and wire requests encoded with protoc.
 # Usage: bash tests/fuzz/run_fuzzers.sh FUZZ_BUILD MUFRIC SECONDS OUT_DIR [TARGET...]
 # Prints one line per target (executions, coverage, features, corpus, faults by owner); exit 1 when
-# any fault is mufric's.
+# any fault is mufric's. MUFRIC_JOBS targets (default: the usable cores) fuzz side by side.
 set -uo pipefail
 if [[ $# -lt 4 || $1 == -h || $1 == --help ]]; then sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 2; fi
 fuzz_build=$(realpath "$1") mufric=$(realpath "$2") seconds=$3 out=$4
@@ -68,13 +68,22 @@ echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model
 echo
 echo "| target | executions | exec/s | coverage (edges) | features | corpus | faults: HDF5 library | faults: mufric |"
 echo "|---|---|---|---|---|---|---|---|"
-for target in "${targets[@]}"; do
-  binary=$fuzz_build/tests/fuzz/$target
-  corpus=$out/corpus/$target artifacts=$out/artifacts/$target
+fuzz() {  # target: SECONDS of libFuzzer in fork mode, log in $out/<target>.log
+  local binary=$fuzz_build/tests/fuzz/$1 corpus=$out/corpus/$1 artifacts=$out/artifacts/$1
   mkdir -p "$corpus" "$artifacts"
   (cd "$out" && "$binary" -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -max_total_time="$seconds" \
-      -timeout=5 -rss_limit_mb=2048 -artifact_prefix="$artifacts/" "$corpus" "$out/seeds/$target" \
-      > "$out/$target.log" 2>&1)
+      -timeout=5 -rss_limit_mb=2048 -artifact_prefix="$artifacts/" "$corpus" "$out/seeds/$1" > "$out/$1.log" 2>&1)
+}
+# Each target is one process (fork mode runs one job at a time): as many side by side as cores.
+jobs=${MUFRIC_JOBS:-$(nproc)}
+for target in "${targets[@]}"; do
+  while (($(jobs -rp | wc -l) >= jobs)); do wait -n; done
+  fuzz "$target" &
+done
+wait
+for target in "${targets[@]}"; do
+  binary=$fuzz_build/tests/fuzz/$target
+  artifacts=$out/artifacts/$target
   last=$(grep -E '^#[0-9]+: cov: ' "$out/$target.log" | tail -1)
   execs=$(sed -nE 's/.*exec\/s:? ([0-9]+).*/\1/p' <<< "$last")
   runs=$(sed -nE 's/^#([0-9]+):.*/\1/p' <<< "$last")
