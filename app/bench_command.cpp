@@ -54,7 +54,9 @@ Measurement measure(const std::string& uri, const client::Options& options, long
       long long errors = 0;
       std::string first_error;
       try {
-        const auto client = client::connect(uri, options);
+        client::Options own = options;
+        own.own_connection = true;  // N clients are N connections, as N meso-code processes would be
+        const auto client = client::connect(uri, own);
         const RandomBlock points(client->describe().inputs, static_cast<size_t>(batch), 7 + static_cast<unsigned>(c));
         client->evaluate(points.block, what);  // warm-up: connection, caches
         while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < seconds ||

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "common/error.hpp"
@@ -52,6 +53,48 @@ std::string one_line(std::string message) {
   return message;
 }
 
+// Edit distance with transpositions (optimal string alignment; Wagner & Fischer 1974, J. ACM 21:168,
+// with Damerau's adjacent swap): "predcit" is 1 from "predict".
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    for (size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  }
+  return d[a.size()][b.size()];
+}
+
+// A suggestion for a mistyped subcommand: the first word of the command line that names no
+// subcommand where one is expected, and the nearest name there (at most two edits away).
+std::string subcommand_suggestion(const CLI::App& app, int argc, char** argv) {
+  constexpr size_t kMostEdits = 2;
+  const CLI::App* level = &app;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') continue;
+    const auto subcommands = level->get_subcommands([](const CLI::App*) { return true; });
+    if (subcommands.empty()) return "";
+    const CLI::App* exact = nullptr;
+    const CLI::App* nearest = nullptr;
+    size_t nearest_distance = kMostEdits + 1;
+    for (const CLI::App* sub : subcommands) {
+      if (sub->get_name() == word) exact = sub;
+      const size_t distance = edit_distance(word, sub->get_name());
+      if (distance < nearest_distance) nearest = sub, nearest_distance = distance;
+    }
+    if (exact) {
+      level = exact;
+      continue;
+    }
+    return nearest ? "; did you mean `" + nearest->get_name() + "`?" : "";
+  }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -79,8 +122,8 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
     // Every other parse error is an error like any other (README: one line, exit code 2), not
     // CLI11's two lines and its own exit codes (105, 106, 114, …).
-    std::fprintf(stderr, "mufric: error: %s (run `%s --help` for usage)\n", one_line(e.what()).c_str(),
-                 command_line_of(app).c_str());
+    std::fprintf(stderr, "mufric: error: %s%s (run `%s --help` for usage)\n", one_line(e.what()).c_str(),
+                 subcommand_suggestion(app, argc, argv).c_str(), command_line_of(app).c_str());
     return kErrorExitCode;
   } catch (const mufric::Error& e) {
     std::fprintf(stderr, "mufric: error: %s\n", e.what());

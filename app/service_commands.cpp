@@ -73,8 +73,8 @@ void add_service_commands(CLI::App& app) {
       ->capture_default_str()->check(FiniteRange(1e-9, 1e9));
   cmd->add_option("--uncertain-max-rows", o->uncertain_max_rows, "Most logged queries per model")->capture_default_str()
       ->check(CLI::Range(1LL, 1'000'000'000LL));
-  cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP reloads the models now; a bad\n"
-              "new file is refused with a log line while the previous version keeps serving. grpc.health.v1 and\n"
+  cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP rescans the models now, by\n"
+              "content; a bad new file is refused, and a deleted file logged, while the loaded version keeps serving. grpc.health.v1 and\n"
               "server reflection are on. Logs go to stderr, one line per event. A call whose deadline passes (or that\n"
               "the client cancels) stops within a few thousand points and answers DEADLINE_EXCEEDED (CANCELLED).");
   cmd->callback([o, shipped] {

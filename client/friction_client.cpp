@@ -28,18 +28,24 @@ const double* input_pointer(const Block& block, const std::string& name) {
   return field ? block.*field : nullptr;
 }
 
-// Options::fill: every output of a point without an answer gets the caller's value instead of NaN.
-// Chosen by the status, not by testing the value: isnan is quiet, but the caller may run with
-// FE_INVALID trapping, and nothing here should even look at a NaN in a way that could raise it.
-void fill_unanswered(Answer& answer, double value) {
+// Options::fill and Options::fallback_mu: the outputs of a point without an answer get the caller's
+// values instead of NaN (fill: every output; fallback_mu: μ, over fill). Chosen by the status, not by
+// testing the value: isnan is quiet, but the caller may run with FE_INVALID trapping, and nothing
+// here should even look at a NaN in a way that could raise it.
+void fill_unanswered(Answer& answer, const Options& options) {
+  if (!options.fill && !options.fallback_mu) return;
   const size_t points = answer.status.size();
   const size_t gradient_width = points > 0 ? answer.gradient.size() / points : 0;
   for (size_t i = 0; i < points; ++i) {
     if (answer.status[i] != PointStatus::invalid_input && answer.status[i] != PointStatus::out_of_box) continue;
-    for (auto* output : {&answer.mu, &answer.std, &answer.lo, &answer.hi, &answer.patch_std}) {
-      if (i < output->size()) (*output)[i] = value;
+    if (options.fill) {
+      for (auto* output : {&answer.mu, &answer.std, &answer.lo, &answer.hi, &answer.patch_std}) {
+        if (i < output->size()) (*output)[i] = *options.fill;
+      }
+      std::fill_n(answer.gradient.begin() + static_cast<std::ptrdiff_t>(i * gradient_width), gradient_width,
+                  *options.fill);
     }
-    std::fill_n(answer.gradient.begin() + static_cast<std::ptrdiff_t>(i * gradient_width), gradient_width, value);
+    if (options.fallback_mu && i < answer.mu.size()) answer.mu[i] = *options.fallback_mu;
   }
 }
 
@@ -48,7 +54,7 @@ class InProcessClient final : public FrictionClient {
   InProcessClient(const std::string& path, const Options& options)
       : path_(path),
         model_(options.isolate_file_parsing ? load_model_isolated(path) : load_model(path)),
-        fill_(options.fill) {}
+        unanswered_(options) {}
 
   Answer evaluate(const Block& block, const EvaluationRequest& request) override {
     // Several threads of the caller at once (std::thread, MPI + threads: an OpenMP caller is caught
@@ -82,7 +88,7 @@ class InProcessClient final : public FrictionClient {
     a.fast_points = e.fast_points;
     a.range_clipped = e.range_clipped;
     a.message = unanswered_points_message(inputs, x, a.status);  // the server's words for the same block
-    if (fill_) fill_unanswered(a, *fill_);
+    fill_unanswered(a, unanswered_);
     return a;
   }
 
@@ -107,7 +113,7 @@ class InProcessClient final : public FrictionClient {
 
   std::string path_;
   std::unique_ptr<FrictionModel> model_;  // evaluation is const and keeps no state: safe from many threads
-  std::optional<double> fill_;
+  Options unanswered_;  // its fill and fallback_mu
   std::atomic<int> in_flight_{0};
 };
 
@@ -159,7 +165,7 @@ std::shared_ptr<grpc::ChannelCredentials> channel_credentials(bool tls, const Op
 class GrpcClient final : public FrictionClient {
  public:
   GrpcClient(const std::string& target, std::string model, bool tls, const Options& options)
-      : model_(std::move(model)), options_(options), token_(setting(options.token, "MUFRIC_TOKEN")) {
+      : model_(std::move(model)), tls_(tls), options_(options), token_(setting(options.token, "MUFRIC_TOKEN")) {
     grpc::ChannelArguments arguments;
     arguments.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
     arguments.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
@@ -169,6 +175,8 @@ class GrpcClient final : public FrictionClient {
     arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, backoff_ms);
     arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, backoff_ms);
     arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, backoff_ms << options.retries);
+    // gRPC shares one connection among a process's channels to the same target with the same arguments.
+    if (options.own_connection) arguments.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
     channel_ = grpc::CreateCustomChannel(target, channel_credentials(tls, options), arguments);
     stub_ = mufric::v1::FrictionService::NewStub(channel_);
   }
@@ -189,7 +197,7 @@ class GrpcClient final : public FrictionClient {
       if (block.points == 0) break;
     }
     if (!answer.message.empty() && chunk < block.points) answer.message = block_message(answer);
-    if (options_.fill) fill_unanswered(answer, *options_.fill);
+    fill_unanswered(answer, options_);
     return answer;
   }
 
@@ -227,8 +235,20 @@ class GrpcClient final : public FrictionClient {
 
   // The caller's own mistake (INVALID_ARGUMENT) is told apart from a failure of the service.
   [[noreturn]] void throw_failure(const std::string& method, const grpc::Status& status) const {
-    const std::string message =
+    std::string message =
         method + " on model '" + model_ + "' failed (" + code_name(status.error_code()) + "): " + status.error_message();
+    // gRPC reports a TLS mismatch as a transport detail of a failed connection ("tcp handshaker
+    // shutdown", "Socket closed"): say its likely cause.
+    const std::string& detail = status.error_message();
+    const bool closed_while_connecting = detail.find("failed to connect") != std::string::npos &&
+                                         (detail.find("andshake") != std::string::npos ||
+                                          detail.find("Socket closed") != std::string::npos);
+    if (status.error_code() == grpc::StatusCode::UNAVAILABLE && closed_while_connecting) {
+      message += tls_ ? " (the TLS handshake failed: is the server plaintext (no --tls-cert), or does it not accept "
+                        "these certificates (tls_ca; tls_cert/tls_key when it asks for a client certificate)?)"
+                      : " (the connection closed while it was being set up: does the server use TLS? then connect "
+                        "with grpcs:// and tls_ca)";
+    }
     if (status.error_code() == grpc::StatusCode::INVALID_ARGUMENT) throw InvalidArgument(message);
     throw Error(message);
   }
@@ -337,6 +357,7 @@ class GrpcClient final : public FrictionClient {
   }
 
   std::string model_;
+  bool tls_;  // grpcs://
   Options options_;
   std::string token_;
   std::mutex stream_mutex_;  // guards stream_context_ and stream_
@@ -451,10 +472,12 @@ Options parse_options(std::string_view text, Options base) {
     } else if (key == "fill") {
       constexpr double largest = std::numeric_limits<double>::max();
       o.fill = number_option(key, value, -largest, largest);  // finite: NaN or inf would defeat its purpose
+    } else if (key == "fallback_mu") {
+      o.fallback_mu = number_option(key, value, 0.0, kLargestFallbackMu);
     } else {
       throw InvalidArgument("option '" + key +
                             "' is unknown (known: deadline, retries, backoff, chunk_points, max_message_mb, stream, "
-                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation, fill)");
+                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation, fill, fallback_mu)");
     }
   }
   return o;

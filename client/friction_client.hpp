@@ -94,14 +94,24 @@ struct Options {
   // σ, lo, hi, gradient) instead of NaN: a code that traps FE_INVALID must never be handed a NaN,
   // and its status array still says which points these are. Applied to the Answer by both transports.
   std::optional<double> fill;
+  // μ of a point without an answer, over `fill`: the value a meso code would use there anyway (its
+  // former constant μ), so that a refused point neither poisons nor reverses its friction force
+  // (fill=-1 did, taken for μ). Its σ, lo and hi stay NaN or `fill`; its status says it was not answered.
+  std::optional<double> fallback_mu;
+  // grpc:// only: a TCP connection of this client's own. Without it gRPC shares one connection among
+  // every client of the process with the same target and options (what a meso code wants; a load
+  // generator measuring N connections does not).
+  bool own_connection = false;
 };
+// The largest fallback_mu accepted: no measured dry friction coefficient reaches it.
+inline constexpr double kLargestFallbackMu = 10.0;
 
 // Options from text, for the C ABI and Fortran (and configuration files): "key=value" pairs separated
 // by commas, semicolons or blanks, e.g. "deadline=2, retries=1, stream=1, token=abc".
 // Keys: deadline (s), retries, backoff (s, the first), chunk_points, max_message_mb, stream (0/1),
 // token, tls_ca, tls_cert, tls_key (PEM file paths), mu_tolerance, std_tolerance (0: exact model),
 // extrapolation (raw, clamp or refuse; default: the model's own), fill (a finite number for the outputs
-// of points without an answer; default: NaN). Starts from `base`; throws InvalidArgument
+// of points without an answer; default: NaN), fallback_mu (their μ, 0 to 10, over fill). Starts from `base`; throws InvalidArgument
 // naming the key or value it cannot use.
 Options parse_options(std::string_view text, Options base = {});
 

@@ -9,7 +9,8 @@ module mufric
   private
   public :: mufric_connect, mufric_error, c_mufric_evaluate, c_mufric_close, c_mufric_evaluate_ex, c_mufric_box
   public :: c_mufric_patch_std, c_mufric_has_patch_scatter
-  integer(c_int), parameter, public :: MUFRIC_OK = 0, MUFRIC_INVALID_ARGUMENT = 1, MUFRIC_FAILED = 2
+  integer(c_int), parameter, public :: MUFRIC_OK = 0, MUFRIC_INVALID_ARGUMENT = 1, MUFRIC_FAILED = 2, &
+                                       MUFRIC_PARTIAL = 3  ! answered, but not every point: see the statuses
   integer(c_int), parameter, public :: MUFRIC_POINT_OK = 0, MUFRIC_POINT_EXTRAPOLATED = 1, &
                                        MUFRIC_POINT_INVALID_INPUT = 2, MUFRIC_POINT_OUT_OF_BOX = 3
 

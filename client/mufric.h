@@ -3,9 +3,25 @@
  * message; no C++ exception crosses this interface. All quantities SI: Pa, m/s, K, rad.
  *
  *   mufric_client* c;
- *   if (mufric_open("grpc://127.0.0.1:50051/gp", &c) != MUFRIC_OK) puts(mufric_last_error());
- *   mufric_evaluate(c, n, p, v, T, NULL, 0.95, mu, NULL, lo, hi, status);
+ *   if (mufric_open_with_options("grpc://127.0.0.1:50051/gp", "fallback_mu=0.35", &c) != MUFRIC_OK) {
+ *     fprintf(stderr, "%s\n", mufric_last_error());
+ *     exit(1);
+ *   }
+ *   int rc = mufric_evaluate(c, n, p, v, T, NULL, 0.95, mu, NULL, lo, hi, status);
+ *   if (rc == MUFRIC_PARTIAL) {            // some points outside what the model answers:
+ *     fprintf(stderr, "%s\n", mufric_last_error());  // their mu is 0.35, status[i] says which
+ *   } else if (rc != MUFRIC_OK) {          // nothing answered: keep the previous mu, or stop
+ *     fprintf(stderr, "%s\n", mufric_last_error());
+ *   }
  *   mufric_close(c);
+ *
+ * Contact pressure from a particle (SPH) or node-to-surface code: send the normal traction the
+ * contact algorithm applies to that particle, i.e. its contact force over the contact length (2D; the
+ * area in 3D) it stands for, not -sigma_nn interpolated from the bulk at the particle. mu was learned
+ * from the micro-model's apparent contact pressure, which is the applied normal load over the
+ * apparent contact length, the same quantity; a kernel-smoothed -sigma_nn at a particle near a free
+ * surface is deficient (its kernel sum is short of 1). Measured on a 2D SPH orthogonal cut of Ti6Al4V:
+ * 95 % of its contact points inside dry_default's box with the penalty traction, 65 % with -sigma_nn.
  *
  * Threads: mufric_evaluate may be called on one handle from many threads at once (an OpenMP or
  * MPI + OpenMP meso code's contact loop); tested under ThreadSanitizer. A handle evaluating
@@ -29,9 +45,11 @@ extern "C" {
 typedef struct mufric_client mufric_client;
 
 enum mufric_status_code {
-  MUFRIC_OK = 0,
+  MUFRIC_OK = 0,               /* every point answered (EXTRAPOLATED points included) */
   MUFRIC_INVALID_ARGUMENT = 1, /* null handle or array, bad level, an input the model needs is NULL */
-  MUFRIC_FAILED = 2            /* model not found, server unreachable, file unreadable: see mufric_last_error */
+  MUFRIC_FAILED = 2,           /* model not found, server unreachable, file unreadable: see mufric_last_error */
+  MUFRIC_PARTIAL = 3           /* answered, but not every point: those with status INVALID_INPUT or OUT_OF_BOX
+                                  have mu = fallback_mu=V (or fill=V, or NaN); mufric_last_error names the first */
 };
 
 /* EXTRAPOLATED: outside the model's training box, answered (raw or clamp policy); OUT_OF_BOX: outside
@@ -70,18 +88,23 @@ int mufric_open(const char* uri, mufric_client** client);
  *                     refuse (OUT_OF_BOX, NaN); default:
  *                     the model file's policy (clamp unless it says otherwise)
  *   fill=V            points without an answer (INVALID_INPUT, OUT_OF_BOX) get the finite value V
- *                     in mu, std, lo and hi instead of NaN (e.g. fill=-1: no physical mu is
- *                     negative); their status still says which they are. For codes that trap
- *                     floating-point exceptions (see "Floating-point traps" below)
+ *                     in mu, std, lo and hi instead of NaN; their status still says which they
+ *                     are. For codes that trap floating-point exceptions (see "Floating-point
+ *                     traps" below). Not a mu to use: a negative V taken for mu reverses friction
+ *   fallback_mu=V     mu of points without an answer (0 <= V <= 10, over fill): the value the code
+ *                     would use there anyway, e.g. its former constant mu; the call still returns
+ *                     MUFRIC_PARTIAL and their status says which they are
  * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
 int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);
 void mufric_close(mufric_client* client);
 
 /* n points. Inputs: NULL for inputs not sent (the model's own inputs are required). Outputs: NULL
  * for outputs not wanted; lo/hi need ci_level in (0, 1), else pass 0. status: one
- * mufric_point_status per point, or NULL. Points without an answer (INVALID_INPUT, OUT_OF_BOX) get
- * NaN outputs, or the fill=V value; the others are answered, and the call returns MUFRIC_OK. Its
- * message (the first such point, the input and why) is then readable through mufric_last_error().
+ * mufric_point_status per point, or NULL. n = 0 (a step without contact) is a no-op that returns
+ * MUFRIC_OK whatever the arrays. Points without an answer (INVALID_INPUT, OUT_OF_BOX) get mu =
+ * fallback_mu=V if the handle has one, else the fill=V value, else NaN (std, lo, hi: fill or NaN);
+ * the others are answered, and the call returns MUFRIC_PARTIAL, with the first such point, the input
+ * and why in mufric_last_error(). MUFRIC_OK: every point was answered.
  *
  * Floating-point traps: a code that enables feenableexcept(FE_INVALID | FE_OVERFLOW | ...) must open
  * its handle with fill=V, or be handed NaN (which it will trap on at its first comparison). With V,
@@ -110,11 +133,32 @@ typedef struct mufric_counts {
  *            degrees) away from a point of the box is inside. Set whatever the point's status (a
  *            negative pressure is below the box too); a NaN input sets no bit.
  *   counts   one struct, this call's counts.
- * As for mufric_evaluate, a call with points without an answer returns MUFRIC_OK and leaves its
- * message in mufric_last_error() ("" when every point was answered). */
+ * As for mufric_evaluate, a call with points without an answer returns MUFRIC_PARTIAL and leaves
+ * its message in mufric_last_error() ("" when every point was answered). */
 int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                        const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
                        double* lo, double* hi, int* status, unsigned* outside, mufric_counts* counts);
+
+/* Every output of one evaluation, each NULL if not wanted (mu included), for mufric_evaluate_outputs. */
+typedef struct mufric_outputs {
+  double* mu;
+  double* std;         /* the standard deviation of mu */
+  double* lo;          /* the ci_level interval of mu; lo and hi need ci_level in (0, 1) */
+  double* hi;
+  double* patch_std;   /* the patch scatter (mufric_patch_std); only from a model that has one */
+  int* status;         /* mufric_point_status */
+  unsigned* outside;   /* the box flags of mufric_evaluate_ex */
+  mufric_counts* counts;
+} mufric_outputs;
+
+/* Everything in one call: mu, its interval and the patch scatter come from one evaluation (a meso
+ * code that wants both pays for one call, not two). Same inputs and return codes as mufric_evaluate;
+ * outputs NULL is MUFRIC_INVALID_ARGUMENT; an outputs struct zero-initialised but for what is wanted:
+ *   mufric_outputs out = {0};  out.mu = mu;  out.patch_std = scatter;  out.status = status;
+ *   rc = mufric_evaluate_outputs(c, n, p, v, T, NULL, 0.0, &out); */
+int mufric_evaluate_outputs(mufric_client* client, size_t n, const double* contact_pressure,
+                            const double* sliding_velocity, const double* temperature, const double* fibre_angle,
+                            double ci_level, const mufric_outputs* outputs);
 
 /* The model's training box, in the argument order of mufric_evaluate (contact_pressure,
  * sliding_velocity, temperature, fibre_angle), SI: used[k] = 1 and lo[k] <= hi[k] for an input the
@@ -125,8 +169,8 @@ int mufric_box(mufric_client* client, int used[4], double lo[4], double hi[4]);
 /* The patch scatter (issue 33): at each of n points, how much one contact patch's mu scatters about
  * the mean mufric_evaluate serves there (the micro-model's per-draw standard deviation), for a meso
  * code that wants a spatially varying mu along the rake face; never part of std or the interval.
- * Same inputs as mufric_evaluate; a point without an answer gets NaN or the fill=V value, and its
- * status (if status is not NULL). MUFRIC_INVALID_ARGUMENT when the model has none (one trained on common
+ * Same inputs and return codes as mufric_evaluate; a point without an answer gets NaN or the fill=V
+ * value, and its status (if status is not NULL). MUFRIC_INVALID_ARGUMENT when the model has none (one trained on common
  * draws, or not a GP): mufric_has_patch_scatter says so beforehand. */
 int mufric_patch_std(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                      const double* temperature, const double* fibre_angle, double* patch_std, int* status);

@@ -52,6 +52,84 @@ mufric::client::Answer evaluate_with_options(const mufric_client& client, const 
   return client.impl->evaluate(block, what);
 }
 
+// Which output a function cannot do without (mufric_evaluate's mu, mufric_patch_std's patch_std).
+enum class Required { nothing, mu, patch_std };
+
+// The box flags of mufric_evaluate_ex: bit 2k below input k's box, 2k+1 above.
+unsigned outside_bits(const mufric_client& client, const std::array<const double*, 4>& inputs, size_t i) {
+  unsigned bits = 0;
+  for (unsigned k = 0; k < 4; ++k) {
+    if (!client.used[k] || inputs[k] == nullptr) continue;
+    const double x = inputs[k][i];
+    const mufric::InputSpec& input = client.box[k];
+    // Outside as the model sees it (an angle a half turn away from the box is inside). A NaN sets no
+    // bit and is never compared: isnan, isless and isgreater are quiet, where an ordered comparison
+    // would raise FE_INVALID in a caller that traps it.
+    if (std::isnan(x) || input.contains(x)) continue;
+    if (std::isless(x, input.lo)) bits |= 1u << (2 * k);
+    if (std::isgreater(x, input.hi)) bits |= 1u << (2 * k + 1);
+  }
+  return bits;
+}
+
+// Every evaluation entry point: checks the arguments, naming `function`, evaluates once for all the
+// outputs asked, copies them out. MUFRIC_PARTIAL when some point got no answer.
+int evaluate_into(const char* function, mufric_client* client, size_t n, const std::array<const double*, 4>& inputs,
+                  double ci_level, const mufric_outputs& out, Required required) {
+  const std::string name(function);
+  if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, name + ": client is NULL");
+  if (out.counts) *out.counts = mufric_counts{};
+  if (n == 0) {  // a step without contact: nothing to do, whatever the arrays are
+    last_error.clear();
+    return MUFRIC_OK;
+  }
+  if (required == Required::mu && out.mu == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, name + ": mu must not be NULL");
+  if (required == Required::patch_std && out.patch_std == nullptr) {
+    return fail(MUFRIC_INVALID_ARGUMENT, name + ": patch_std must not be NULL");
+  }
+  const bool want_interval = out.lo != nullptr || out.hi != nullptr;
+  if (want_interval && !(ci_level > 0.0 && ci_level < 1.0)) {
+    return fail(MUFRIC_INVALID_ARGUMENT, name + ": lo/hi requested but ci_level is not in (0, 1)");
+  }
+  if (out.patch_std != nullptr && !client->has_patch_scatter) {
+    return fail(MUFRIC_INVALID_ARGUMENT, name + ": the model has no patch scatter (it was not trained by "
+                                                "stochastic kriging on a dataset of independent draws)");
+  }
+  return guarded(function, [&] {
+    const mufric::client::Block block{n, inputs[0], inputs[1], inputs[2], inputs[3]};
+    const auto answer = evaluate_with_options(*client, block,
+                                              {.std = out.std != nullptr,
+                                               .ci_level = want_interval ? ci_level : 0.0,
+                                               .gradient = false,
+                                               .patch_std = out.patch_std != nullptr});
+    // Copies only: the outputs of points without an answer are NaN or the caller's values, and
+    // nothing here compares them (a caller trapping FE_INVALID would die on an ordered comparison with NaN).
+    bool all_answered = true;
+    for (size_t i = 0; i < n; ++i) {
+      if (out.mu) out.mu[i] = answer.mu[i];
+      if (out.std) out.std[i] = answer.std[i];
+      if (out.lo) out.lo[i] = answer.lo[i];
+      if (out.hi) out.hi[i] = answer.hi[i];
+      if (out.patch_std) out.patch_std[i] = answer.patch_std[i];
+      if (out.status) out.status[i] = static_cast<int>(answer.status[i]);
+      if (out.outside) out.outside[i] = outside_bits(*client, inputs, i);
+      all_answered = all_answered && answer.status[i] != mufric::PointStatus::invalid_input &&
+                     answer.status[i] != mufric::PointStatus::out_of_box;
+    }
+    if (out.counts) {
+      for (const auto s : answer.status) {
+        out.counts->extrapolated += s == mufric::PointStatus::extrapolated;
+        out.counts->invalid += s == mufric::PointStatus::invalid_input;
+        out.counts->out_of_box += s == mufric::PointStatus::out_of_box;
+      }
+      out.counts->range_clipped = static_cast<size_t>(answer.range_clipped);
+      out.counts->fast_points = static_cast<size_t>(answer.fast_points);
+    }
+    last_error = answer.message;  // the first point without an answer, or ""
+    return all_answered ? MUFRIC_OK : MUFRIC_PARTIAL;
+  });
+}
+
 // A Fortran CHARACTER argument: its hidden length, blank padding removed.
 std::string fortran_string(const char* text, size_t length) {
   std::string s(text, length);
@@ -103,83 +181,33 @@ void mufric_close(mufric_client* client) { delete client; }
 int mufric_evaluate(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                     const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
                     double* lo, double* hi, int* status) {
-  return mufric_evaluate_ex(client, n, contact_pressure, sliding_velocity, temperature, fibre_angle, ci_level, mu, std,
-                            lo, hi, status, nullptr, nullptr);
+  const mufric_outputs outputs{mu, std, lo, hi, nullptr, status, nullptr, nullptr};
+  return evaluate_into("mufric_evaluate", client, n, {contact_pressure, sliding_velocity, temperature, fibre_angle},
+                       ci_level, outputs, Required::mu);
 }
 
 int mufric_evaluate_ex(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                        const double* temperature, const double* fibre_angle, double ci_level, double* mu, double* std,
                        double* lo, double* hi, int* status, unsigned* outside, mufric_counts* counts) {
-  if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: client is NULL");
-  if (mu == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: mu must not be NULL");
-  const bool want_interval = lo != nullptr || hi != nullptr;
-  if (want_interval && !(ci_level > 0.0 && ci_level < 1.0)) {
-    return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate: lo/hi requested but ci_level is not in (0, 1)");
-  }
-  return guarded("mufric_evaluate", [&] {
-    const mufric::client::Block block{n, contact_pressure, sliding_velocity, temperature, fibre_angle};
-    const auto answer = evaluate_with_options(*client, block, {.std = std != nullptr, .ci_level = want_interval ? ci_level : 0.0, .gradient = false});
-    // Copies only: the outputs of points without an answer are NaN or the fill value, and nothing
-    // here compares them (a caller trapping FE_INVALID would die on an ordered comparison with NaN).
-    for (size_t i = 0; i < n; ++i) {
-      mu[i] = answer.mu[i];
-      if (std) std[i] = answer.std[i];
-      if (lo) lo[i] = answer.lo[i];
-      if (hi) hi[i] = answer.hi[i];
-      if (status) status[i] = static_cast<int>(answer.status[i]);
-    }
-    if (outside) {
-      const std::array<const double*, 4> inputs{contact_pressure, sliding_velocity, temperature, fibre_angle};
-      for (size_t i = 0; i < n; ++i) {
-        unsigned bits = 0;
-        for (unsigned k = 0; k < 4; ++k) {
-          if (!client->used[k] || inputs[k] == nullptr) continue;
-          const double x = inputs[k][i];
-          const mufric::InputSpec& input = client->box[k];
-          // Outside as the model sees it (an angle a half turn away from the box is inside). A NaN
-          // sets no bit and is never compared: isnan, isless and isgreater are quiet, where an
-          // ordered comparison would raise FE_INVALID in a caller that traps it.
-          if (std::isnan(x) || input.contains(x)) continue;
-          if (std::isless(x, input.lo)) bits |= 1u << (2 * k);
-          if (std::isgreater(x, input.hi)) bits |= 1u << (2 * k + 1);
-        }
-        outside[i] = bits;
-      }
-    }
-    if (counts) {
-      *counts = mufric_counts{};
-      for (const auto s : answer.status) {
-        counts->extrapolated += s == mufric::PointStatus::extrapolated;
-        counts->invalid += s == mufric::PointStatus::invalid_input;
-        counts->out_of_box += s == mufric::PointStatus::out_of_box;
-      }
-      counts->range_clipped = static_cast<size_t>(answer.range_clipped);
-      counts->fast_points = static_cast<size_t>(answer.fast_points);
-    }
-    // A call with points without an answer succeeds; their message is what mufric_last_error says.
-    last_error = answer.message;
-    return MUFRIC_OK;
-  });
+  const mufric_outputs outputs{mu, std, lo, hi, nullptr, status, outside, counts};
+  return evaluate_into("mufric_evaluate_ex", client, n, {contact_pressure, sliding_velocity, temperature, fibre_angle},
+                       ci_level, outputs, Required::mu);
+}
+
+int mufric_evaluate_outputs(mufric_client* client, size_t n, const double* contact_pressure,
+                            const double* sliding_velocity, const double* temperature, const double* fibre_angle,
+                            double ci_level, const mufric_outputs* outputs) {
+  if (outputs == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_evaluate_outputs: outputs must not be NULL");
+  return evaluate_into("mufric_evaluate_outputs", client, n,
+                       {contact_pressure, sliding_velocity, temperature, fibre_angle}, ci_level, *outputs,
+                       Required::nothing);
 }
 
 int mufric_patch_std(mufric_client* client, size_t n, const double* contact_pressure, const double* sliding_velocity,
                      const double* temperature, const double* fibre_angle, double* patch_std, int* status) {
-  if (client == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: client is NULL");
-  if (patch_std == nullptr) return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: patch_std must not be NULL");
-  if (!client->has_patch_scatter) {
-    return fail(MUFRIC_INVALID_ARGUMENT, "mufric_patch_std: the model has no patch scatter (it was not trained by "
-                                         "stochastic kriging on a dataset of independent draws)");
-  }
-  return guarded("mufric_patch_std", [&] {
-    const mufric::client::Block block{n, contact_pressure, sliding_velocity, temperature, fibre_angle};
-    const auto answer = evaluate_with_options(*client, block, {.patch_std = true});
-    for (size_t i = 0; i < n; ++i) {  // copies only, as in mufric_evaluate_ex
-      patch_std[i] = answer.patch_std[i];
-      if (status) status[i] = static_cast<int>(answer.status[i]);
-    }
-    last_error = answer.message;
-    return MUFRIC_OK;
-  });
+  const mufric_outputs outputs{nullptr, nullptr, nullptr, nullptr, patch_std, status, nullptr, nullptr};
+  return evaluate_into("mufric_patch_std", client, n, {contact_pressure, sliding_velocity, temperature, fibre_angle},
+                       0.0, outputs, Required::patch_std);
 }
 
 int mufric_has_patch_scatter(mufric_client* client) { return client != nullptr && client->has_patch_scatter ? 1 : 0; }

@@ -58,6 +58,7 @@ void quiet_hdf5_errors() { H5::Exception::dontPrint(); }
 Reader::Reader(const std::string& path, const std::string& what) : path_(path), what_(what) {
   quiet_hdf5_errors();
   if (!std::filesystem::exists(path)) throw Error(what + " '" + path + "': no such file");
+  if (std::filesystem::is_directory(path)) throw Error(what + " '" + path + "': a directory, not a file");
   std::error_code size_error;
   file_bytes_ = std::filesystem::file_size(path, size_error);
   if (H5Fis_hdf5(path.c_str()) <= 0) {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cctype>
 #include <exception>
+#include <string_view>
 
 #include <omp.h>
 
@@ -203,8 +205,15 @@ grpc::Status FrictionService::authorise(const grpc::CallbackServerContext& conte
   if (limits_.bearer_token.empty()) return grpc::Status::OK;
   const auto& metadata = context.client_metadata();
   const auto it = metadata.find("authorization");
-  if (it != metadata.end() && std::string(it->second.data(), it->second.size()) == "Bearer " + limits_.bearer_token) {
-    return grpc::Status::OK;
+  if (it != metadata.end()) {
+    // "Bearer <token>": the scheme is case-insensitive (RFC 7235 §2.1), the token is not.
+    const std::string_view value(it->second.data(), it->second.size());
+    constexpr std::string_view kScheme = "bearer ";
+    const bool scheme_matches = value.size() >= kScheme.size() &&
+                                std::equal(kScheme.begin(), kScheme.end(), value.begin(), [](char a, char b) {
+                                  return a == std::tolower(static_cast<unsigned char>(b));
+                                });
+    if (scheme_matches && value.substr(kScheme.size()) == limits_.bearer_token) return grpc::Status::OK;
   }
   return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token (metadata 'authorization: Bearer ...')"};
 }
@@ -220,7 +229,6 @@ grpc::ServerUnaryReactor* FrictionService::refuse_unless_authorised(grpc::Callba
 
 grpc::Status FrictionService::handle(const grpc::CallbackServerContext& context, const EvaluateRequest& request,
                                      mufric::v1::EvaluateResponse& response) {
-  ++counters_.requests;
   const auto start = std::chrono::steady_clock::now();
   // The OpenMP thread count is per calling thread, and gRPC runs handlers on its own threads.
   omp_set_num_threads(threads_per_evaluation(limits_.evaluation_threads, counters_.in_flight.load()));
@@ -240,6 +248,7 @@ grpc::Status FrictionService::handle(const grpc::CallbackServerContext& context,
 grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
                                                     mufric::v1::EvaluateResponse* response) {
   ++counters_.in_flight;
+  ++counters_.requests;  // answered or refused, each is a request (and a refusal an error too)
   grpc::Status status = authorise(*context);
   if (status.ok()) {
     status = handle(*context, *request, *response);
@@ -262,6 +271,7 @@ class FrictionService::StreamReactor final
     if (authorised.ok()) {
       StartRead(&request_);
     } else {
+      ++service_.counters_.requests;
       ++service_.counters_.errors;
       Finish(authorised);
     }
@@ -273,6 +283,7 @@ class FrictionService::StreamReactor final
       return;
     }
     ++service_.counters_.in_flight;
+    ++service_.counters_.requests;
     response_.Clear();
     const grpc::Status status = service_.handle(context_, request_, response_);
     if (status.ok()) {

@@ -52,7 +52,11 @@ Error listen_error(const std::string& listen, const std::string& why) { return E
 ListenAddress parse_listen_address(const std::string& listen) {
   const std::string expected = " (expected host:port, e.g. 127.0.0.1:50051; port 0: any free port)";
   const size_t colon = listen.rfind(':');
-  if (colon == std::string::npos) throw listen_error(listen, "no port" + expected);
+  if (colon == std::string::npos) {
+    const bool digits_only = !listen.empty() && std::all_of(listen.begin(), listen.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    if (digits_only) throw listen_error(listen, "a port alone; give host:port, e.g. 127.0.0.1:" + listen + " (loopback) or 0.0.0.0:" + listen + " (every interface)");
+    throw listen_error(listen, "no port" + expected);
+  }
   ListenAddress address{listen.substr(0, colon), listen.substr(colon + 1)};
   if (address.host.size() >= 2 && address.host.front() == '[' && address.host.back() == ']') {
     address.host = address.host.substr(1, address.host.size() - 2);
@@ -67,6 +71,11 @@ ListenAddress parse_listen_address(const std::string& listen) {
     throw listen_error(listen, "the port must be a number from 0 to " + std::to_string(kLargestPort) + expected);
   }
   return address;
+}
+
+// 127.0.0.0/8, ::1 and "localhost": a token sent there never leaves the machine.
+bool is_loopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
 }
 
 // Binds a socket to every address the host resolves to, as gRPC will, and closes it again, so that a
@@ -150,11 +159,19 @@ void run_server(const ServerOptions& options) {
 
   ModelRegistry registry(options.models_directory, log_line);
   registry.refresh();
+  if (registry.all().empty()) {
+    log_line("warning", "no model in " + options.models_directory +
+                            " yet: every Evaluate answers NOT_FOUND until a valid *.h5 appears there");
+  }
   std::string token;
   if (!options.token_file.empty()) {
     token = read_text_file(options.token_file, "--token-file");
     token.erase(token.find_last_not_of(" \t\r\n") + 1);
     if (token.empty()) throw Error("--token-file: '" + options.token_file + "' is empty");
+    if (options.tls_cert.empty() && !is_loopback(parse_listen_address(options.listen).host)) {
+      log_line("warning", "--token-file over plaintext on " + options.listen +
+                              ": the token crosses the network in the clear; give --tls-cert/--tls-key, or listen on loopback");
+    }
   }
   const int threads = options.threads > 0 ? options.threads : usable_cores();
   std::unique_ptr<UncertainQueryLog> uncertain_log;
@@ -208,8 +225,8 @@ void run_server(const ServerOptions& options) {
     int signal_number = 0;
     sigwait(&signals, &signal_number);
     if (signal_number == SIGHUP) {
-      log_line("info", "SIGHUP: reloading models");
-      registry.refresh();
+      log_line("info", "SIGHUP: rescanning the models by content");
+      registry.refresh(ModelRegistry::Rescan::kByContent);
       continue;
     }
     log_line("info", std::string(signal_number == SIGTERM ? "SIGTERM" : "SIGINT") + ": draining");

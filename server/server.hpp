@@ -1,6 +1,6 @@
 #pragma once
-// `mufric serve`: runs the FrictionService until SIGTERM/SIGINT (graceful drain), reloading models
-// on SIGHUP and whenever a file in the directory appears, changes or disappears.
+// `mufric serve`: runs the FrictionService until SIGTERM/SIGINT (graceful drain), loading a model
+// when its file appears or changes (polled; SIGHUP rescans by content at once).
 #include <memory>
 #include <string>
 

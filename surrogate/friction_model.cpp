@@ -207,17 +207,21 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
 }
 
 std::string point_reason(const InputSpace& inputs, const double* x) {
+  // Every input at fault, not the first: a user fixing one would otherwise meet the next one later.
+  std::string reasons;
+  const auto add = [&reasons](const std::string& reason) { reasons += (reasons.empty() ? "" : "; ") + reason; };
   for (size_t j = 0; j < inputs.size(); ++j) {
     const std::string why = physical_range_violation(x[j], inputs[j].kind());
-    if (!why.empty()) return inputs[j].name + ": " + why;
+    if (!why.empty()) add(inputs[j].name + ": " + why);
   }
+  if (!reasons.empty()) return reasons;
   for (size_t j = 0; j < inputs.size(); ++j) {
     if (inputs[j].contains(x[j])) continue;
     const QuantityKind kind = inputs[j].kind();
-    return inputs[j].name + ": " + format_human(x[j], kind) + " is " + (x[j] < inputs[j].lo ? "below" : "above") +
-           " the box (" + format_human(inputs[j].lo, kind) + " to " + format_human(inputs[j].hi, kind) + ")";
+    add(inputs[j].name + ": " + format_human(x[j], kind) + " is " + (x[j] < inputs[j].lo ? "below" : "above") +
+        " the box (" + format_human(inputs[j].lo, kind) + " to " + format_human(inputs[j].hi, kind) + ")");
   }
-  return "";
+  return reasons;
 }
 
 std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status) {

@@ -184,5 +184,39 @@ with tempfile.TemporaryDirectory() as tmp:
         server.send_signal(signal.SIGTERM)
         check(server.wait(timeout=20) == 0, "server drained and exited 0 on SIGTERM")
 
+    # A restarted server is found again within the reconnect schedule of examples/python/mufric_channel.py
+    # (regression: gRPC's default backoff, 1 s growing 1.6x, left a call waiting 12 s or more).
+    import mufric_channel  # noqa: E402
+
+    def start_server(listen, ready):
+        ready.unlink(missing_ok=True)
+        process = subprocess.Popen([mufric, "serve", "--models", str(tmp / "models"), "--listen", listen,
+                                    "--ready-file", str(ready)], stderr=subprocess.DEVNULL)
+        for _ in range(200):
+            if ready.exists() and ready.read_text().strip():
+                return process, ready.read_text().strip()
+            time.sleep(0.05)
+        raise SystemExit("serve did not start")
+
+    first, address = start_server("127.0.0.1:0", tmp / "address")
+    with mufric_channel.open_channel(address) as channel:
+        stub = friction_pb2_grpc.FrictionServiceStub(channel)
+        stub.ListModels(friction_pb2.ListModelsRequest(), timeout=10, wait_for_ready=True)
+        first.send_signal(signal.SIGTERM)
+        first.wait(timeout=20)
+        pending = stub.ListModels.future(friction_pb2.ListModelsRequest(), timeout=60, wait_for_ready=True)
+        DOWN_SECONDS, MOST_SECONDS_TO_FIND_IT = 6.0, 2.0  # default backoff would redial at ~5.2 s, then ~9.3 s
+        time.sleep(DOWN_SECONDS)
+        second, _ = start_server(address, tmp / "address2")
+        up = time.monotonic()
+        try:
+            pending.result()
+            waited = time.monotonic() - up
+            check(waited < MOST_SECONDS_TO_FIND_IT,
+                  f"a server restarted after {DOWN_SECONDS:.0f} s is reached {waited:.2f} s after it is up")
+        finally:
+            second.send_signal(signal.SIGTERM)
+            second.wait(timeout=20)
+
 print(f"{checks - len(failures)} passed, {len(failures)} failed")
 sys.exit(1 if failures else 0)

@@ -165,6 +165,10 @@ TEST(FrictionModel, PointReasonsNameTheInputAndTheSide) {
   EXPECT_EQ(point_reason(box, above), "contact_pressure: 1e+04MPa is above the box (300MPa to 1300MPa)");
   EXPECT_EQ(point_reason(box, below), "sliding_velocity: 6m/min is below the box (22.5m/min to 200m/min)");
   EXPECT_EQ(point_reason(box, negative), "contact_pressure: -5MPa is below 0MPa, the least a pressure can be");
+  // Every input at fault is named (regression: a point outside in two inputs named one).
+  const double two_outside[] = {10000e6, 0.1, 700.0};
+  EXPECT_EQ(point_reason(box, two_outside), "contact_pressure: 1e+04MPa is above the box (300MPa to 1300MPa); "
+                                            "sliding_velocity: 6m/min is below the box (22.5m/min to 200m/min)");
   QueryBatch x(3, 3);
   x.row(0) = Eigen::Map<const Eigen::RowVector3d>(inside);
   x.row(1) = Eigen::Map<const Eigen::RowVector3d>(negative);

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <mutex>
 #include <random>
+#include <sstream>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -25,6 +26,7 @@
 #include "client/friction_client.hpp"
 #include "client/mufric.h"
 #include "common/csv_table.hpp"
+#include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
@@ -444,6 +446,108 @@ TEST_F(Service, HotReloadUnderLoadFailsNoRequestAndRefusesABadFile) {
   EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.32);
 }
 
+// Established TCP connections whose local port is `port` (the server's side), from /proc/net/tcp
+// and tcp6 (gRPC listens on an IPv6 socket, IPv4 addresses mapped into it).
+int established_connections_to(int port) {
+  int count = 0;
+  constexpr const char* kEstablished = "01";
+  for (const char* path : {"/proc/self/net/tcp", "/proc/self/net/tcp6"}) {
+    std::ifstream table(path);
+    std::string line;
+    std::getline(table, line);  // header
+    while (std::getline(table, line)) {
+      std::istringstream fields(line);
+      std::string slot, local, remote, state;
+      fields >> slot >> local >> remote >> state;
+      const int local_port = std::stoi(local.substr(local.find(':') + 1), nullptr, 16);
+      count += local_port == port && state == kEstablished;
+    }
+  }
+  return count;
+}
+
+// Regression: `bench --clients 8` said "each with its own connection" and opened one (gRPC shares a
+// connection among channels to one target). Options::own_connection gives each client its own.
+TEST_F(Service, ClientsWithTheirOwnConnectionOpenOneEach) {
+  const Points pts = random_points(2);
+  LoopbackServer shared_server(dir_), own_server(dir_);
+  const std::string shared_uri = "grpc://" + shared_server.address() + "/coulomb";
+  const auto a = client::connect(shared_uri), b = client::connect(shared_uri);
+  a->evaluate(pts.block(), {});
+  b->evaluate(pts.block(), {});
+  EXPECT_EQ(established_connections_to(shared_server.port()), 1);
+  client::Options own;
+  own.own_connection = true;
+  const std::string own_uri = "grpc://" + own_server.address() + "/coulomb";
+  const auto c = client::connect(own_uri, own), d = client::connect(own_uri, own);
+  c->evaluate(pts.block(), {});
+  d->evaluate(pts.block(), {});
+  EXPECT_EQ(established_connections_to(own_server.port()), 2);
+}
+
+// A registry over dir/ whose log lines are kept, for the reload tests.
+struct LoggedRegistry {
+  explicit LoggedRegistry(const fs::path& dir)
+      : registry(dir, [this](const std::string& level, const std::string& line) { log += level + ": " + line + "\n"; }) {}
+  std::string log;
+  server::ModelRegistry registry;
+};
+
+std::string served_version(const server::ModelRegistry& registry, const std::string& name) {
+  const auto served = registry.find(name);
+  return served ? served->version : "(not served)";
+}
+
+std::string file_version(const fs::path& path) { return sha256_file(path.string()).substr(0, 16); }
+
+// Regression: reload compared size and modification time only, so a different model written in
+// place with the same size and a pinned time (deploy tools that keep file times) was never loaded.
+TEST_F(Service, AModelReplacedWithTheSameSizeAndTimeIsLoaded) {
+  const fs::path served = dir_ / "coulomb.h5", other = dir_ / "other.dat";
+  save_model(other.string(), CoulombLaw(0.45));
+  ASSERT_EQ(fs::file_size(other), fs::file_size(served)) << "the test needs two models of one size";
+  LoggedRegistry logged(dir_);
+  logged.registry.refresh();
+  ASSERT_EQ(served_version(logged.registry, "coulomb"), file_version(served));
+  const auto pinned_time = fs::last_write_time(served);
+  std::ifstream in(other, std::ios::binary);
+  std::ofstream(served, std::ios::binary | std::ios::trunc) << in.rdbuf();  // same inode, new bytes
+  fs::last_write_time(served, pinned_time);
+  EXPECT_EQ(logged.registry.refresh(), 1) << logged.log;
+  EXPECT_EQ(served_version(logged.registry, "coulomb"), file_version(other));
+  // The same bytes under a new time are not reloaded, on the poll or on SIGHUP's rescan by content.
+  fs::last_write_time(served, pinned_time + std::chrono::seconds(5));
+  EXPECT_EQ(logged.registry.refresh(), 0);
+  EXPECT_EQ(logged.registry.refresh(server::ModelRegistry::Rescan::kByContent), 0);
+  EXPECT_EQ(served_version(logged.registry, "coulomb"), file_version(other));
+}
+
+// Regression: deleting a served file stopped its model (an rm-then-cp deploy answered NOT_FOUND
+// for 12 s). The loaded version keeps serving, and the log says so, until a new file replaces it.
+TEST_F(Service, ADeletedModelFileKeepsServingUntilANewFileReplacesIt) {
+  LoopbackServer server(dir_);
+  const fs::path served = dir_ / "coulomb.h5";
+  const std::string first = file_version(served);
+  LoggedRegistry logged(dir_);
+  logged.registry.refresh();
+  fs::remove(served);
+  server.registry().refresh();
+  logged.registry.refresh();
+  logged.registry.refresh();
+  EXPECT_EQ(served_version(logged.registry, "coulomb"), first);
+  EXPECT_NE(logged.log.find("coulomb.h5 is gone; version " + first + " keeps serving"), std::string::npos) << logged.log;
+  EXPECT_EQ(logged.log.find("is gone", logged.log.find("is gone") + 1), std::string::npos) << "logged once: " << logged.log;
+  const Points pts = random_points(8);
+  const auto remote = client::connect("grpc://" + server.address() + "/coulomb");
+  EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.3);
+  save_model(served.string(), CoulombLaw(0.35));
+  server.registry().refresh();
+  logged.registry.refresh();
+  EXPECT_EQ(served_version(logged.registry, "coulomb"), file_version(served));
+  EXPECT_NE(logged.log.find("coulomb.h5 is back"), std::string::npos) << logged.log;
+  EXPECT_DOUBLE_EQ(remote->evaluate(pts.block(), {}).mu[0], 0.35);
+}
+
 // Regression: a model file whose global-heap string length had one flipped byte, dropped into the
 // served directory, killed `mufric serve` with SIGSEGV. It is now refused, and every other model
 // keeps serving (this test process is the server: a crash would end it).
@@ -498,11 +602,26 @@ TEST_F(Service, BearerTokenIsRequiredWhenConfigured) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("UNAUTHENTICATED"), std::string::npos) << e.what();
   }
+  // A refused call is a request and an error (regression: an error but not a request).
+  EXPECT_EQ(server.service().counters().requests.load(), 1);
+  EXPECT_EQ(server.service().counters().errors.load(), 1);
   client::Options with = without;
   with.token = "s3cret";
   EXPECT_DOUBLE_EQ(client::connect("grpc://" + server.address() + "/coulomb", with)->evaluate(pts.block(), {}).mu[0], 0.3);
   with.streaming = true;
   EXPECT_DOUBLE_EQ(client::connect("grpc://" + server.address() + "/coulomb", with)->evaluate(pts.block(), {}).mu[0], 0.3);
+  // The scheme is case-insensitive (RFC 7235 §2.1); the token is not.
+  const auto list_with = [&](const std::string& authorization) {
+    auto stub = mufric::v1::FrictionService::NewStub(grpc::CreateChannel(server.address(), grpc::InsecureChannelCredentials()));
+    grpc::ClientContext context;
+    context.AddMetadata("authorization", authorization);
+    mufric::v1::ListModelsResponse response;
+    return stub->ListModels(&context, {}, &response).error_code();
+  };
+  EXPECT_EQ(list_with("bearer s3cret"), grpc::StatusCode::OK);
+  EXPECT_EQ(list_with("BEARER s3cret"), grpc::StatusCode::OK);
+  EXPECT_EQ(list_with("Bearer S3CRET"), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(list_with("Basic s3cret"), grpc::StatusCode::UNAUTHENTICATED);
 }
 
 // A test CA, a server certificate for 127.0.0.1 and a client certificate, made with openssl.
@@ -532,7 +651,14 @@ TEST_F(Service, TlsAndMutualTls) {
   {
     LoopbackServer server(dir_, 0, {}, server::server_credentials(tls));
     EXPECT_DOUBLE_EQ(client::connect("grpcs://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}).mu[0], 0.3);
-    EXPECT_THROW(client::connect("grpc://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {}), Error);
+    // Regression: a plaintext client of a TLS server was told "tcp handshaker shutdown" only.
+    try {
+      client::connect("grpc://" + server.address() + "/coulomb", options)->evaluate(pts.block(), {});
+      ADD_FAILURE() << "a plaintext client reached a TLS server";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("does the server use TLS? then connect with grpcs://"), std::string::npos)
+          << e.what();
+    }
   }
   tls.tls_client_ca = (dir_ / "ca.pem").string();
   LoopbackServer server(dir_, 0, {}, server::server_credentials(tls));
@@ -732,7 +858,7 @@ TEST_F(Service, ExtrapolationPolicyIsChosenPerRequest) {
   std::vector<int> status(4);
   ASSERT_EQ(mufric_evaluate(c, 4, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, mu.data(), nullptr, nullptr,
                             nullptr, status.data()),
-            MUFRIC_OK);
+            MUFRIC_PARTIAL);  // point 1 refused, the others answered
   EXPECT_EQ(status[1], MUFRIC_POINT_OUT_OF_BOX);
   mufric_close(c);
   EXPECT_EQ(mufric_open_with_options(uri.c_str(), "extrapolation=nearest", &c), MUFRIC_INVALID_ARGUMENT);
@@ -798,11 +924,25 @@ TEST_F(Service, ThePatchScatterReachesEveryInterface) {
     Points bad = outside;
     bad.t[9] = -1.0;  // no answer: the fill value
     ASSERT_EQ(mufric_patch_std(c, 300, bad.p.data(), bad.v.data(), bad.t.data(), nullptr, out.data(), status.data()),
-              MUFRIC_OK)
+              MUFRIC_PARTIAL)
         << mufric_last_error();
     EXPECT_EQ(out[9], -1.0);
     EXPECT_EQ(status[9], MUFRIC_POINT_INVALID_INPUT);
     EXPECT_EQ(out[8], local.patch_std[8]) << uri;
+    // One call for mu, its interval and the patch scatter gives what the separate calls give.
+    std::vector<double> mu(300), lo(300), hi(300), together(300), mu_alone(300), lo_alone(300), hi_alone(300);
+    mufric_outputs outputs{};
+    outputs.mu = mu.data(), outputs.lo = lo.data(), outputs.hi = hi.data(), outputs.patch_std = together.data();
+    ASSERT_EQ(mufric_evaluate_outputs(c, 300, bad.p.data(), bad.v.data(), bad.t.data(), nullptr, 0.95, &outputs),
+              MUFRIC_PARTIAL)
+        << mufric_last_error();
+    ASSERT_EQ(mufric_evaluate(c, 300, bad.p.data(), bad.v.data(), bad.t.data(), nullptr, 0.95, mu_alone.data(), nullptr,
+                              lo_alone.data(), hi_alone.data(), nullptr),
+              MUFRIC_PARTIAL);
+    EXPECT_EQ(together, out) << uri;
+    EXPECT_EQ(mu, mu_alone);
+    EXPECT_EQ(lo, lo_alone);
+    EXPECT_EQ(hi, hi_alone);
     mufric_close(c);
   }
   mufric_client* c = nullptr;
@@ -813,6 +953,62 @@ TEST_F(Service, ThePatchScatterReachesEveryInterface) {
             MUFRIC_INVALID_ARGUMENT);
   EXPECT_NE(std::string(mufric_last_error()).find("no patch scatter"), std::string::npos) << mufric_last_error();
   mufric_close(c);
+}
+
+// Regression: under extrapolation=refuse every call returned MUFRIC_OK, with mu NaN or the fill
+// value (fill=-1 reversed the friction force of an SPH code at 3853 points); n = 0 with NULL arrays
+// was an error; the messages of mufric_evaluate_ex named mufric_evaluate.
+TEST_F(Service, CAbiSaysWhenPointsWereNotAnsweredAndTakesAFallbackMu) {
+  LoopbackServer server(dir_);
+  Points pts = random_points(6);
+  pts.p[2] = 5e9;   // above the box, a possible pressure: refused
+  pts.t[4] = -3.0;  // impossible: invalid
+  for (const std::string& uri : {"grpc://" + server.address() + "/gp", "file://" + (dir_ / "gp.h5").string()}) {
+    mufric_client* c = nullptr;
+    ASSERT_EQ(mufric_open_with_options(uri.c_str(), "extrapolation=refuse, fill=-1, fallback_mu=0.35", &c), MUFRIC_OK)
+        << mufric_last_error();
+    std::vector<double> mu(6), sd(6);
+    std::vector<int> status(6);
+    EXPECT_EQ(mufric_evaluate(c, 6, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, mu.data(), sd.data(), nullptr,
+                              nullptr, status.data()),
+              MUFRIC_PARTIAL)
+        << uri;
+    EXPECT_NE(std::string(mufric_last_error()).find("point 2 OUT_OF_BOX"), std::string::npos) << mufric_last_error();
+    EXPECT_EQ(status[2], MUFRIC_POINT_OUT_OF_BOX);
+    EXPECT_EQ(status[4], MUFRIC_POINT_INVALID_INPUT);
+    EXPECT_EQ(mu[2], 0.35);  // the caller's fallback, not the fill
+    EXPECT_EQ(mu[4], 0.35);
+    EXPECT_EQ(sd[2], -1.0);  // the fill where no fallback applies
+    EXPECT_GT(mu[0], 0.0);
+    EXPECT_EQ(status[0], MUFRIC_POINT_OK);
+    // Every point answered: MUFRIC_OK and no message.
+    EXPECT_EQ(mufric_evaluate(c, 2, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, mu.data(), nullptr, nullptr,
+                              nullptr, nullptr),
+              MUFRIC_OK);
+    EXPECT_STREQ(mufric_last_error(), "");
+    // A step without contact: n = 0 with NULL arrays is a no-op.
+    mufric_counts counts{};
+    counts.invalid = 99;
+    EXPECT_EQ(mufric_evaluate(c, 0, nullptr, nullptr, nullptr, nullptr, 0.0, nullptr, nullptr, nullptr, nullptr, nullptr),
+              MUFRIC_OK)
+        << mufric_last_error();
+    EXPECT_EQ(mufric_evaluate_ex(c, 0, nullptr, nullptr, nullptr, nullptr, 0.0, nullptr, nullptr, nullptr, nullptr,
+                                 nullptr, nullptr, &counts),
+              MUFRIC_OK);
+    EXPECT_EQ(counts.invalid, 0u);
+    // A message names the function called.
+    EXPECT_EQ(mufric_evaluate_ex(c, 2, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, nullptr, nullptr,
+                                 nullptr, nullptr, nullptr, nullptr, nullptr),
+              MUFRIC_INVALID_ARGUMENT);
+    EXPECT_STREQ(mufric_last_error(), "mufric_evaluate_ex: mu must not be NULL");
+    EXPECT_EQ(mufric_evaluate_outputs(c, 2, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.0, nullptr),
+              MUFRIC_INVALID_ARGUMENT);
+    EXPECT_STREQ(mufric_last_error(), "mufric_evaluate_outputs: outputs must not be NULL");
+    mufric_close(c);
+  }
+  mufric_client* c = nullptr;
+  EXPECT_EQ(mufric_open_with_options("grpc://127.0.0.1:1/gp", "fallback_mu=-1", &c), MUFRIC_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(mufric_last_error()).find("fallback_mu"), std::string::npos) << mufric_last_error();
 }
 
 TEST_F(Service, CAbiOptionsReachTheConnection) {

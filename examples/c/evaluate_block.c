@@ -27,10 +27,13 @@ int main(int argc, char** argv) {
     angle[i] = M_PI / 2;
   }
   int failures = 0;
-  if (mufric_evaluate(client, n, p, v, NULL, angle, 0.95, mu, NULL, lo, hi, status) != MUFRIC_OK) {
+  /* MUFRIC_PARTIAL: answered, but not every point (here the NaN pressure); status says which. */
+  const int code = mufric_evaluate(client, n, p, v, NULL, angle, 0.95, mu, NULL, lo, hi, status);
+  if (code != MUFRIC_OK && code != MUFRIC_PARTIAL) {
     fprintf(stderr, "%s\n", mufric_last_error());
     return 2;
   }
+  if (code != MUFRIC_PARTIAL) ++failures;
   for (int i = 0; i < 3; ++i) {
     double expected = 0.149911 + 0.013133 * v_m_min[i] - 0.000753 * p_mpa[i];
     expected = fmin(fmax(expected, 0.093755565), 0.322395506);

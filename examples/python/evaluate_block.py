@@ -11,14 +11,15 @@ import sys
 
 import grpc
 from mufric.v1 import friction_pb2, friction_pb2_grpc
+from mufric_channel import open_channel
 
 
 def main(address, model):
-    with grpc.insecure_channel(address) as channel:
+    with open_channel(address) as channel:
         stub = friction_pb2_grpc.FrictionServiceStub(channel)
-        served = stub.ListModels(friction_pb2.ListModelsRequest(), timeout=10)
+        served = stub.ListModels(friction_pb2.ListModelsRequest(), timeout=10, wait_for_ready=True)
         print("serving:", ", ".join(f"{m.name} ({m.kind}, {m.version})" for m in served.models))
-        description = stub.DescribeModel(friction_pb2.DescribeModelRequest(model=model), timeout=10)
+        description = stub.DescribeModel(friction_pb2.DescribeModelRequest(model=model), timeout=10, wait_for_ready=True)
         print(f"{model}: inputs", [(i.name, i.unit) for i in description.inputs])
         pressure_mpa = [50.0, 120.0, 180.0]
         velocity_m_min = [6.0, 10.0, 14.0]
@@ -30,7 +31,7 @@ def main(address, model):
             fibre_angle=[math.pi / 2] * 3,
             ci_level=0.95,
         )
-        answer = stub.Evaluate(request, timeout=10)
+        answer = stub.Evaluate(request, timeout=10, wait_for_ready=True)
         for p, v, mu, lo, hi, status in zip(pressure_mpa, velocity_m_min, answer.mu, answer.lo, answer.hi,
                                             answer.status):
             print(f"p {p:6.1f} MPa  v {v:5.1f} m/min  mu {mu:.6f}  95 % [{lo:.6f}, {hi:.6f}]  "

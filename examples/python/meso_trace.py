@@ -16,6 +16,7 @@ import math
 import grpc
 import numpy as np
 from mufric.v1 import friction_pb2, friction_pb2_grpc
+from mufric_channel import open_channel
 
 HUMAN = {"contact_pressure": (1e-6, "MPa"), "sliding_velocity": (60.0, "m/min"), "temperature": (1.0, "K")}
 
@@ -30,7 +31,7 @@ def human(name, value):
 def evaluate(stub, model, p, v, t):
     request = friction_pb2.EvaluateRequest(model=model, contact_pressure=p, sliding_velocity=v, temperature=t,
                                            std=True, ci_level=0.95)
-    return stub.Evaluate(request, timeout=30)
+    return stub.Evaluate(request, timeout=30, wait_for_ready=True)
 
 
 def trace(stub, model, box, points, increments, seed):
@@ -105,9 +106,9 @@ def main():
     parser.add_argument("--dataset", help="micro-model dataset (HDF5) to show as points in the plot")
     parser.add_argument("--plot", help="PNG to write: mu with its 95 % band along each input")
     args = parser.parse_args()
-    with grpc.insecure_channel(args.address) as channel:
+    with open_channel(args.address) as channel:
         stub = friction_pb2_grpc.FrictionServiceStub(channel)
-        description = stub.DescribeModel(friction_pb2.DescribeModelRequest(model=args.model), timeout=10)
+        description = stub.DescribeModel(friction_pb2.DescribeModelRequest(model=args.model), timeout=10, wait_for_ready=True)
         box = {i.name: (i.lo, i.hi) for i in description.inputs}
         missing = [n for n in HUMAN if n not in box]
         if missing:

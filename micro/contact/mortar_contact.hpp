@@ -1,5 +1,6 @@
 #pragma once
-// Frictionless penalty contact between the chip's top surface and a rigid tool, in the mortar
+// Penalty contact between the chip's top surface and a rigid tool, frictionless or with an interface
+// law (below: Coulomb, shear factor, Zorev, an adhesion table; dry or wetted spots), in the mortar
 // knot-to-surface form of seed 000 eq. (14)–(16) (Temizer, Wriggers & Hughes, CMAME 200, 2011;
 // Dimitri et al., CMAME 269, 2014): the normal gap of every surface quadrature point to its closest
 // point on the tool, g = (x_p − x_q)·n_p (positive when the chip penetrates the tool), is averaged

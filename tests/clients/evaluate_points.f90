@@ -22,7 +22,7 @@ program evaluate_points
     stop 1
   end if
   if (c_mufric_evaluate(client, int(n, c_size_t), c_loc(p), c_loc(v), c_loc(t), c_null_ptr, 0.95d0, &
-                        c_loc(mu), c_loc(sd), c_loc(lo), c_loc(hi), c_loc(status)) /= MUFRIC_OK) then
+                        c_loc(mu), c_loc(sd), c_loc(lo), c_loc(hi), c_loc(status)) == MUFRIC_FAILED) then
     write (0, *) 'mufric_evaluate: ', mufric_error()
     stop 1
   end if

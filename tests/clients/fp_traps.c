@@ -52,8 +52,8 @@ static void evaluate_block(const char* uri, const char* options, double fill, co
                          ? mufric_evaluate(client, kPoints, p, v, t, NULL, 0.95, mu, sd, lo, hi, status)
                          : mufric_evaluate_ex(client, kPoints, p, v, t, NULL, 0.95, mu, sd, lo, hi, status, outside,
                                               &counts);
-    check(code == MUFRIC_OK, mufric_last_error(), where);
-    if (code != MUFRIC_OK) break;
+    check(code == MUFRIC_PARTIAL, mufric_last_error(), where); /* five points without an answer */
+    if (code != MUFRIC_PARTIAL) break;
     check(strncmp(mufric_last_error(), "point 1 OUT_OF_BOX: contact_pressure", 36) == 0,
           "the message names the first point without an answer", where);
     check(strstr(mufric_last_error(), "(and 4 more points without an answer)") != NULL, "and counts the others", where);
