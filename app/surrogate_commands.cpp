@@ -77,9 +77,7 @@ void print_training_report(const GaussianProcess& gp, const GpTrainingReport& re
   std::printf("interval: %s\n", gp_interval_meaning(gp.interval_meaning()).c_str());
   if (s.jitter > 0) std::printf("  jitter %.3g\n", s.jitter);
   const auto& t = s.summary;
-  std::printf("cross-validation (leave-one-out, closed form): mean relative error %.4f %%, max %.4f %%, "
-              "RMSE %.4g, 95 %% interval coverage %.1f %%\n",
-              100 * t.loo_mean_relative_error, 100 * t.loo_max_relative_error, t.loo_rmse, 100 * t.loo_coverage_95);
+  std::printf("cross-validation %s\n", leave_one_out_text(t, s.known_noise.size() != 0).c_str());
   for (const auto& w : report.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
@@ -124,18 +122,24 @@ void apply_box_options(FrictionModel& model, const BoxOptions& o) {
 // --fast-* options of train and upgrade.
 struct FastOptions {
   FastEvaluatorOptions build;
-  double max_seconds = 0.0;  // 0: the GP fit's own time (see fast_evaluator_budget)
+  double max_gigawork = 0.0;  // 10⁹ multiply-adds; 0: fast_evaluator_budget's default
   bool skip = false;
 };
 
-// The fast evaluator's default time budget: the GP fit's own wall time (a grid pays off in proportion
-// to the exact model's cost per point, which grows with n as the fit's does), but at least this much:
-// at n = 900 the fit takes about a second, and the grid that holds μ to 1e-6 for data with structure
-// at a fifth of the box takes 3-5 s on one core, while it answers 100x faster than the exact model for
-// the rest of the model's life (bench/RESULTS.md, "train: fit and fast evaluator against scikit-learn").
-constexpr double kLeastFastEvaluatorSeconds = 10.0;
-double fast_evaluator_budget(const FastOptions& o, double fit_seconds) {
-  return o.max_seconds > 0.0 ? o.max_seconds : std::max(kLeastFastEvaluatorSeconds, fit_seconds);
+// The fast evaluator's default budget, counted in work (multiply-adds of the exact model,
+// exact_point_work), never in seconds: a model file must not depend on how busy the machine was
+// (issue 49: a 900-point model was written without its grid on a loaded machine, with it on an idle
+// one). A grid pays off in proportion to the exact model's cost per point, which grows with n as the
+// fit's does: the budget is about what a fit of n points costs, ~100 likelihood evaluations of
+// ~n³ each, and at least 1e11 (about 10 s of one core here at n = 900, where the grid that holds μ to
+// 1e-6 takes 3-5 s and then answers 100x faster than the exact model; bench/RESULTS.md, "train: fit
+// and fast evaluator against scikit-learn").
+constexpr double kLeastFastEvaluatorWork = 1e11;
+constexpr double kFitLikeEvaluations = 100.0;
+double fast_evaluator_budget(const FastOptions& o, const GaussianProcess& gp) {
+  if (o.max_gigawork > 0.0) return o.max_gigawork * 1e9;
+  const auto n = static_cast<double>(gp.state().x_train.rows());
+  return std::max(kLeastFastEvaluatorWork, kFitLikeEvaluations * n * n * n);
 }
 
 void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
@@ -152,10 +156,12 @@ void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
       ->capture_default_str()->check(FiniteRange(kLeastTolerance, 1.0));
   cmd->add_option("--fast-max-mb", o.build.max_megabytes, "Fast evaluator: largest grid, MB")
       ->capture_default_str()->check(FiniteRange(kLeastBudget, 1e6));
-  cmd->add_option("--fast-max-seconds", o.max_seconds,
-                  "Fast evaluator: time budget; a finer grid whose predicted cost would not fit is not built\n"
-                  "(default: the GP fit's wall time, at least 10 s)")
-      ->check(FiniteRange(kLeastBudget, 1e6));
+  cmd->add_option("--fast-max-work", o.max_gigawork,
+                  "Fast evaluator: work budget in 10^9 multiply-adds of the exact model (about 0.1 s each on one\n"
+                  "core with AVX2); a finer grid that would take the build past it is not built. Counted, not timed:\n"
+                  "the same data and command give the same file on a busy machine and an idle one\n"
+                  "(default: 100 n^3 for a GP of n points, at least 100)")
+      ->check(FiniteRange(kLeastBudget, 1e9));
   cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
 }
 
@@ -169,14 +175,22 @@ std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess&
     std::printf("  fast evaluator (%s): %s\n", label.c_str(), line.c_str());
     std::fflush(stdout);
   };
-  std::printf("fast evaluator (%s): building within %.1f s and %.0f MB (--fast-max-seconds, --fast-max-mb)\n",
-              label.c_str(), build.max_seconds, build.max_megabytes);
+  std::printf("fast evaluator (%s): building within %.3g G multiply-adds and %.0f MB (--fast-max-work, --fast-max-mb)\n",
+              label.c_str(), build.max_work / 1e9, build.max_megabytes);
   const auto start = std::chrono::steady_clock::now();
-  auto fast = std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, build));
+  std::shared_ptr<const FastEvaluator> fast;
+  try {
+    fast = std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, build));
+  } catch (const FastEvaluatorOverCap& e) {
+    // Regression: train exited here with no model written at all.
+    std::printf("fast evaluator (%s): not stored: %s; the exact model answers every request (a larger "
+                "--fast-max-mb with `mufric upgrade --rebuild`)\n", label.c_str(), e.what());
+    return nullptr;
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!fast->meets(build.mu_tolerance, build.std_relative_tolerance)) {
     std::printf("fast evaluator (%s): not stored, built in %.1f s: %s before the tolerances were met; the exact model "
-                "answers every request (a larger --fast-max-seconds / --fast-max-mb, or looser --fast-*-tolerance, "
+                "answers every request (a larger --fast-max-work / --fast-max-mb, or looser --fast-*-tolerance, "
                 "with `mufric upgrade --rebuild`)\n",
                 label.c_str(), seconds, fast->stop_reason().c_str());
     return nullptr;
@@ -189,12 +203,12 @@ std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess&
 
 // The model's fast evaluator and, for a model with a patch scatter, the scatter's: its log variance
 // tabulated to the tolerance that holds patch_std to --fast-std-tolerance (relative), its own σ unused.
-void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o, double fit_seconds) {
+void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o) {
   gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
   if (gp.patch_scatter()) gp.attach_patch_scatter_fast_evaluator(nullptr);
   if (o.skip) return;
   FastEvaluatorOptions build = o.build;
-  build.max_seconds = fast_evaluator_budget(o, fit_seconds);
+  build.max_work = fast_evaluator_budget(o, gp);
   gp.attach_fast_evaluator(build_fast_evaluator(gp, build, "model"));
   if (gp.patch_scatter()) {
     FastEvaluatorOptions scatter = build;
@@ -303,7 +317,7 @@ void add_train(CLI::App& app) {
     GaussianProcess& gp = *trained;
     print_training_report(gp, report);
     apply_box_options(gp, o->box);  // before the grid: it tabulates μ as served (clipped to the range)
-    attach_fast_evaluator(gp, o->fast, report.seconds);
+    attach_fast_evaluator(gp, o->fast);
     save_model(o->out, gp);
     std::printf("wrote %s (gp, %lld training points) in %.2f s\n", o->out.c_str(),
                 static_cast<long long>(data.x.rows()), report.seconds);
@@ -359,6 +373,7 @@ PredictPoints points_from_csv(const std::string& path, const InputSpace& inputs)
     p.columns.push_back(table.si_column(input.name));
   }
   p.lines = table.line_of_row;
+  if (p.lines.empty()) throw Error(path + ": a header and no rows: no point to predict");
   return p;
 }
 
@@ -610,7 +625,7 @@ void add_upgrade(CLI::App& app) {
     apply_box_options(*model, o->box);
     if (auto* gp = dynamic_cast<GaussianProcess*>(model.get())) {
       if (gp->fast_evaluator() == nullptr || o->rebuild || range_changed) {
-        attach_fast_evaluator(*gp, o->fast, gp->state().summary.seconds);
+        attach_fast_evaluator(*gp, o->fast);
       } else {
         std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
       }

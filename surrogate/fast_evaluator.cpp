@@ -28,7 +28,7 @@ constexpr int kLocalSearchEvaluations = 60;
 // the final grid uses the options' full check set and the local searches.
 constexpr long long kRefinementCheckPoints = 2000;
 // A search evaluates one point per call, several times dearer than a point of a batch (measured
-// ~4× at n = 900); the time prediction counts each as this many batch points.
+// ~4× at n = 900); the work count takes each as this many batch points.
 constexpr double kSearchEvaluationCost = 4.0;
 
 // What the grid is built from and measured against: the exact GP, never a grid the GP may already
@@ -72,6 +72,16 @@ TensorCubicGrid tabulate(const GaussianProcess& gp, const std::vector<int>& cell
   values.col(1) = e.std.array().max(kSmallestTabulatedStd).log().matrix();
   return TensorCubicGrid(cells, values);
 }
+
+}  // namespace
+
+double exact_point_work(const GaussianProcess& gp) {
+  const auto n = static_cast<double>(gp.state().x_train.rows());
+  const auto d = static_cast<double>(gp.inputs().size());
+  return n * (n + d);
+}
+
+namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
@@ -248,7 +258,7 @@ FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluato
     throw Error("fast evaluator: tolerances must be > 0");
   }
   if (o.check_points < 1) throw Error("fast evaluator: check_points must be >= 1");
-  if (!(o.max_seconds > 0.0)) throw Error("fast evaluator: the time budget must be > 0 s");
+  if (!(o.max_work > 0.0)) throw Error("fast evaluator: the work budget must be > 0");
   auto say = [&](const std::string& line) {
     if (o.progress) o.progress(line);
   };
@@ -256,19 +266,18 @@ FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluato
   const FastEvaluatorBounds unmeasured{.std_floor = std_floor_for(o.mu_tolerance, o.std_relative_tolerance)};
   double resolution = kFirstResolution;
   std::vector<int> cells = cells_for(gp, resolution);
+  const double per_point = exact_point_work(gp);
+  double work_done = 0.0;
   if (grid_megabytes(cells) > o.max_megabytes) {
-    throw Error("fast evaluator: the coarsest grid needs " + std::to_string(grid_megabytes(cells)) +
+    throw FastEvaluatorOverCap("the coarsest grid needs " + std::to_string(grid_megabytes(cells)) +
                 " MB, more than the cap of " + std::to_string(o.max_megabytes) + " MB");
   }
   char line[320];
   for (unsigned round = 0;; ++round) {
-    const Clock::time_point round_start = Clock::now();
     FastEvaluator fast(gp.inputs(), tabulate(gp, cells), unmeasured);
     const FastEvaluatorBounds sampled = measured_bounds(fast, gp, o, o.seed + round, false);
-    // The cost of one exact evaluation in a batch, as this round measured it: what the next round's
-    // and the certification's times are predicted from.
-    const double per_point = seconds_since(round_start) /
-                             static_cast<double>(TensorCubicGrid::node_count(cells) + std::min(o.check_points, kRefinementCheckPoints));
+    work_done += per_point * static_cast<double>(TensorCubicGrid::node_count(cells) +
+                                                 std::min(o.check_points, kRefinementCheckPoints));
     const double score = std::max(sampled.mu_absolute / o.mu_tolerance, sampled.std_relative / o.std_relative_tolerance);
     std::snprintf(line, sizeof line,
                   "grid %s cells (%.1f MB): mu within %.2e, std within %.2e of max(std, %.0e) (sampled); %.1f s so far",
@@ -277,9 +286,9 @@ FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluato
     say(line);
     const double growth = std::clamp(std::pow(score, 0.25) * kGrowthMargin, kLeastGrowth, kMostGrowth);
     const std::vector<int> finer = cells_for(gp, resolution * growth);
-    const double certification_seconds =
+    const double certification_work =
         per_point * (static_cast<double>(o.check_points) + o.local_searches * kLocalSearchEvaluations * kSearchEvaluationCost);
-    const double next_round_seconds =
+    const double next_round_work =
         per_point * static_cast<double>(TensorCubicGrid::node_count(finer) + std::min(o.check_points, kRefinementCheckPoints));
     std::string limit;
     if (finer == cells) {
@@ -288,9 +297,9 @@ FastEvaluator FastEvaluator::build(const GaussianProcess& gp, const FastEvaluato
       std::snprintf(line, sizeof line, "the next grid (%s cells, %.1f MB) exceeds the memory cap of %.1f MB",
                     shape_text(finer).c_str(), grid_megabytes(finer), o.max_megabytes);
       limit = line;
-    } else if (seconds_since(start) + next_round_seconds + certification_seconds > o.max_seconds) {
-      std::snprintf(line, sizeof line, "the next grid (%s cells) would take about %.1f s more, past the time budget of %.1f s",
-                    shape_text(finer).c_str(), next_round_seconds + certification_seconds, o.max_seconds);
+    } else if (work_done + next_round_work + certification_work > o.max_work) {
+      std::snprintf(line, sizeof line, "the next grid (%s cells) would take %.3g G multiply-adds more, past the work budget of %.3g G",
+                    shape_text(finer).c_str(), (next_round_work + certification_work) / 1e9, o.max_work / 1e9);
       limit = line;
     }
     if (score <= 1.0 || !limit.empty()) {

@@ -4,7 +4,7 @@
 // error bound measured against the exact GP — on a random check set independent of the grid plus
 // local searches for the worst error from its worst points — times a safety factor. The grid is
 // refined (cells per input ∝ 1/length scale) until the bound is within the tolerances, or until the
-// next grid would break the memory or time budget (both predicted before it is built); the bound
+// next grid would break the memory or work budget (both predicted before it is built); the bound
 // actually reached is kept either way, so a caller uses the grid only where the bound serves the
 // request.
 //
@@ -20,6 +20,7 @@
 #include <limits>
 #include <string>
 
+#include "common/error.hpp"
 #include "common/input_space.hpp"
 #include "surrogate/gaussian_process.hpp"
 #include "surrogate/tensor_cubic_grid.hpp"
@@ -33,6 +34,13 @@ struct FastEvaluatorBounds {
   double std_floor = 0.0;
 };
 
+// Even the coarsest grid would exceed FastEvaluatorOptions::max_megabytes: no fast evaluator can be
+// built within the cap, and the exact model is the answer (train stores the model without one).
+class FastEvaluatorOverCap : public Error {
+ public:
+  using Error::Error;
+};
+
 struct FastEvaluatorOptions {
   double mu_tolerance = 1e-6;            // absolute, μ units
   double std_relative_tolerance = 1e-3;  // the interval's half-width to 0.1 %
@@ -41,13 +49,19 @@ struct FastEvaluatorOptions {
   long long check_points = 5000;
   int local_searches = 16;               // from the worst check points, at the final grid
   double max_megabytes = 64.0;           // the grid's node values
-  // Wall-time budget of the whole build, refinements and certification: a finer grid whose predicted
-  // cost (its nodes and checks × the measured cost of one exact evaluation) would not fit is not
-  // built. `train` sets it from the GP fit's own time.
-  double max_seconds = std::numeric_limits<double>::infinity();
+  // Work budget of the whole build, refinements and certification, in multiply-adds of the exact
+  // model (exact_point_work per point evaluated): a finer grid whose nodes and checks would take the
+  // work done past it is not built. Counted, not timed, so that the same model and options give the
+  // same grid on a busy machine and an idle one. `train` sets it from the GP fit's own work.
+  double max_work = std::numeric_limits<double>::infinity();
   unsigned seed = 1;
   std::function<void(const std::string&)> progress;  // one line per refinement; may be empty
 };
+
+// Multiply-adds of one exact evaluation of μ and σ, the unit of FastEvaluatorOptions::max_work:
+// n(n + d) for a GP of n training points in d inputs (k* is n·d, σ's triangular solve n²). About
+// 1e10 per second on one core of a 2-core AMD EPYC with AVX2 (bench/RESULTS.md).
+double exact_point_work(const GaussianProcess& gp);
 
 class FastEvaluator {
  public:
@@ -58,7 +72,7 @@ class FastEvaluator {
   FastEvaluator(InputSpace box, TensorCubicGrid grid, FastEvaluatorBounds bounds);
 
   // Refines until the bounds are within the options' tolerances, or the next grid would exceed the
-  // memory cap or the time budget (then the finest grid built, whose bounds say what it reached).
+  // memory cap or the work budget (then the finest grid built, whose bounds say what it reached).
   static FastEvaluator build(const GaussianProcess& gp, const FastEvaluatorOptions& options);
   // Why build() stopped, for the caller's message: "" when it met the tolerances.
   const std::string& stop_reason() const { return stop_reason_; }

@@ -491,6 +491,25 @@ std::optional<TrainingDescription> GaussianProcess::training_description() const
                              .micro_std_error = state_.micro_std_error};
 }
 
+std::string leave_one_out_text(const GpTrainingSummary& t, bool noisy_samples) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "leave-one-out (each sample predicted from the others, closed form): ";
+  if (t.loo_standardised_rms >= 0.0) {
+    s << "standardised residuals RMS " << t.loo_standardised_rms << " (1: the interval is as wide as the errors), ";
+  } else {
+    s << "standardised residuals not stored in this file (`mufric upgrade --rebuild` adds them), ";
+  }
+  s << "95 % coverage " << 100.0 * t.loo_coverage_95 << " %; mean relative error " << 100.0 * t.loo_mean_relative_error
+    << " %, max " << 100.0 * t.loo_max_relative_error << " %, RMSE " << t.loo_rmse;
+  if (noisy_samples) {
+    s << ". Each sample is a noisy mean of its own draws, and these errors are mostly that noise, not the "
+         "model's error: the residuals and coverage say whether the interval accounts for it; the error "
+         "against held-out means of many draws is measured in bench/RESULTS.md";
+  }
+  return s.str();
+}
+
 std::string GaussianProcess::summary() const {
   std::ostringstream s;
   const auto& h = state_.hyper;
@@ -530,9 +549,7 @@ std::string GaussianProcess::summary() const {
   s << (state_.mean_estimated ? "  log restricted likelihood (REML) " : "  log marginal likelihood ") << t.log_marginal_likelihood
     << "\n";
   if (!t.dataset_description.empty()) s << "  trained on: " << t.dataset_description << "\n";
-  s << "  leave-one-out: mean relative error " << 100.0 * t.loo_mean_relative_error << " %, max "
-    << 100.0 * t.loo_max_relative_error << " %, RMSE " << t.loo_rmse << ", 95 % coverage "
-    << 100.0 * t.loo_coverage_95 << " %";
+  s << "  " << leave_one_out_text(t, state_.known_noise.size() != 0);
   if (fast_) {
     s << "\n  fast evaluator: grid ";
     for (size_t k = 0; k < fast_->grid().cells().size(); ++k) s << (k ? "x" : "") << fast_->grid().cells()[k];

@@ -46,6 +46,11 @@ std::string_view to_string(IntervalMeaning m);  // "new-run", "shared-scatter", 
 // For DescribeModel and `describe`.
 std::string gp_interval_meaning(IntervalMeaning m);
 
+struct GpTrainingSummary;
+// The leave-one-out figures in words, saying what each is; noisy_samples: a model whose samples carry
+// their own noise (stochastic kriging), where the errors are mostly that noise.
+std::string leave_one_out_text(const GpTrainingSummary& summary, bool noisy_samples);
+
 // Figures from training, stored in the model file and shown by `describe`.
 struct GpTrainingSummary {
   double log_marginal_likelihood = 0.0;
@@ -53,6 +58,10 @@ struct GpTrainingSummary {
   double loo_max_relative_error = 0.0;
   double loo_rmse = 0.0;                 // in μ units
   double loo_coverage_95 = 0.0;          // fraction of samples inside their LOO 95 % interval
+  // RMS of the LOO residuals over their predictive std (each sample's own noise included): 1 when the
+  // interval is as wide as the errors are. Negative: not known (a file from before it was kept,
+  // too large to recompute at load: `mufric upgrade --rebuild` stores it).
+  double loo_standardised_rms = -1.0;
   long long starts = 0;
   long long best_start = 0;
   double seconds = 0.0;

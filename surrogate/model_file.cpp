@@ -1,5 +1,7 @@
 #include "surrogate/model_file.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +18,7 @@
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gaussian_process.hpp"
+#include "surrogate/gp_training.hpp"
 
 namespace mufric {
 namespace {
@@ -68,6 +71,10 @@ constexpr std::pair<const char*, std::string GpTrainingSummary::*> kSummaryTexts
     {"created_utc", &GpTrainingSummary::created_utc}};
 // Written by every model since it was kept; a file from before has none (read as "").
 constexpr const char* kSummaryDatasetDescription = "dataset_description";
+// Likewise; a file from before has none, and it is recomputed at load up to this many training points
+// (the LOO needs K⁻¹: n³/3, ~0.05 s at 1000).
+constexpr const char* kSummaryStandardisedRms = "loo_standardised_rms";
+constexpr Eigen::Index kMostPointsForLooAtLoad = 1000;
 // Nodes of a stored fast evaluator recomputed with the exact model at load. A node is the exact
 // model's value, but computed in another batch: near the noise floor σ is the square root of a
 // difference of nearly equal numbers, and two evaluation paths differ there far beyond 1e-9 (issue
@@ -179,17 +186,52 @@ std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, cons
   return load_model(copy.path());
 }
 
+namespace {
+
+// The file this code was loaded from: libmufric.so for a meso code linked with -lmufric, else the
+// executable it is linked into statically (dladdr of a function of this library).
+std::filesystem::path file_holding_this_code() {
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&shipped_models_directory), &info) == 0 || info.dli_fname == nullptr) return {};
+  std::error_code ignored;
+  const std::filesystem::path path = std::filesystem::canonical(info.dli_fname, ignored);
+  return ignored ? std::filesystem::path(info.dli_fname) : path;
+}
+
+// <prefix>/share/mufric/models for a file in <prefix>/bin, <prefix>/lib or <prefix>/lib/<multiarch>.
+std::string models_beside(const std::filesystem::path& file) {
+  std::error_code ignored;
+  std::filesystem::path dir = file.parent_path();
+  for (int up = 0; up < 2 && !dir.empty(); ++up, dir = dir.parent_path()) {
+    const auto candidate = dir.parent_path() / "share/mufric/models";
+    if (std::filesystem::is_directory(candidate, ignored)) return candidate.string();
+  }
+  return {};
+}
+
+bool is_inside(const std::filesystem::path& file, const std::filesystem::path& dir) {
+  const auto relative = file.lexically_relative(dir);
+  return !relative.empty() && *relative.begin() != "..";
+}
+
+}  // namespace
+
 std::string shipped_models_directory() {
   namespace fs = std::filesystem;
   if (const char* set = std::getenv("MUFRIC_MODELS_DIR"); set != nullptr && *set != '\0') return set;
   std::error_code ignored;
-  // Beside the running executable's prefix first (an install moved elsewhere, a container), then the
-  // prefix configured at build time, then the source tree (a build that is not installed).
-  const fs::path executable = fs::read_symlink("/proc/self/exe", ignored);
-  const std::string beside = executable.empty() ? std::string()
-                                                : (executable.parent_path().parent_path() / "share/mufric/models").string();
-  for (const std::string& candidate : {beside, std::string(MUFRIC_INSTALLED_MODELS_DIR), std::string(MUFRIC_SOURCE_MODELS_DIR)}) {
-    if (!candidate.empty() && fs::is_directory(candidate, ignored)) return candidate;
+  // From where this code lives, not from the calling executable: a meso code linked against an
+  // installed libmufric.so finds <its prefix>/share/mufric/models wherever the meso code itself is
+  // (issue 49: it found the build's source tree instead). Then the prefix configured at build time;
+  // the source tree only for code running from its own build tree, so that an installed copy never
+  // reads models from a source tree that may be gone or newer.
+  const fs::path holder = file_holding_this_code();
+  if (!holder.empty()) {
+    if (std::string beside = models_beside(holder); !beside.empty()) return beside;
+  }
+  if (fs::is_directory(MUFRIC_INSTALLED_MODELS_DIR, ignored)) return MUFRIC_INSTALLED_MODELS_DIR;
+  if ((holder.empty() || is_inside(holder, MUFRIC_BUILD_DIR)) && fs::is_directory(MUFRIC_SOURCE_MODELS_DIR, ignored)) {
+    return MUFRIC_SOURCE_MODELS_DIR;
   }
   return {};
 }
@@ -209,12 +251,21 @@ std::vector<std::string> shipped_model_names() {
 
 namespace {
 
-// A bare name that is not a file here: the shipped model of that name, if there is one.
+// A bare name (no '/'): the shipped model of that name, if there is one. Without ".h5" the shipped
+// model wins over anything of that name here (a folder or file named dry_default in the working
+// directory shadowed it with "not an HDF5 file"; a local file is ./dry_default); with ".h5" a
+// regular file here comes first.
 std::string shipped_model_path(const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ignored;
-  if (name.empty() || name.find('/') != std::string::npos || fs::exists(name, ignored)) return name;
+  if (name.empty() || name.find('/') != std::string::npos) return name;
   const bool has_extension = name.ends_with(".h5");
+  if (has_extension && fs::is_regular_file(name, ignored)) return name;
+  if (!has_extension && fs::exists(name, ignored)) {
+    const std::string dir = shipped_models_directory();
+    const bool shipped = !dir.empty() && fs::is_regular_file(fs::path(dir) / (name + ".h5"), ignored);
+    if (!shipped) return name;
+  }
   const std::string stem = has_extension ? name.substr(0, name.size() - 3) : name;
   const std::string dir = shipped_models_directory();
   if (const fs::path shipped = fs::path(dir) / (stem + ".h5"); !dir.empty() && fs::is_regular_file(shipped, ignored)) {
@@ -384,6 +435,7 @@ void GaussianProcess::write_group(h5::Writer& out, const std::string& group) con
   for (const auto& [name, field] : kSummaryCounts) out.int_attribute(summary_group, name, s.summary.*field);
   for (const auto& [name, field] : kSummaryTexts) out.string_attribute(summary_group, name, s.summary.*field);
   out.string_attribute(summary_group, kSummaryDatasetDescription, s.summary.dataset_description);
+  out.double_attribute(summary_group, kSummaryStandardisedRms, s.summary.loo_standardised_rms);
   if (fast_) {
     const std::vector<long long> cells(fast_->grid().cells().begin(), fast_->grid().cells().end());
     const FastEvaluatorBounds& b = fast_->bounds();
@@ -510,6 +562,13 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
     for (const auto& [name, field] : kSummaryTexts) s.summary.*field = in.string_attribute(summary_group, name);
     if (in.has_attribute(summary_group, kSummaryDatasetDescription)) {
       s.summary.dataset_description = in.string_attribute(summary_group, kSummaryDatasetDescription);
+    }
+    if (in.has_attribute(summary_group, kSummaryStandardisedRms)) {
+      s.summary.loo_standardised_rms = in.double_attribute(summary_group, kSummaryStandardisedRms);
+    } else if (s.x_train.rows() <= kMostPointsForLooAtLoad) {
+      GpTrainingSummary recomputed;
+      leave_one_out(s, recomputed);
+      s.summary.loo_standardised_rms = recomputed.loo_standardised_rms;
     }
   }
   const InputSpace inputs_of_model = s.inputs;

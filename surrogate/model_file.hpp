@@ -33,8 +33,9 @@ std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, cons
 
 // The models shipped with mufric (models/*.h5 of the source tree, installed to
 // <prefix>/share/mufric/models): $MUFRIC_MODELS_DIR if set, else the first that exists of
-// share/mufric/models beside the running executable's prefix, the configured install prefix's, and
-// the source tree's; "" when there is none.
+// share/mufric/models of the prefix this code was loaded from (libmufric.so's, or the executable's it
+// is linked into), the configured install prefix's, and the source tree's (only for code running
+// from its build tree); "" when there is none.
 std::string shipped_models_directory();
 // The stems of the shipped models ("dry_default", ...), sorted; empty without a directory.
 std::vector<std::string> shipped_model_names();

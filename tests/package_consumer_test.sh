@@ -42,4 +42,15 @@ PKG_CONFIG_PATH="$prefix/lib/pkgconfig" make -s -C "$work/make" -f "$source_dir/
 for program in meso_loop_c meso_loop_fortran; do
   OMP_WAIT_POLICY=passive "$work/make/$program" "file://$work/gp.h5" 5 200
 done
+echo "== the installed shipped model carries the fast evaluator the build tabulated"
+"$mufric" describe "$prefix/share/mufric/models/dry_default.h5" | grep -q "measured bound" ||
+  { echo "the installed dry_default.h5 has no fast evaluator"; exit 1; }
+echo "== a shipped model's name reaches <prefix>/share/mufric/models of the installed library"
+# The prefix here is not the one configured at build time, and the source tree is still there: the
+# name must reach this prefix's file, which is made distinct (a Coulomb law, mu = 0.4321), from a
+# working directory where a folder of the same name could shadow it.
+"$mufric" law coulomb --mu 0.4321 --out "$prefix/share/mufric/models/dry_default.h5" >/dev/null
+mkdir -p "$work/run/dry_default"
+mu=$(cd "$work/run" && "$work/make/shipped_model" dry_default)
+test "$mu" = 0.432100 || { echo "dry_default reached mu = $mu, not the installed prefix's 0.432100"; exit 1; }
 echo "== every consumer built and ran"

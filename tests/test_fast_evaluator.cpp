@@ -2,6 +2,10 @@
 // exact GP on points it never saw.
 #include <gtest/gtest.h>
 
+#include <thread>
+
+#include <atomic>
+
 #include <limits>
 #include <memory>
 
@@ -13,6 +17,7 @@
 #include "surrogate/fast_evaluator.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/tensor_cubic_grid.hpp"
+#include "common/sanitizers.hpp"
 
 namespace mufric {
 namespace {
@@ -113,16 +118,16 @@ TEST(TensorCubicGrid, RefusesShapesThatDoNotFit) {
   EXPECT_THROW(TensorCubicGrid({3, 4}, nan), Error);
 }
 
-GaussianProcess small_gp() { return test::fixed_hyper_gp(120, 7, 1.0, {0.4, 0.6, 0.5}, 1e-3); }
+GaussianProcess grid_test_gp() { return test::fixed_hyper_gp(120, 7, 1.0, {0.4, 0.6, 0.5}, 1e-3); }
 
 // A GP that already carries a grid (a model file being rebuilt) is measured without it: the new
 // grid's bound is the same as when built from the bare GP, not its distance to the old grid.
 TEST(FastEvaluator, ARebuildMeasuresAgainstTheExactModelNotTheOldGrid) {
-  const GaussianProcess bare = small_gp();
+  const GaussianProcess bare = grid_test_gp();
   FastEvaluatorOptions o;
   o.check_points = 2000;
   const FastEvaluator first = FastEvaluator::build(bare, o);
-  GaussianProcess carrying = small_gp();
+  GaussianProcess carrying = grid_test_gp();
   carrying.attach_fast_evaluator(std::make_shared<const FastEvaluator>(first));
   const FastEvaluator rebuilt = FastEvaluator::build(carrying, o);
   EXPECT_EQ(rebuilt.bounds().mu_absolute, first.bounds().mu_absolute);
@@ -132,13 +137,13 @@ TEST(FastEvaluator, ARebuildMeasuresAgainstTheExactModelNotTheOldGrid) {
 
 // The stored bound is never exceeded on fresh random points (10⁶ in the optimised build).
 TEST(FastEvaluator, TheMeasuredBoundHoldsOnFreshPoints) {
-  const GaussianProcess gp = small_gp();
+  const GaussianProcess gp = grid_test_gp();
   FastEvaluatorOptions o;
   o.check_points = 5000;
   const FastEvaluator fast = FastEvaluator::build(gp, o);
   ASSERT_TRUE(fast.meets(o.mu_tolerance, o.std_relative_tolerance))
       << fast.bounds().mu_absolute << " " << fast.bounds().std_relative;
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if MUFRIC_ADDRESS_SANITIZER || MUFRIC_THREAD_SANITIZER
   constexpr Eigen::Index kFresh = 20000;
 #else
   constexpr Eigen::Index kFresh = 1000000;
@@ -153,7 +158,7 @@ TEST(FastEvaluator, TheMeasuredBoundHoldsOnFreshPoints) {
 // A grid held to a memory cap too small for the tolerance reports the bound it reached, and does
 // not claim to meet the tolerance.
 TEST(FastEvaluator, ACappedGridSaysItDoesNotMeetTheTolerance) {
-  const GaussianProcess gp = small_gp();
+  const GaussianProcess gp = grid_test_gp();
   FastEvaluatorOptions o;
   o.check_points = 2000;
   o.max_megabytes = 0.05;
@@ -205,20 +210,35 @@ TEST(FastEvaluator, StdErrorIsMeasuredAgainstMaxOfStdAndTheFloor) {
   EXPECT_GT(worst_relative_to_std, worst);               // so the purely relative error is larger
 }
 
-// A time budget too small for the tolerances stops refining after the first grid and says why.
-TEST(FastEvaluator, StopsAtItsTimeBudgetAndSaysWhy) {
-  const GaussianProcess gp = small_gp();
+// A work budget too small for the tolerances stops refining after the first grid and says why.
+// Regression: the budget was wall-clock, so a loaded machine wrote a model without the grid an idle
+// one wrote with it. Counted in work, the build is the same whatever the machine's load: here with
+// both cores kept busy by a spinning thread for one build and not the other.
+TEST(FastEvaluator, StopsAtItsWorkBudgetAndSaysWhyWhateverTheLoad) {
+  const GaussianProcess gp = grid_test_gp();
+  const double n = static_cast<double>(gp.state().x_train.rows()), d = static_cast<double>(gp.inputs().size());
+  EXPECT_EQ(exact_point_work(gp), n * (n + d));
   FastEvaluatorOptions o;
   o.check_points = 1000;
-  o.max_seconds = 1e-4;
+  o.max_work = 1e3 * exact_point_work(gp);  // the first grid's nodes alone take more
   const FastEvaluator fast = FastEvaluator::build(gp, o);
   EXPECT_FALSE(fast.meets(o.mu_tolerance, o.std_relative_tolerance));
-  EXPECT_NE(fast.stop_reason().find("past the time budget"), std::string::npos) << fast.stop_reason();
+  EXPECT_NE(fast.stop_reason().find("past the work budget"), std::string::npos) << fast.stop_reason();
   FastEvaluatorOptions unlimited = o;
-  unlimited.max_seconds = std::numeric_limits<double>::infinity();
+  unlimited.max_work = std::numeric_limits<double>::infinity();
   const FastEvaluator full = FastEvaluator::build(gp, unlimited);
   EXPECT_TRUE(full.meets(o.mu_tolerance, o.std_relative_tolerance));
   EXPECT_TRUE(full.stop_reason().empty());
+  std::atomic<bool> stop{false};
+  std::thread spinner([&] {
+    while (!stop.load()) {
+    }
+  });
+  const FastEvaluator under_load = FastEvaluator::build(gp, o);
+  stop = true;
+  spinner.join();
+  EXPECT_EQ(under_load.grid().bytes(), fast.grid().bytes());
+  EXPECT_EQ(under_load.stop_reason(), fast.stop_reason());
   EXPECT_GT(full.grid().bytes(), fast.grid().bytes());
 }
 }  // namespace
@@ -243,7 +263,7 @@ Eigen::MatrixXd queries_with_some_outside(Eigen::Index count) {
 // Inside the box and within the request's tolerances the fast evaluator answers (and says so);
 // outside the box, or with tighter tolerances than its bound, the exact model does.
 TEST(FastEvaluator, AnswersInsideTheBoxWhenItsBoundMeetsTheRequest) {
-  GaussianProcess gp = small_gp();
+  GaussianProcess gp = grid_test_gp();
   const auto fast = fast_for(gp);
   gp.attach_fast_evaluator(fast);
   const Eigen::MatrixXd x = queries_with_some_outside(1000);
@@ -280,7 +300,7 @@ TEST(FastEvaluator, AnswersInsideTheBoxWhenItsBoundMeetsTheRequest) {
 
 // With the fast evaluator too, μ does not move by a bit when the interval or the gradient is asked.
 TEST(FastEvaluator, MuIsTheSameBitsWhateverElseIsAsked) {
-  GaussianProcess gp = small_gp();
+  GaussianProcess gp = grid_test_gp();
   gp.attach_fast_evaluator(fast_for(gp));
   const Eigen::MatrixXd x = queries_with_some_outside(500);
   const Evaluation mean_only = gp.evaluate(x, {});

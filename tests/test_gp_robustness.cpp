@@ -1,8 +1,10 @@
 // Numerical robustness: every case fits or fails with a clear message, never NaN.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -60,6 +62,29 @@ TEST(GpRobustness, ConstantOutputsPredictTheConstantWithAWarning) {
   const Evaluation e = gp.evaluate(test::smooth_training_set(20, 5).x, {.std = true, .ci_level = 0.95});
   expect_all_finite(e);
   for (Eigen::Index i = 0; i < 20; ++i) EXPECT_NEAR(e.mu(i), 0.42, 1e-12);
+}
+
+bool warns_of(const GpTrainingReport& report, const std::string& words) {
+  return std::any_of(report.warnings.begin(), report.warnings.end(),
+                     [&](const std::string& w) { return w.find(words) != std::string::npos; });
+}
+
+// Regression: a fit that explains nothing (all noise) was reported like any other. Pure noise is such
+// a fit whatever the optimiser does; a smooth field is not.
+TEST(GpRobustness, AFitThatExplainsNothingSaysSo) {
+  TrainingSet noise = test::smooth_training_set(60, 3);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal(0.2, 0.01);
+  for (Eigen::Index i = 0; i < noise.mu.size(); ++i) noise.mu(i) = normal(rng);
+  GpTrainingOptions options;
+  options.restarts = 1;
+  GpTrainingReport report;
+  train_gaussian_process(noise, options, &report);
+  EXPECT_TRUE(warns_of(report, "the fit explains almost nothing")) << ::testing::PrintToString(report.warnings);
+  EXPECT_TRUE(warns_of(report, "try the default --restarts"));
+  GpTrainingReport smooth;
+  train_gaussian_process(test::smooth_training_set(60, 3), options, &smooth);
+  EXPECT_FALSE(warns_of(smooth, "explains almost nothing")) << ::testing::PrintToString(smooth.warnings);
 }
 
 TEST(GpRobustness, SinglePointMatchesClosedForm) {
