@@ -7,7 +7,7 @@
 #       ThreadSanitizer build of the shared-handle client tests; one clang build with ASan + UBSan +
 #       libFuzzer coverage that runs every fuzz target and then the unit, service and CLI tests.
 #   bash deploy/test.sh --long   the long verification studies (CTest label "long": the Westergaard
-#       and Challen-Oxley studies, the container image compiled from source), ~15 min on 2 cores.
+#       and Challen-Oxley studies, the container image compiled from source), ~11 min after the build.
 #       Run them before resolving a physics issue.
 #
 # Each stage's time is printed at the end, also when a stage fails (bench/RESULTS.md, "The test
