@@ -460,7 +460,7 @@ void add_predict(CLI::App& app) {
     long long unanswered = 0;
     std::string first_unanswered;
     for (size_t i = 0; i < n; ++i) {
-      if (a.status[i] == PointStatus::invalid_input || a.status[i] == PointStatus::out_of_box) {
+      if (has_no_answer(a.status[i])) {
         if (unanswered++ == 0) {
           first_unanswered = (from_csv ? o->csv + ": line " + std::to_string(points.lines[i]) + ": " : std::string()) +
                              std::string(to_string(a.status[i])) + ": " + reason_of(i);
@@ -494,7 +494,7 @@ void add_predict(CLI::App& app) {
         std::printf("  patch scatter %.3g: one contact patch's mu scatters about this mean with this standard deviation "
                     "(the micro-model's per-draw spread; not part of the interval)\n", a.patch_std[0]);
       }
-      if (o->gradient && a.status[0] != PointStatus::invalid_input && a.status[0] != PointStatus::out_of_box) {
+      if (o->gradient && !has_no_answer(a.status[0])) {
         for (size_t j = 0; j < inputs.size(); ++j) {
           std::printf("  dmu/d%s = %.6g per %s\n", inputs[j].name.c_str(),
                       gradient_per_human_unit(a.gradient[j], inputs[j].kind()), std::string(human_unit(inputs[j].kind())).c_str());

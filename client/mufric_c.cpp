@@ -104,7 +104,7 @@ int evaluate_into(const char* function, mufric_client* client, size_t n, const s
                                                .patch_std = out.patch_std != nullptr});
     // Copies only: the outputs of points without an answer are NaN or the caller's values, and
     // nothing here compares them (a caller trapping FE_INVALID would die on an ordered comparison with NaN).
-    bool all_answered = true;
+    mufric_counts counts{};
     for (size_t i = 0; i < n; ++i) {
       if (out.mu) out.mu[i] = answer.mu[i];
       if (out.std) out.std[i] = answer.std[i];
@@ -113,20 +113,15 @@ int evaluate_into(const char* function, mufric_client* client, size_t n, const s
       if (out.patch_std) out.patch_std[i] = answer.patch_std[i];
       if (out.status) out.status[i] = static_cast<int>(answer.status[i]);
       if (out.outside) out.outside[i] = outside_bits(*client, inputs, i);
-      all_answered = all_answered && answer.status[i] != mufric::PointStatus::invalid_input &&
-                     answer.status[i] != mufric::PointStatus::out_of_box;
+      counts.extrapolated += answer.status[i] == mufric::PointStatus::extrapolated;
+      counts.invalid += answer.status[i] == mufric::PointStatus::invalid_input;
+      counts.out_of_box += answer.status[i] == mufric::PointStatus::out_of_box;
     }
-    if (out.counts) {
-      for (const auto s : answer.status) {
-        out.counts->extrapolated += s == mufric::PointStatus::extrapolated;
-        out.counts->invalid += s == mufric::PointStatus::invalid_input;
-        out.counts->out_of_box += s == mufric::PointStatus::out_of_box;
-      }
-      out.counts->range_clipped = static_cast<size_t>(answer.range_clipped);
-      out.counts->fast_points = static_cast<size_t>(answer.fast_points);
-    }
+    counts.range_clipped = static_cast<size_t>(answer.range_clipped);
+    counts.fast_points = static_cast<size_t>(answer.fast_points);
+    if (out.counts) *out.counts = counts;
     last_error = answer.message;  // the first point without an answer, or ""
-    return all_answered ? MUFRIC_OK : MUFRIC_PARTIAL;
+    return counts.invalid + counts.out_of_box == 0 ? MUFRIC_OK : MUFRIC_PARTIAL;
   });
 }
 

@@ -129,7 +129,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
       }
       if (!input.contains(x(i, j))) status = policy == Extrapolation::refuse ? PointStatus::out_of_box : PointStatus::extrapolated;
     }
-    if (status == PointStatus::invalid_input || status == PointStatus::out_of_box) continue;
+    if (has_no_answer(status)) continue;
     any_outside = any_outside || status == PointStatus::extrapolated;
     valid.push_back(i);
   }
@@ -228,7 +228,7 @@ std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch
   long long unanswered = 0;
   std::string first;
   for (size_t i = 0; i < status.size(); ++i) {
-    if (status[i] != PointStatus::invalid_input && status[i] != PointStatus::out_of_box) continue;
+    if (!has_no_answer(status[i])) continue;
     if (unanswered++ == 0) {
       const Eigen::RowVectorXd row = x.row(static_cast<Eigen::Index>(i));
       first = "point " + std::to_string(i) + " " + std::string(to_string(status[i])) + ": " + point_reason(inputs, row.data());

@@ -19,6 +19,10 @@ namespace mufric {
 // it under the refuse policy, NaN outputs.
 enum class PointStatus : std::uint8_t { ok = 0, extrapolated = 1, invalid_input = 2, out_of_box = 3 };
 std::string_view to_string(PointStatus status);
+// Whether a point got no μ: its input was invalid, or it lay outside the box under the refuse policy.
+constexpr bool has_no_answer(PointStatus status) {
+  return status == PointStatus::invalid_input || status == PointStatus::out_of_box;
+}
 
 // What a model does with a point outside its training box.
 //   raw     the model itself, far from its data (a GP reverts to its prior mean, with a wide band)
