@@ -61,7 +61,6 @@ int ModelRegistry::refresh(Rescan rescan) {
     auto served = std::make_shared<ServedModel>();
     served->name = name;
     served->path = entry.path();
-    served->sha256 = sha256;
     served->version = sha256.substr(0, kVersionDigits);
     try {
       served->model = load_model_isolated(entry.path().string());

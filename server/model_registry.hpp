@@ -31,7 +31,6 @@ struct FileIdentity {
 struct ServedModel {
   std::string name;     // file stem
   std::string version;  // first 16 hex digits of the file's SHA-256
-  std::string sha256;   // of the whole file: what "changed" means on a forced rescan
   std::filesystem::path path;
   std::unique_ptr<FrictionModel> model;
 };
