@@ -51,6 +51,16 @@ void add_service_commands(CLI::App& app) {
       ->check(CLI::Range(1, 2000));
   cmd->add_option("--max-points", o->max_points, "Most points in one request")->capture_default_str()
       ->check(CLI::Range(1LL, 100'000'000LL));
+  cmd->add_option("--max-memory-mb", o->max_memory_mb,
+                  "The server's memory, MB: the models at start, gRPC's buffers (an eighth) and calls in flight (the "
+                  "rest). A call that does not fit is refused with RESOURCE_EXHAUSTED and a retry hint, which mufric's "
+                  "clients follow. 0: no limit")
+      ->capture_default_str()->check(CLI::Range(0, 1'000'000));
+  cmd->add_option("--max-streams", o->max_streams, "EvaluateStream calls open at once; more are refused (0: no limit)")
+      ->capture_default_str()->check(CLI::Range(0, 1'000'000));
+  cmd->add_option("--stream-write-seconds", o->stream_write_seconds,
+                  "A stream whose client has not taken an answer within this is cancelled (0: never)")
+      ->capture_default_str()->check(FiniteRange(0.0, 86400.0));
   cmd->add_option("--threads", o->threads,
                   "Cores evaluation may use (0: all the CPU affinity allows, at most OMP_NUM_THREADS). A batch "
                   "running alone uses them all; k concurrent batches share them, max(1, threads/k) each")

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <limits>
 #include <optional>
+#include <random>
 #include <chrono>
 #include <thread>
 
@@ -32,12 +33,17 @@ const double* input_pointer(const Block& block, const std::string& name) {
 // values instead of NaN (fill: every output; fallback_mu: μ, over fill). Chosen by the status, not by
 // testing the value: isnan is quiet, but the caller may run with FE_INVALID trapping, and nothing
 // here should even look at a NaN in a way that could raise it.
-void fill_unanswered(Answer& answer, const Options& options) {
+struct UnansweredValues {
+  std::optional<double> fill;
+  std::optional<double> fallback_mu;
+};
+
+void fill_unanswered(Answer& answer, const UnansweredValues& options) {
   if (!options.fill && !options.fallback_mu) return;
   const size_t points = answer.status.size();
   const size_t gradient_width = points > 0 ? answer.gradient.size() / points : 0;
   for (size_t i = 0; i < points; ++i) {
-    if (answer.status[i] != PointStatus::invalid_input && answer.status[i] != PointStatus::out_of_box) continue;
+    if (!has_no_answer(answer.status[i])) continue;
     if (options.fill) {
       for (auto* output : {&answer.mu, &answer.std, &answer.lo, &answer.hi, &answer.patch_std}) {
         if (i < output->size()) (*output)[i] = *options.fill;
@@ -49,12 +55,55 @@ void fill_unanswered(Answer& answer, const Options& options) {
   }
 }
 
+// The server's retry hint when it refused a call for want of memory or streams (ms), else nullopt.
+// gRPC's transport sheds calls itself when its buffers exceed the server's quota (RST_STREAM
+// ENHANCE_YOUR_CALM, HTTP/2 error 11; grpc 1.51 chttp2 destructive_reclaimer): retried the same way.
+std::optional<double> busy_retry_ms(const grpc::ClientContext& context, const grpc::Status& status) {
+  if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED) return std::nullopt;
+  if (status.error_message().find(wire::kTransportShedMessage) != std::string::npos) return wire::kTransportShedRetryMs;
+  const auto& trailers = context.GetServerTrailingMetadata();
+  const auto hint = trailers.find(wire::kRetryAfterKey);
+  if (hint == trailers.end()) return std::nullopt;
+  double ms = 0.0;
+  const auto [end, error] = std::from_chars(hint->second.data(), hint->second.data() + hint->second.size(), ms);
+  if (error != std::errc() || !(ms >= 0.0)) return std::nullopt;
+  return ms;
+}
+
+// Retries of calls the server refused as busy: until the call's deadline, each after the server's
+// hint times a factor that grows 1.5x a time from a random start in [1, 2) (full-jitter style,
+// Brooker 2015, "Exponential Backoff And Jitter"), so that refused clients do not return together.
+class BusyRetry {
+ public:
+  explicit BusyRetry(double deadline_seconds)
+      : end_(std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                    std::chrono::duration<double>(deadline_seconds))),
+        factor_(std::uniform_real_distribution<double>(1.0, 2.0)(generator())) {}
+  // Sleeps and returns true when there is time for another try.
+  bool wait(double hint_ms) {
+    const auto pause = std::chrono::duration<double, std::milli>(std::min(hint_ms * factor_, kLongestPauseMs));
+    if (std::chrono::steady_clock::now() + pause >= end_) return false;
+    std::this_thread::sleep_for(pause);
+    factor_ *= 1.5;
+    return true;
+  }
+
+ private:
+  static constexpr double kLongestPauseMs = 1000.0;
+  static std::minstd_rand& generator() {
+    thread_local std::minstd_rand engine(std::random_device{}());
+    return engine;
+  }
+  std::chrono::steady_clock::time_point end_;
+  double factor_;
+};
+
 class InProcessClient final : public FrictionClient {
  public:
   InProcessClient(const std::string& path, const Options& options)
       : path_(path),
         model_(options.isolate_file_parsing ? load_model_isolated(path) : load_model(path)),
-        unanswered_(options) {}
+        unanswered_{options.fill, options.fallback_mu} {}
 
   Answer evaluate(const Block& block, const EvaluationRequest& request) override {
     // Several threads of the caller at once (std::thread, MPI + threads: an OpenMP caller is caught
@@ -113,7 +162,7 @@ class InProcessClient final : public FrictionClient {
 
   std::string path_;
   std::unique_ptr<FrictionModel> model_;  // evaluation is const and keeps no state: safe from many threads
-  Options unanswered_;  // its fill and fallback_mu
+  UnansweredValues unanswered_;
   std::atomic<int> in_flight_{0};
 };
 
@@ -197,7 +246,7 @@ class GrpcClient final : public FrictionClient {
       if (block.points == 0) break;
     }
     if (!answer.message.empty() && chunk < block.points) answer.message = block_message(answer);
-    fill_unanswered(answer, options_);
+    fill_unanswered(answer, {options_.fill, options_.fallback_mu});
     return answer;
   }
 
@@ -212,10 +261,12 @@ class GrpcClient final : public FrictionClient {
   }
 
  private:
-  // Deadline on every attempt; UNAVAILABLE (server restarting, not yet up) is retried with backoff.
+  // Deadline on every attempt; UNAVAILABLE (server restarting, not yet up) is retried with backoff,
+  // a busy server's refusal after its hint until the deadline.
   template <typename Rpc>
   void call(const char* method, Rpc rpc) {
     double backoff = options_.first_backoff_seconds;
+    BusyRetry busy(options_.deadline_seconds);
     for (int attempt = 0;; ++attempt) {
       grpc::ClientContext context;
       authorise(context);
@@ -224,6 +275,10 @@ class GrpcClient final : public FrictionClient {
                                std::chrono::duration<double>(options_.deadline_seconds)));
       const grpc::Status status = rpc(&context);
       if (status.ok()) return;
+      if (const auto hint = busy_retry_ms(context, status); hint && busy.wait(*hint)) {
+        --attempt;  // a busy server is not a failed attempt
+        continue;
+      }
       if (status.error_code() == grpc::StatusCode::UNAVAILABLE && attempt < options_.retries) {
         std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
         backoff *= 2.0;
@@ -319,9 +374,7 @@ class GrpcClient final : public FrictionClient {
     std::string message = answer.message;
     const auto tail = message.rfind(" (and ");
     if (tail != std::string::npos && message.ends_with(more)) message.erase(tail);
-    const auto unanswered = std::count_if(answer.status.begin(), answer.status.end(), [](PointStatus s) {
-      return s == PointStatus::invalid_input || s == PointStatus::out_of_box;
-    });
+    const auto unanswered = std::count_if(answer.status.begin(), answer.status.end(), has_no_answer);
     if (unanswered > 1) message += " (and " + std::to_string(unanswered - 1) + std::string(more);
     return message;
   }
@@ -333,6 +386,7 @@ class GrpcClient final : public FrictionClient {
     // (a thread that wants its own stream opens its own handle).
     const std::lock_guard<std::mutex> lock(stream_mutex_);
     double backoff = options_.first_backoff_seconds;
+    BusyRetry busy(options_.deadline_seconds);
     for (int attempt = 0;; ++attempt) {
       if (!stream_) {
         stream_context_ = std::make_unique<grpc::ClientContext>();
@@ -341,8 +395,13 @@ class GrpcClient final : public FrictionClient {
       }
       if (stream_->Write(request) && stream_->Read(&response)) return;
       const grpc::Status status = stream_->Finish();
+      const auto hint = busy_retry_ms(*stream_context_, status);
       stream_.reset();
       stream_context_.reset();
+      if (hint && busy.wait(*hint)) {
+        --attempt;  // a busy server is not a failed attempt
+        continue;
+      }
       if ((status.ok() || status.error_code() == grpc::StatusCode::UNAVAILABLE) && attempt < options_.retries) {
         std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
         backoff *= 2.0;

@@ -20,6 +20,15 @@ google::protobuf::RepeatedField<double>* mutable_input_array(v1::EvaluateRequest
 // tolerance 0), and 0 (a field a client did not set) leaves the server's default.
 inline constexpr double kExactModelOnly = -1.0;
 
+// Trailing metadata of a call refused with RESOURCE_EXHAUSTED because the server's memory for calls
+// in flight (or its streams) were taken: milliseconds after which a retry is likely admitted. A
+// RESOURCE_EXHAUSTED without it (too many points in one request) is not worth retrying.
+inline constexpr const char* kRetryAfterKey = "mufric-retry-after-ms";
+// gRPC's words for a call its transport shed under memory pressure (the server's ResourceQuota),
+// retried like a refusal with the hint kTransportShedRetryMs.
+inline constexpr const char* kTransportShedMessage = "RST_STREAM with error code 11";
+inline constexpr double kTransportShedRetryMs = 50.0;
+
 // What to compute (std, interval, gradient, patch scatter), the tolerances and the extrapolation
 // policy, onto the wire.
 void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out);

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cctype>
+#include <cstdio>
 #include <exception>
 #include <string_view>
 
+#include <grpcpp/alarm.h>
 #include <omp.h>
 
 #include "common/units.hpp"
@@ -107,6 +109,18 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
   }
   out.set_has_patch_scatter(model.has_patch_scatter());
   out.set_summary(model.summary());
+}
+
+std::size_t evaluation_bytes(const EvaluateRequest& request, int gradient_width, bool patch_std) {
+  std::size_t points = 0;
+  for (const std::string& name : known_input_names()) {
+    if (const auto* array = input_array(request, name)) points = std::max(points, static_cast<std::size_t>(array->size()));
+  }
+  const auto width = static_cast<std::size_t>(std::max(gradient_width, 1));
+  const std::size_t answer_doubles = 1 + (request.std() ? 1 : 0) + (request.ci_level() > 0.0 ? 2 : 0) +
+                                     (patch_std ? 1 : 0) + (request.gradient() ? width : 0);
+  const std::size_t answer_bytes = points * (answer_doubles * sizeof(double) + 1);  // + the status byte
+  return request.ByteSizeLong() + points * width * sizeof(double) + 2 * answer_bytes;
 }
 
 int threads_per_evaluation(int evaluation_threads, int in_flight) {
@@ -227,14 +241,35 @@ grpc::ServerUnaryReactor* FrictionService::refuse_unless_authorised(grpc::Callba
   return reactor;
 }
 
-grpc::Status FrictionService::handle(const grpc::CallbackServerContext& context, const EvaluateRequest& request,
-                                     mufric::v1::EvaluateResponse& response) {
+grpc::Status FrictionService::admit(grpc::CallbackServerContext& context, const EvaluateRequest& request,
+                                    MemoryBudget::Reservation& held) {
+  const auto served = registry_.find(request.model());
+  const int width = served ? static_cast<int>(served->model->inputs().size()) : static_cast<int>(known_input_names().size());
+  const std::size_t bytes = evaluation_bytes(request, width, request.patch_std());
+  held = memory_.try_reserve(bytes);
+  if (held) return grpc::Status::OK;
+  ++counters_.refused_busy;
+  context.AddTrailingMetadata(wire::kRetryAfterKey, std::to_string(kRetryAfterMs));
+  constexpr double kMB = 1024.0 * 1024.0;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the server is busy: this call needs %.1f MB and %.1f MB of its %.0f MB for calls in flight are "
+                "taken (serve --max-memory-mb); retry after %d ms",
+                static_cast<double>(bytes) / kMB, static_cast<double>(memory_.in_use()) / kMB,
+                static_cast<double>(memory_.limit()) / kMB, kRetryAfterMs);
+  return {grpc::StatusCode::RESOURCE_EXHAUSTED, text};
+}
+
+grpc::Status FrictionService::handle(grpc::CallbackServerContext& context, const EvaluateRequest& request,
+                                     mufric::v1::EvaluateResponse& response, MemoryBudget::Reservation& held) {
   const auto start = std::chrono::steady_clock::now();
   // The OpenMP thread count is per calling thread, and gRPC runs handlers on its own threads.
   omp_set_num_threads(threads_per_evaluation(limits_.evaluation_threads, counters_.in_flight.load()));
-  grpc::Status status;
+  grpc::Status status = admit(context, request, held);
   try {
-    status = evaluate(request, response, [&context](int done, int total) { return caller_gone(context, done, total); });
+    if (status.ok()) {
+      status = evaluate(request, response, [&context](int done, int total) { return caller_gone(context, done, total); });
+    }
   } catch (const std::exception& e) {
     status = grpc::Status(grpc::StatusCode::INTERNAL, std::string("evaluation failed: ") + e.what());
   }
@@ -245,35 +280,46 @@ grpc::Status FrictionService::handle(const grpc::CallbackServerContext& context,
   return status;
 }
 
+// Holds the call's memory reservation until gRPC has sent the answer (OnDone).
+class FrictionService::UnaryReactor final : public grpc::ServerUnaryReactor {
+ public:
+  MemoryBudget::Reservation held;
+  void OnDone() override { delete this; }
+};
+
 grpc::ServerUnaryReactor* FrictionService::Evaluate(grpc::CallbackServerContext* context, const EvaluateRequest* request,
                                                     mufric::v1::EvaluateResponse* response) {
   ++counters_.in_flight;
   ++counters_.requests;  // answered or refused, each is a request (and a refusal an error too)
+  auto* reactor = new UnaryReactor;
   grpc::Status status = authorise(*context);
   if (status.ok()) {
-    status = handle(*context, *request, *response);
+    status = handle(*context, *request, *response, reactor->held);
   } else {
     ++counters_.errors;
   }
-  auto* reactor = context->DefaultReactor();
   reactor->Finish(status);
   --counters_.in_flight;
   return reactor;
 }
 
-// Read a block, answer it, read the next: one response per request, in order.
+// Read a block, answer it, read the next: one response per request, in order. An answer the client
+// does not take within stream_write_seconds cancels the stream; its memory reservation is held from
+// the request until the answer is written.
 class FrictionService::StreamReactor final
     : public grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse> {
  public:
-  StreamReactor(FrictionService& service, const grpc::CallbackServerContext& context, const grpc::Status& authorised)
-      : service_(service), context_(context) {
+  StreamReactor(FrictionService& service, grpc::CallbackServerContext& context, const grpc::Status& admitted)
+      : service_(service), context_(context), watch_(std::make_shared<WriteWatch>()) {
     ++service_.counters_.streams;
-    if (authorised.ok()) {
+    ++service_.counters_.open_streams;
+    watch_->context = &context;
+    if (admitted.ok()) {
       StartRead(&request_);
     } else {
       ++service_.counters_.requests;
       ++service_.counters_.errors;
-      Finish(authorised);
+      Finish(admitted);
     }
   }
 
@@ -285,16 +331,23 @@ class FrictionService::StreamReactor final
     ++service_.counters_.in_flight;
     ++service_.counters_.requests;
     response_.Clear();
-    const grpc::Status status = service_.handle(context_, request_, response_);
+    const grpc::Status status = service_.handle(context_, request_, response_, held_);
     if (status.ok()) {
+      watch_write();
       StartWrite(&response_);
     } else {
+      held_.release();
       --service_.counters_.in_flight;
       Finish(status);
     }
   }
 
   void OnWriteDone(bool ok) override {
+    {
+      std::lock_guard lock(watch_->mutex);
+      ++watch_->writes_done;
+    }
+    held_.release();
     --service_.counters_.in_flight;
     if (!ok) {
       Finish(grpc::Status(grpc::StatusCode::CANCELLED, "the client went away"));
@@ -303,18 +356,64 @@ class FrictionService::StreamReactor final
     StartRead(&request_);
   }
 
-  void OnDone() override { delete this; }
+  void OnDone() override {
+    {
+      std::lock_guard lock(watch_->mutex);
+      watch_->context = nullptr;  // an alarm firing from now on finds nothing to cancel
+    }
+    --service_.counters_.open_streams;
+    delete this;
+  }
 
  private:
+  // Shared with the write alarms, which may fire after the reactor is gone (grpc::Alarm does not
+  // wait for its callback on Cancel or destruction).
+  struct WriteWatch {
+    std::mutex mutex;
+    grpc::CallbackServerContext* context = nullptr;
+    long long writes_done = 0;
+  };
+
+  void watch_write() {
+    if (service_.limits_.stream_write_seconds <= 0.0) return;
+    long long write;
+    {
+      std::lock_guard lock(watch_->mutex);
+      write = watch_->writes_done;
+    }
+    const auto deadline = std::chrono::system_clock::now() +
+                          std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                              std::chrono::duration<double>(service_.limits_.stream_write_seconds));
+    alarm_ = std::make_unique<grpc::Alarm>();  // the previous one, cancelled, fires with ok = false
+    alarm_->Set(deadline, [watch = watch_, write, stalled = &service_.counters_.stalled_streams](bool fired) {
+      if (!fired) return;
+      std::lock_guard lock(watch->mutex);
+      if (watch->context == nullptr || watch->writes_done != write) return;  // gone, or the answer was taken
+      ++*stalled;
+      watch->context->TryCancel();
+    });
+  }
+
   FrictionService& service_;
-  const grpc::CallbackServerContext& context_;
+  grpc::CallbackServerContext& context_;
   EvaluateRequest request_;
   mufric::v1::EvaluateResponse response_;
+  MemoryBudget::Reservation held_;
+  std::shared_ptr<WriteWatch> watch_;
+  std::unique_ptr<grpc::Alarm> alarm_;
 };
 
 grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse>* FrictionService::EvaluateStream(
     grpc::CallbackServerContext* context) {
-  return new StreamReactor(*this, *context, authorise(*context));
+  grpc::Status admitted = authorise(*context);
+  if (admitted.ok() && limits_.max_streams > 0 && counters_.open_streams.load() >= limits_.max_streams) {
+    ++counters_.refused_streams;
+    context->AddTrailingMetadata(wire::kRetryAfterKey, std::to_string(kRetryAfterMs));
+    admitted = {grpc::StatusCode::RESOURCE_EXHAUSTED,
+                std::to_string(limits_.max_streams) + " streams are open, the server's limit (serve --max-streams); "
+                "retry after " + std::to_string(kRetryAfterMs) + " ms, or send blocks over fewer streams"};
+  }
+  return new StreamReactor(*this, *context, admitted);
 }
 
 grpc::ServerUnaryReactor* FrictionService::ListModels(grpc::CallbackServerContext* context,

@@ -3,6 +3,8 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/resource_quota.h>
+#include <malloc.h>
 #include <netdb.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <chrono>
 #include <condition_variable>
@@ -32,6 +35,33 @@ namespace {
 
 // After the last evaluation has finished, replies get this long to leave before connections close.
 constexpr int kReplyFlushMs = 200;
+
+// The transport's share of --max-memory-mb: a grpc::ResourceQuota, which under pressure closes idle
+// connections and then cancels streams (gRPC 1.51 lib/resource_quota/memory_quota.cc reclaimers).
+constexpr int kTransportShareDivisor = 8;
+// Less than this left for calls in flight after the models and the transport: refused at start.
+constexpr double kLeastRequestMemoryMb = 32.0;
+// Allocations from this size on are mmapped and go back to the system when freed. glibc's default
+// threshold grows with every large block freed (up to 32 MB), after which answers' arrays came from
+// the arenas and stayed resident: 1015 MB idle after a burst (bench/RESULTS.md, "The server's memory").
+constexpr int kMmapThresholdBytes = 1 << 20;
+
+double resident_mb() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return 0.0;
+}
+
+// Resident memory this far above the start, with nothing in flight, is freed memory glibc kept:
+// gRPC's transport buffers of a burst of streams, which the memory budget does not count.
+constexpr double kIdleGrowthBeforeTrim = 1.25;
+
+void give_back_idle_memory(const FrictionService& service, double start_mb) {
+  if (service.counters().in_flight.load() > 0 || service.memory().in_use() > 0) return;
+  if (resident_mb() > kIdleGrowthBeforeTrim * start_mb) malloc_trim(0);
+}
 
 void log_line(const std::string& level, const std::string& message) {
   std::fprintf(stderr, "%s level=%s msg=\"%s\"\n", utc_timestamp().c_str(), level.c_str(), message.c_str());
@@ -174,6 +204,19 @@ void run_server(const ServerOptions& options) {
     }
   }
   const int threads = options.threads > 0 ? options.threads : usable_cores();
+  mallopt(M_MMAP_THRESHOLD, kMmapThresholdBytes);
+  const double start_mb = resident_mb();
+  const double transport_mb = options.max_memory_mb / static_cast<double>(kTransportShareDivisor);
+  const double request_mb = options.max_memory_mb - start_mb - transport_mb;
+  if (options.max_memory_mb > 0 && request_mb < kLeastRequestMemoryMb) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "--max-memory-mb %d: the models take %.0f MB at start and the transport %.0f MB, which leaves %.0f MB "
+                  "for calls in flight; give at least %.0f, or 0 for no limit",
+                  options.max_memory_mb, start_mb, transport_mb, request_mb,
+                  std::ceil((start_mb + kLeastRequestMemoryMb) * kTransportShareDivisor / (kTransportShareDivisor - 1)));
+    throw Error(text);
+  }
   std::unique_ptr<UncertainQueryLog> uncertain_log;
   if (!options.uncertain_log_directory.empty()) {
     uncertain_log = std::make_unique<UncertainQueryLog>(options.uncertain_log_directory, options.uncertain_width,
@@ -182,7 +225,12 @@ void run_server(const ServerOptions& options) {
   FrictionService service(registry, {.max_points_per_request = options.max_points,
                                      .bearer_token = token,
                                      .evaluation_threads = threads,
-                                     .uncertain_log = uncertain_log.get()});
+                                     .uncertain_log = uncertain_log.get(),
+                                     .request_memory_bytes = options.max_memory_mb > 0
+                                                                 ? static_cast<std::size_t>(request_mb * 1024 * 1024)
+                                                                 : 0,
+                                     .max_streams = options.max_streams,
+                                     .stream_write_seconds = options.stream_write_seconds});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -194,6 +242,11 @@ void run_server(const ServerOptions& options) {
   builder.AddListeningPort(options.listen, server_credentials(options), &bound_port);
   builder.SetMaxReceiveMessageSize(options.max_message_mb * 1024 * 1024);
   builder.SetMaxSendMessageSize(options.max_message_mb * 1024 * 1024);
+  if (options.max_memory_mb > 0) {
+    grpc::ResourceQuota quota("mufric serve transport");
+    quota.Resize(static_cast<std::size_t>(transport_mb * 1024 * 1024));
+    builder.SetResourceQuota(quota);
+  }
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   // check_listen_address found the port free: taken since, or refused for a reason gRPC logged above.
@@ -206,6 +259,15 @@ void run_server(const ServerOptions& options) {
   log_line("info", "mufric " + code_version() + " serving " + registry.names() + " on " + address + " (" + security +
                        (token.empty() ? "" : ", bearer token required") + ", " +
                        count_of(threads, "evaluation thread", "evaluation threads") + ")");
+  if (options.max_memory_mb > 0) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "memory: %d MB (--max-memory-mb): %.0f MB at start, %.0f MB for the transport, %.0f MB for calls in "
+                  "flight; at most %d streams, each answer taken within %g s",
+                  options.max_memory_mb, start_mb, transport_mb, request_mb, options.max_streams,
+                  options.stream_write_seconds);
+    log_line("info", text);
+  }
   if (!options.ready_file.empty()) std::ofstream(options.ready_file) << address << "\n";
 
   std::mutex mutex;
@@ -218,6 +280,7 @@ void run_server(const ServerOptions& options) {
       if (stopping) break;
       lock.unlock();
       registry.refresh();
+      give_back_idle_memory(service, start_mb);
       lock.lock();
     }
   });
@@ -248,7 +311,10 @@ void run_server(const ServerOptions& options) {
   server->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(kReplyFlushMs));
   const auto& c = service.counters();
   log_line("info", "stopped after " + std::to_string(c.requests.load()) + " requests, " + std::to_string(c.points.load()) +
-                       " points, " + std::to_string(c.errors.load()) + " errors");
+                       " points, " + std::to_string(c.errors.load()) + " errors (" +
+                       std::to_string(c.refused_busy.load()) + " refused while the memory for calls in flight was taken, " +
+                       std::to_string(c.refused_streams.load()) + " streams refused over --max-streams, " +
+                       std::to_string(c.stalled_streams.load()) + " streams cancelled whose answer was not taken)");
 }
 
 }  // namespace mufric::server

@@ -14,6 +14,12 @@ struct ServerOptions {
   double poll_seconds = 1.0;          // directory rescan period
   int max_message_mb = 64;            // receive limit; 10⁵ points × 4 doubles needs ~3.2 MB
   long long max_points = 1'000'000;   // per request
+  // The process's memory, MB: what the models take at start, gRPC's transport buffers (an eighth,
+  // a grpc::ResourceQuota) and the calls in flight (the rest; a call that does not fit waits for
+  // its client's retry). 0: no limit.
+  int max_memory_mb = 512;
+  int max_streams = 256;              // EvaluateStream calls open at once
+  double stream_write_seconds = 30.0;  // an answer not taken by its client within this cancels the stream
   double drain_seconds = 5.0;         // requests in flight get this long on shutdown
   int threads = 0;                    // cores for evaluation; 0: all this process may use (usable_cores())
   std::string ready_file;             // written with the bound address once serving (for scripts)

@@ -30,7 +30,9 @@
 #include "common/error.hpp"
 #include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
+#include "proto/wire_codec.hpp"
 #include "server/friction_service.hpp"
+#include "server/memory_budget.hpp"
 #include "server/server.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/fast_evaluator.hpp"
@@ -718,6 +720,144 @@ TEST_F(Service, AnEvaluationWhoseDeadlinePassedStopsEarly) {
   const double busy_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(server.service().counters().abandoned.load(), 1);
   EXPECT_LT(busy_seconds, full_seconds / 2) << "in-process evaluation of the whole batch takes " << full_seconds << " s";
+}
+
+// The memory budget's arithmetic against sums done by hand.
+TEST(MemoryBudget, AdmitsWhatFitsBesideTheCallsInFlightAndALoneCallWhateverItsSize) {
+  server::MemoryBudget budget(100, /*trim_after_bytes=*/150);
+  auto first = budget.try_reserve(60);
+  ASSERT_TRUE(first);
+  EXPECT_FALSE(budget.try_reserve(41));  // 60 + 41 > 100
+  auto second = budget.try_reserve(40);  // 60 + 40 = 100 fits
+  ASSERT_TRUE(second);
+  EXPECT_EQ(budget.in_use(), 100u);
+  first.release();
+  second = {};
+  EXPECT_EQ(budget.in_use(), 0u);
+  EXPECT_EQ(budget.trims(), 0);  // 100 bytes since idle: under the 150 that asks for a trim
+  {
+    const auto alone = budget.try_reserve(1000);  // larger than the budget, but nothing else runs
+    ASSERT_TRUE(alone);
+    EXPECT_FALSE(budget.try_reserve(1));
+  }
+  EXPECT_EQ(budget.in_use(), 0u);
+  EXPECT_EQ(budget.trims(), 1);  // 1000 bytes went through since the last idle moment
+}
+
+// evaluation_bytes counts the request, the batch and the answer twice.
+TEST(MemoryBudget, AnEvaluationsBytesAreItsRequestBatchAndTwoAnswers) {
+  mufric::v1::EvaluateRequest request;
+  request.set_model("gp");
+  for (int i = 0; i < 1000; ++i) {
+    request.add_contact_pressure(1e9);
+    request.add_sliding_velocity(1.0);
+    request.add_temperature(500.0);
+  }
+  request.set_std(true);
+  request.set_ci_level(0.95);
+  request.set_gradient(true);
+  // Answer per point: mu, std, lo, hi and 3 gradient entries (7 doubles) and a status byte.
+  const std::size_t expected = request.ByteSizeLong() + 1000 * 3 * 8 + 2 * 1000 * (7 * 8 + 1);
+  EXPECT_EQ(server::evaluation_bytes(request, 3, false), expected);
+  EXPECT_EQ(server::evaluation_bytes(request, 3, true), expected + 2 * 1000 * 8);
+}
+
+// A server whose memory for calls in flight is taken refuses with RESOURCE_EXHAUSTED and a retry
+// hint; mufric's client follows the hint and gets its answer once the other call is done.
+TEST_F(Service, ABusyServerRefusesWithARetryHintAndTheClientWaitsItsTurn) {
+  GpTrainingOptions options;
+  options.optimise = false;
+  options.initial.length_scales = Eigen::Vector3d(0.3, 0.3, 0.3);
+  options.initial.noise_variance = 1e-4;
+  save_model((dir_ / "heavy.h5").string(), train_gaussian_process(test::smooth_training_set(500, 5), options));
+  const Points pts = random_points(40'000);
+  mufric::v1::EvaluateRequest request;
+  request.set_model("heavy");
+  request.set_std(true);
+  request.mutable_contact_pressure()->Add(pts.p.begin(), pts.p.end());
+  request.mutable_sliding_velocity()->Add(pts.v.begin(), pts.v.end());
+  request.mutable_temperature()->Add(pts.t.begin(), pts.t.end());
+  server::ServiceLimits limits;
+  limits.request_memory_bytes = server::evaluation_bytes(request, 3, false) * 3 / 2;  // one such call at a time
+  LoopbackServer server(dir_, 0, limits);
+  const EvaluationRequest what{.std = true};
+  client::Options one_call;
+  one_call.chunk_points = 100'000;
+  std::thread first([&] { client::connect("grpc://" + server.address() + "/heavy", one_call)->evaluate(pts.block(), what); });
+  while (server.service().memory().in_use() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  auto stub = mufric::v1::FrictionService::NewStub(grpc::CreateChannel(server.address(), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  mufric::v1::EvaluateResponse response;
+  const grpc::Status refused = stub->Evaluate(&context, request, &response);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << refused.error_message();
+  EXPECT_NE(refused.error_message().find("--max-memory-mb"), std::string::npos) << refused.error_message();
+  const auto hint = context.GetServerTrailingMetadata().find(wire::kRetryAfterKey);
+  ASSERT_NE(hint, context.GetServerTrailingMetadata().end());
+  EXPECT_EQ(std::string(hint->second.data(), hint->second.size()), std::to_string(server::kRetryAfterMs));
+  // The client waits its turn while the first call runs, and both are answered.
+  const client::Answer answer = client::connect("grpc://" + server.address() + "/heavy", one_call)->evaluate(pts.block(), what);
+  first.join();
+  EXPECT_EQ(answer.mu.size(), pts.p.size());
+  EXPECT_GE(server.service().counters().refused_busy.load(), 1);
+  // Given back once gRPC has sent the last answer (the reactor's OnDone, just after the client has it).
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (server.service().memory().in_use() > 0 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(server.service().memory().in_use(), 0u);
+}
+
+// A stream beyond --max-streams is refused with the retry hint; a stream whose client does not take
+// its answer is cancelled after stream_write_seconds, and its memory is given back.
+TEST_F(Service, StreamsAreBoundedInNumberAndInHowLongAnAnswerWaitsForItsReader) {
+  server::ServiceLimits limits;
+  limits.max_streams = 1;
+  limits.stream_write_seconds = 0.5;
+  LoopbackServer server(dir_, 0, limits);
+  // A 100 000-point answer with std and interval (3.3 MB; gRPC's default limit is 4 MB) is far more
+  // than this client's fixed 64 kB flow-control window (no BDP probing, which would grow it): it
+  // waits for a reader that never comes.
+  grpc::ChannelArguments small_window;
+  small_window.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  small_window.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 65536);
+  auto stub = mufric::v1::FrictionService::NewStub(
+      grpc::CreateCustomChannel(server.address(), grpc::InsecureChannelCredentials(), small_window));
+  const Points pts = random_points(100'000);
+  mufric::v1::EvaluateRequest request;
+  request.set_model("gp");
+  request.set_std(true);
+  request.set_ci_level(0.95);
+  request.mutable_contact_pressure()->Add(pts.p.begin(), pts.p.end());
+  request.mutable_sliding_velocity()->Add(pts.v.begin(), pts.v.end());
+  request.mutable_temperature()->Add(pts.t.begin(), pts.t.end());
+  grpc::ClientContext unread_context;
+  auto unread = stub->EvaluateStream(&unread_context);
+  ASSERT_TRUE(unread->Write(request));
+  while (server.service().counters().open_streams.load() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  {
+    grpc::ClientContext context;
+    auto second = stub->EvaluateStream(&context);
+    mufric::v1::EvaluateResponse response;
+    EXPECT_FALSE(second->Read(&response));
+    const grpc::Status refused = second->Finish();
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << refused.error_message();
+    EXPECT_NE(refused.error_message().find("--max-streams"), std::string::npos) << refused.error_message();
+    EXPECT_NE(context.GetServerTrailingMetadata().find(wire::kRetryAfterKey), context.GetServerTrailingMetadata().end());
+  }
+  const auto start = std::chrono::steady_clock::now();
+  while (server.service().counters().stalled_streams.load() == 0 &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(server.service().counters().stalled_streams.load(), 1);
+  while (server.service().counters().open_streams.load() > 0 && std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(server.service().counters().open_streams.load(), 0);
+  EXPECT_EQ(server.service().memory().in_use(), 0u);
+  EXPECT_EQ(server.service().counters().refused_streams.load(), 1);
+  unread_context.TryCancel();
+  unread->Finish();
 }
 
 TEST(ServiceThreads, ConcurrentEvaluationsShareTheCores) {
