@@ -19,7 +19,7 @@
 #include "common/wording.hpp"
 #include "surrogate/accuracy.hpp"
 #include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 #include "surrogate/stochastic_kriging.hpp"
@@ -180,7 +180,7 @@ std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess&
   const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<const FastEvaluator> fast;
   try {
-    fast = std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, build));
+    fast = std::make_shared<const FastEvaluator>(build_fast_evaluator(gp, build));
   } catch (const FastEvaluatorOverCap& e) {
     // Regression: train exited here with no model written at all.
     std::printf("fast evaluator (%s): not stored: %s; the exact model answers every request (a larger "

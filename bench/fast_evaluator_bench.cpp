@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <random>
 
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/model_file.hpp"
 
 using namespace mufric;
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   FastEvaluatorOptions options;
   options.progress = [](const std::string& line) { std::printf("  %s\n", line.c_str()); };
   auto start = std::chrono::steady_clock::now();
-  const FastEvaluator fast = FastEvaluator::build(*gp, options);
+  const FastEvaluator fast = build_fast_evaluator(*gp, options);
   const double build_seconds = seconds_since(start);
   std::string shape;
   for (const int c : fast.grid().cells()) {

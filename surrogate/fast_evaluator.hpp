@@ -22,10 +22,12 @@
 
 #include "common/error.hpp"
 #include "common/input_space.hpp"
-#include "surrogate/gaussian_process.hpp"
 #include "surrogate/tensor_cubic_grid.hpp"
 
 namespace mufric {
+
+class GaussianProcess;
+struct FastEvaluatorOptions;
 
 struct FastEvaluatorBounds {
   double mu_absolute = std::numeric_limits<double>::infinity();   // max |μ_fast − μ|
@@ -33,35 +35,6 @@ struct FastEvaluatorBounds {
   // μ units; 0 in files written before it (a purely relative bound then).
   double std_floor = 0.0;
 };
-
-// Even the coarsest grid would exceed FastEvaluatorOptions::max_megabytes: no fast evaluator can be
-// built within the cap, and the exact model is the answer (train stores the model without one).
-class FastEvaluatorOverCap : public Error {
- public:
-  using Error::Error;
-};
-
-struct FastEvaluatorOptions {
-  double mu_tolerance = 1e-6;            // absolute, μ units
-  double std_relative_tolerance = 1e-3;  // the interval's half-width to 0.1 %
-  // Random points of the final certification (refinement rounds use fewer). 5000 with the local
-  // searches and the safety factor held on 10⁶ fresh points (FastEvaluator.TheMeasuredBoundHoldsOnFreshPoints).
-  long long check_points = 5000;
-  int local_searches = 16;               // from the worst check points, at the final grid
-  double max_megabytes = 64.0;           // the grid's node values
-  // Work budget of the whole build, refinements and certification, in multiply-adds of the exact
-  // model (exact_point_work per point evaluated): a finer grid whose nodes and checks would take the
-  // work done past it is not built. Counted, not timed, so that the same model and options give the
-  // same grid on a busy machine and an idle one. `train` sets it from the GP fit's own work.
-  double max_work = std::numeric_limits<double>::infinity();
-  unsigned seed = 1;
-  std::function<void(const std::string&)> progress;  // one line per refinement; may be empty
-};
-
-// Multiply-adds of one exact evaluation of μ and σ, the unit of FastEvaluatorOptions::max_work:
-// n(n + d) for a GP of n training points in d inputs (k* is n·d, σ's triangular solve n²). About
-// 1e10 per second on one core of a 2-core AMD EPYC with AVX2 (bench/RESULTS.md).
-double exact_point_work(const GaussianProcess& gp);
 
 class FastEvaluator {
  public:
@@ -71,10 +44,7 @@ class FastEvaluator {
 
   FastEvaluator(InputSpace box, TensorCubicGrid grid, FastEvaluatorBounds bounds);
 
-  // Refines until the bounds are within the options' tolerances, or the next grid would exceed the
-  // memory cap or the work budget (then the finest grid built, whose bounds say what it reached).
-  static FastEvaluator build(const GaussianProcess& gp, const FastEvaluatorOptions& options);
-  // Why build() stopped, for the caller's message: "" when it met the tolerances.
+  // Why build_fast_evaluator stopped, for the caller's message: "" when it met the tolerances.
   const std::string& stop_reason() const { return stop_reason_; }
 
   // μ and σ at x (SI, d inputs); x must be inside the box (inside()).
@@ -91,6 +61,9 @@ class FastEvaluator {
   const InputSpace& box() const { return box_; }
 
  private:
+  // The builder (surrogate/fast_evaluator_build.hpp) sets the certified bounds and the stop reason.
+  friend FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options);
+
   InputSpace box_;
   TensorCubicGrid grid_;
   FastEvaluatorBounds bounds_;
@@ -106,9 +79,5 @@ inline double tabulated_log_std(double std) { return std::log(std::max(std, kSma
 inline double std_floor_for(double mu_tolerance, double std_relative_tolerance) {
   return mu_tolerance / std_relative_tolerance;
 }
-
-// The largest errors of `fast` against the exact `gp` at the points x (SI, one row each): what the
-// bound is measured from, and what a test checks it with.
-FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x);
 
 }  // namespace mufric

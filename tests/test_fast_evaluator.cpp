@@ -14,7 +14,7 @@
 
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/tensor_cubic_grid.hpp"
 #include "common/sanitizers.hpp"
@@ -126,10 +126,10 @@ TEST(FastEvaluator, ARebuildMeasuresAgainstTheExactModelNotTheOldGrid) {
   const GaussianProcess bare = grid_test_gp();
   FastEvaluatorOptions o;
   o.check_points = 2000;
-  const FastEvaluator first = FastEvaluator::build(bare, o);
+  const FastEvaluator first = build_fast_evaluator(bare, o);
   GaussianProcess carrying = grid_test_gp();
   carrying.attach_fast_evaluator(std::make_shared<const FastEvaluator>(first));
-  const FastEvaluator rebuilt = FastEvaluator::build(carrying, o);
+  const FastEvaluator rebuilt = build_fast_evaluator(carrying, o);
   EXPECT_EQ(rebuilt.bounds().mu_absolute, first.bounds().mu_absolute);
   EXPECT_EQ(rebuilt.bounds().std_relative, first.bounds().std_relative);
   EXPECT_GT(rebuilt.bounds().mu_absolute, 1e-12);  // a grid, not the exact model
@@ -140,7 +140,7 @@ TEST(FastEvaluator, TheMeasuredBoundHoldsOnFreshPoints) {
   const GaussianProcess gp = grid_test_gp();
   FastEvaluatorOptions o;
   o.check_points = 5000;
-  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  const FastEvaluator fast = build_fast_evaluator(gp, o);
   ASSERT_TRUE(fast.meets(o.mu_tolerance, o.std_relative_tolerance))
       << fast.bounds().mu_absolute << " " << fast.bounds().std_relative;
 #if MUFRIC_ADDRESS_SANITIZER || MUFRIC_THREAD_SANITIZER
@@ -162,7 +162,7 @@ TEST(FastEvaluator, ACappedGridSaysItDoesNotMeetTheTolerance) {
   FastEvaluatorOptions o;
   o.check_points = 2000;
   o.max_megabytes = 0.05;
-  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  const FastEvaluator fast = build_fast_evaluator(gp, o);
   EXPECT_FALSE(fast.meets(o.mu_tolerance, o.std_relative_tolerance));
   EXPECT_LE(static_cast<double>(fast.grid().bytes()) / 1e6, o.max_megabytes);
   const FastEvaluatorBounds seen = measure_errors(fast, gp, test::smooth_training_set(20000, 98).x);
@@ -179,7 +179,7 @@ GaussianProcess noise_floor_gp() { return test::fixed_hyper_gp(400, 13, 50.0, {1
 TEST(FastEvaluator, ANoiseFreeModelMeetsTheTolerancesOnASmallGrid) {
   const GaussianProcess gp = noise_floor_gp();
   FastEvaluatorOptions o;
-  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  const FastEvaluator fast = build_fast_evaluator(gp, o);
   EXPECT_TRUE(fast.meets(o.mu_tolerance, o.std_relative_tolerance)) << fast.stop_reason();
   EXPECT_LT(static_cast<double>(fast.grid().bytes()) / 1e6, 2.0);
   EXPECT_EQ(fast.bounds().std_floor, o.mu_tolerance / o.std_relative_tolerance);
@@ -190,7 +190,7 @@ TEST(FastEvaluator, StdErrorIsMeasuredAgainstMaxOfStdAndTheFloor) {
   const GaussianProcess gp = noise_floor_gp();
   FastEvaluatorOptions o;
   o.check_points = 1000;
-  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  const FastEvaluator fast = build_fast_evaluator(gp, o);
   const Eigen::MatrixXd x = test::smooth_training_set(3000, 41).x;
   EvaluationRequest exact{.std = true};
   exact.mu_tolerance = 0.0;
@@ -221,12 +221,12 @@ TEST(FastEvaluator, StopsAtItsWorkBudgetAndSaysWhyWhateverTheLoad) {
   FastEvaluatorOptions o;
   o.check_points = 1000;
   o.max_work = 1e3 * exact_point_work(gp);  // the first grid's nodes alone take more
-  const FastEvaluator fast = FastEvaluator::build(gp, o);
+  const FastEvaluator fast = build_fast_evaluator(gp, o);
   EXPECT_FALSE(fast.meets(o.mu_tolerance, o.std_relative_tolerance));
   EXPECT_NE(fast.stop_reason().find("past the work budget"), std::string::npos) << fast.stop_reason();
   FastEvaluatorOptions unlimited = o;
   unlimited.max_work = std::numeric_limits<double>::infinity();
-  const FastEvaluator full = FastEvaluator::build(gp, unlimited);
+  const FastEvaluator full = build_fast_evaluator(gp, unlimited);
   EXPECT_TRUE(full.meets(o.mu_tolerance, o.std_relative_tolerance));
   EXPECT_TRUE(full.stop_reason().empty());
   std::atomic<bool> stop{false};
@@ -234,7 +234,7 @@ TEST(FastEvaluator, StopsAtItsWorkBudgetAndSaysWhyWhateverTheLoad) {
     while (!stop.load()) {
     }
   });
-  const FastEvaluator under_load = FastEvaluator::build(gp, o);
+  const FastEvaluator under_load = build_fast_evaluator(gp, o);
   stop = true;
   spinner.join();
   EXPECT_EQ(under_load.grid().bytes(), fast.grid().bytes());
@@ -250,7 +250,7 @@ namespace {
 std::shared_ptr<const FastEvaluator> fast_for(const GaussianProcess& gp) {
   FastEvaluatorOptions o;
   o.check_points = 3000;
-  return std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, o));
+  return std::make_shared<const FastEvaluator>(build_fast_evaluator(gp, o));
 }
 
 // Points with their coordinates outside the box in every fifth row.

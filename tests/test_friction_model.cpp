@@ -8,7 +8,7 @@
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
 #include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 
 namespace mufric {
 namespace {
@@ -109,7 +109,7 @@ TEST(FrictionModel, AClampedIntervalGrowsWithTheDistanceFromTheBox) {
     if (fast) {
       FastEvaluatorOptions o;
       o.check_points = 1000;
-      gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, o)));
+      gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(build_fast_evaluator(gp, o)));
     }
     const double face = 1300e6;
     QueryBatch x(4, 3), at_face(4, 3);

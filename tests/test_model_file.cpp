@@ -9,7 +9,7 @@
 #include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
 #include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 #include "temp_path.hpp"
@@ -323,7 +323,7 @@ GaussianProcess gp_with_fast_evaluator(unsigned data_seed) {
   GaussianProcess gp = test::fixed_hyper_gp(80, data_seed, 1.0, {0.5, 0.6, 0.7}, 1e-3);
   FastEvaluatorOptions f;
   f.check_points = 2000;
-  gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, f)));
+  gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(build_fast_evaluator(gp, f)));
   return gp;
 }
 
@@ -380,7 +380,7 @@ TEST(ModelFile, ATamperedOrForeignFastEvaluatorIsRefused) {
 TEST(ModelFile, ANoiseFreeModelLoadsWithItsFastEvaluator) {
   const std::string path = temp_path("noise_floor.h5");
   GaussianProcess gp = test::fixed_hyper_gp(400, 13, 50.0, {1.5, 2.0, 3.0}, 1e-6);
-  gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(gp, FastEvaluatorOptions{})));
+  gp.attach_fast_evaluator(std::make_shared<const FastEvaluator>(build_fast_evaluator(gp, FastEvaluatorOptions{})));
   save_model(path, gp);
   const auto loaded = load_model(path);
   const auto* back = dynamic_cast<const GaussianProcess*>(loaded.get());

@@ -12,7 +12,7 @@
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
 #include "temp_path.hpp"
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 #include "surrogate/stochastic_kriging.hpp"
@@ -384,7 +384,7 @@ TEST(StochasticKriging, ThePatchScatterFastEvaluatorHoldsItsTolerance) {
   build.std_relative_tolerance = 1.0;
   build.check_points = 2000;
   gp.attach_patch_scatter_fast_evaluator(
-      std::make_shared<const FastEvaluator>(FastEvaluator::build(*gp.patch_scatter(), build)));
+      std::make_shared<const FastEvaluator>(build_fast_evaluator(*gp.patch_scatter(), build)));
   ASSERT_NE(gp.patch_scatter()->fast_evaluator(), nullptr);
   ASSERT_TRUE(gp.patch_scatter()->fast_evaluator()->meets(build.mu_tolerance, 1.0));
 

@@ -1,0 +1,53 @@
+#pragma once
+// Building and certifying a FastEvaluator (surrogate/fast_evaluator.hpp) from a Gaussian process:
+// the tolerances and budgets, the refinement loop and the error measurement against the exact GP.
+// Apart from the evaluator itself so that the GP, which evaluates through a grid, does not depend
+// on the code that builds one from it.
+#include <functional>
+#include <limits>
+#include <string>
+
+#include "common/error.hpp"
+#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/gaussian_process.hpp"
+
+namespace mufric {
+
+// Even the coarsest grid would exceed FastEvaluatorOptions::max_megabytes: no fast evaluator can be
+// built within the cap, and the exact model is the answer (train stores the model without one).
+class FastEvaluatorOverCap : public Error {
+ public:
+  using Error::Error;
+};
+
+struct FastEvaluatorOptions {
+  double mu_tolerance = 1e-6;            // absolute, μ units
+  double std_relative_tolerance = 1e-3;  // the interval's half-width to 0.1 %
+  // Random points of the final certification (refinement rounds use fewer). 5000 with the local
+  // searches and the safety factor held on 10⁶ fresh points (FastEvaluator.TheMeasuredBoundHoldsOnFreshPoints).
+  long long check_points = 5000;
+  int local_searches = 16;               // from the worst check points, at the final grid
+  double max_megabytes = 64.0;           // the grid's node values
+  // Work budget of the whole build, refinements and certification, in multiply-adds of the exact
+  // model (exact_point_work per point evaluated): a finer grid whose nodes and checks would take the
+  // work done past it is not built. Counted, not timed, so that the same model and options give the
+  // same grid on a busy machine and an idle one. `train` sets it from the GP fit's own work.
+  double max_work = std::numeric_limits<double>::infinity();
+  unsigned seed = 1;
+  std::function<void(const std::string&)> progress;  // one line per refinement; may be empty
+};
+
+// Multiply-adds of one exact evaluation of μ and σ, the unit of FastEvaluatorOptions::max_work:
+// n(n + d) for a GP of n training points in d inputs (k* is n·d, σ's triangular solve n²). About
+// 1e10 per second on one core of a 2-core AMD EPYC with AVX2 (bench/RESULTS.md).
+double exact_point_work(const GaussianProcess& gp);
+
+// Refines until the bounds are within the options' tolerances, or the next grid would exceed the
+// memory cap or the work budget (then the finest grid built, whose bounds say what it reached).
+FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options);
+
+// The largest errors of `fast` against the exact `gp` at the points x (SI, one row each): what the
+// bound is measured from, and what a test checks it with.
+FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x);
+
+}  // namespace mufric
