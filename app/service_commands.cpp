@@ -24,6 +24,11 @@ void add_status_command(CLI::App& app) {
                 s.code_version.c_str(), s.uptime_seconds,
                 count_of(s.evaluation_threads, "evaluation thread", "evaluation threads").c_str(), s.requests, s.points, s.errors,
                 s.abandoned, s.in_flight, s.streams, s.fast_points);
+    std::printf("memory for calls in flight: %.1f of %s MB in use; %lld calls refused while it was taken; %lld streams "
+                "open, %lld refused over --max-streams, %lld cancelled with their answer not taken\n",
+                static_cast<double>(s.memory_in_use_bytes) / (1024.0 * 1024.0),
+                s.memory_limit_bytes > 0 ? std::to_string(s.memory_limit_bytes / (1024 * 1024)).c_str() : "unlimited",
+                s.refused_busy, s.open_streams, s.refused_streams, s.stalled_streams);
     std::printf("server-side evaluation time:\n");
     for (size_t i = 0; i < s.latency_counts.size(); ++i) {
       if (i < s.latency_bounds_us.size()) {

@@ -449,6 +449,12 @@ ServerStatus server_status(const std::string& uri, const Options& options) {
                    {s.latency_bounds_us().begin(), s.latency_bounds_us().end()},
                    {s.latency_counts().begin(), s.latency_counts().end()}, {}};
   for (const auto& m : s.models()) out.models.push_back(m.name() + " " + m.version() + " " + m.kind());
+  out.memory_limit_bytes = static_cast<long long>(s.memory_limit_bytes());
+  out.memory_in_use_bytes = static_cast<long long>(s.memory_in_use_bytes());
+  out.refused_busy = static_cast<long long>(s.refused_busy());
+  out.open_streams = static_cast<long long>(s.open_streams());
+  out.refused_streams = static_cast<long long>(s.refused_streams());
+  out.stalled_streams = static_cast<long long>(s.stalled_streams());
   return out;
 }
 

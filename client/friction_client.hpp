@@ -143,6 +143,9 @@ struct ServerStatus {
   std::vector<double> latency_bounds_us;  // histogram of server-side evaluation time
   std::vector<long long> latency_counts;  // one more than bounds: the last is unbounded
   std::vector<std::string> models;        // "name version kind"
+  // serve's memory and stream limits (friction.proto ServerStatus; 0 limit: none).
+  long long memory_limit_bytes = 0, memory_in_use_bytes = 0, refused_busy = 0;
+  long long open_streams = 0, refused_streams = 0, stalled_streams = 0;
 };
 
 // Counters of a server: "grpc://host:port" or "grpcs://host:port" (a model path is ignored).

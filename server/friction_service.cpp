@@ -441,6 +441,12 @@ grpc::ServerUnaryReactor* FrictionService::GetServerStatus(grpc::CallbackServerC
   response->set_abandoned(static_cast<uint64_t>(counters_.abandoned.load()));
   response->set_streams(static_cast<uint64_t>(counters_.streams.load()));
   response->set_fast_points(static_cast<uint64_t>(counters_.fast_points.load()));
+  response->set_memory_limit_bytes(memory_.limit());
+  response->set_memory_in_use_bytes(memory_.in_use());
+  response->set_refused_busy(static_cast<uint64_t>(counters_.refused_busy.load()));
+  response->set_open_streams(static_cast<uint64_t>(std::max(0, counters_.open_streams.load())));
+  response->set_refused_streams(static_cast<uint64_t>(counters_.refused_streams.load()));
+  response->set_stalled_streams(static_cast<uint64_t>(counters_.stalled_streams.load()));
   response->set_evaluation_threads(static_cast<uint32_t>(limits_.evaluation_threads));
   for (const double bound : kLatencyBoundsUs) response->add_latency_bounds_us(bound);
   for (const auto& count : counters_.latency) response->add_latency_counts(static_cast<uint64_t>(count.load()));

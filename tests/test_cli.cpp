@@ -499,6 +499,10 @@ TEST_F(Cli, ServeRefusesAPortInUseAndAnAddressThatIsNoHostAndPort) {
     EXPECT_EQ(r.output.rfind("mufric: error: --listen " + listen + ": ", 0), 0u) << r.output;  // nothing from gRPC first
     EXPECT_EQ(line_count(r.output), 1u) << r.output;
   }
+  // A memory cap that leaves calls in flight too little is refused at start, naming the option.
+  r = run(serve + "127.0.0.1:0 --max-memory-mb 40", "timeout 20");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("mufric: error: --max-memory-mb 40: the models take "), std::string::npos) << r.output;
   r = run(serve + "55060", "timeout 20");  // a port alone: say how to write it, not "no port"
   EXPECT_EQ(r.output, "mufric: error: --listen 55060: a port alone; give host:port, e.g. 127.0.0.1:55060 (loopback) "
                       "or 0.0.0.0:55060 (every interface)\n");

@@ -35,7 +35,7 @@
 #include "server/memory_budget.hpp"
 #include "server/server.hpp"
 #include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
 #include "surrogate/model_file.hpp"
 #include "surrogate/stochastic_kriging.hpp"
@@ -799,6 +799,9 @@ TEST_F(Service, ABusyServerRefusesWithARetryHintAndTheClientWaitsItsTurn) {
   first.join();
   EXPECT_EQ(answer.mu.size(), pts.p.size());
   EXPECT_GE(server.service().counters().refused_busy.load(), 1);
+  const client::ServerStatus status = client::server_status("grpc://" + server.address());
+  EXPECT_EQ(status.refused_busy, server.service().counters().refused_busy.load());
+  EXPECT_EQ(status.memory_limit_bytes, static_cast<long long>(limits.request_memory_bytes));
   // Given back once gRPC has sent the last answer (the reactor's OnDone, just after the client has it).
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (server.service().memory().in_use() > 0 && std::chrono::steady_clock::now() < end) {
@@ -856,6 +859,10 @@ TEST_F(Service, StreamsAreBoundedInNumberAndInHowLongAnAnswerWaitsForItsReader) 
   EXPECT_EQ(server.service().counters().open_streams.load(), 0);
   EXPECT_EQ(server.service().memory().in_use(), 0u);
   EXPECT_EQ(server.service().counters().refused_streams.load(), 1);
+  const client::ServerStatus status = client::server_status("grpc://" + server.address());
+  EXPECT_EQ(status.stalled_streams, 1);
+  EXPECT_EQ(status.refused_streams, 1);
+  EXPECT_EQ(status.open_streams, 0);
   unread_context.TryCancel();
   unread->Finish();
 }
@@ -947,7 +954,7 @@ TEST_F(Service, FastEvaluatorPointsAreCountedAndCanBeRefused) {
     auto& trained = dynamic_cast<GaussianProcess&>(*gp);
     FastEvaluatorOptions o;
     o.check_points = 2000;
-    trained.attach_fast_evaluator(std::make_shared<const FastEvaluator>(FastEvaluator::build(trained, o)));
+    trained.attach_fast_evaluator(std::make_shared<const FastEvaluator>(build_fast_evaluator(trained, o)));
     save_model((dir_ / "fast.h5").string(), trained);
   }
   LoopbackServer server(dir_);
