@@ -323,6 +323,26 @@ TEST_F(Service, OutsideCountsRestartWhenTheModelsBoxChanges) {
   EXPECT_EQ(json.at("inputs").at(0).at("box_hi").get<double>(), 3e9);
 }
 
+// A GP heavy enough that its std takes a while: fixed hyper-parameters, `points` training points
+// (80 000 points with std take about half a second at 1000: L⁻¹ of 1000² per point).
+void save_heavy_gp(const fs::path& file, Eigen::Index points) {
+  GpTrainingOptions options;
+  options.optimise = false;
+  options.initial.length_scales = Eigen::Vector3d(0.3, 0.3, 0.3);
+  options.initial.noise_variance = 1e-4;
+  save_model(file.string(), train_gaussian_process(test::smooth_training_set(points, 5), options));
+}
+
+// An Evaluate request of `model` at the points, for calls made with the raw stub.
+mufric::v1::EvaluateRequest request_of(const std::string& model, const Points& pts) {
+  mufric::v1::EvaluateRequest request;
+  request.set_model(model);
+  request.mutable_contact_pressure()->Add(pts.p.begin(), pts.p.end());
+  request.mutable_sliding_velocity()->Add(pts.v.begin(), pts.v.end());
+  request.mutable_temperature()->Add(pts.t.begin(), pts.t.end());
+  return request;
+}
+
 TEST_F(Service, StreamOfIncrementsAnswersLikeUnaryCallsAndSurvivesAnError) {
   LoopbackServer server(dir_);
   client::Options streaming;
@@ -692,11 +712,7 @@ TEST_F(Service, StatusCountsRequestsPointsErrorsAndLatencies) {
 TEST_F(Service, AnEvaluationWhoseDeadlinePassedStopsEarly) {
   // A GP heavy enough that 80 000 points with std take about half a second (L⁻¹ of 1000² per point;
   // ten chunks of 8192 points).
-  GpTrainingOptions options;
-  options.optimise = false;
-  options.initial.length_scales = Eigen::Vector3d(0.3, 0.3, 0.3);
-  options.initial.noise_variance = 1e-4;
-  save_model((dir_ / "heavy.h5").string(), train_gaussian_process(test::smooth_training_set(1000, 5), options));
+  save_heavy_gp(dir_ / "heavy.h5", 1000);
   const Points pts = random_points(80'000);
   const EvaluationRequest what{.std = true};
   const auto start_local = std::chrono::steady_clock::now();
@@ -765,18 +781,10 @@ TEST(MemoryBudget, AnEvaluationsBytesAreItsRequestBatchAndTwoAnswers) {
 // A server whose memory for calls in flight is taken refuses with RESOURCE_EXHAUSTED and a retry
 // hint; mufric's client follows the hint and gets its answer once the other call is done.
 TEST_F(Service, ABusyServerRefusesWithARetryHintAndTheClientWaitsItsTurn) {
-  GpTrainingOptions options;
-  options.optimise = false;
-  options.initial.length_scales = Eigen::Vector3d(0.3, 0.3, 0.3);
-  options.initial.noise_variance = 1e-4;
-  save_model((dir_ / "heavy.h5").string(), train_gaussian_process(test::smooth_training_set(500, 5), options));
+  save_heavy_gp(dir_ / "heavy.h5", 500);
   const Points pts = random_points(40'000);
-  mufric::v1::EvaluateRequest request;
-  request.set_model("heavy");
+  mufric::v1::EvaluateRequest request = request_of("heavy", pts);
   request.set_std(true);
-  request.mutable_contact_pressure()->Add(pts.p.begin(), pts.p.end());
-  request.mutable_sliding_velocity()->Add(pts.v.begin(), pts.v.end());
-  request.mutable_temperature()->Add(pts.t.begin(), pts.t.end());
   server::ServiceLimits limits;
   limits.request_memory_bytes = server::evaluation_bytes(request, 3, false) * 3 / 2;  // one such call at a time
   LoopbackServer server(dir_, 0, limits);
@@ -826,13 +834,9 @@ TEST_F(Service, StreamsAreBoundedInNumberAndInHowLongAnAnswerWaitsForItsReader) 
   auto stub = mufric::v1::FrictionService::NewStub(
       grpc::CreateCustomChannel(server.address(), grpc::InsecureChannelCredentials(), small_window));
   const Points pts = random_points(100'000);
-  mufric::v1::EvaluateRequest request;
-  request.set_model("gp");
+  mufric::v1::EvaluateRequest request = request_of("gp", pts);
   request.set_std(true);
   request.set_ci_level(0.95);
-  request.mutable_contact_pressure()->Add(pts.p.begin(), pts.p.end());
-  request.mutable_sliding_velocity()->Add(pts.v.begin(), pts.v.end());
-  request.mutable_temperature()->Add(pts.t.begin(), pts.t.end());
   grpc::ClientContext unread_context;
   auto unread = stub->EvaluateStream(&unread_context);
   ASSERT_TRUE(unread->Write(request));
