@@ -481,7 +481,7 @@ class WallTimeLimit {
 std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, const LoadedChip& chip,
                                                            solid::TimeIntegrationOptions& o) {
   solid::SolidProblem& problem = *chip.problem;
-  if (!scene.heat_conduction) return nullptr;
+  if (!scene.heat_conduction()) return nullptr;
   auto heat = std::make_unique<solid::HeatConduction>(
       problem.space(), solid::HeatConductionOptions{.conductivity = scene.conductivity,
                                                     .density = scene.material.density,

@@ -299,8 +299,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   }
   {
     Section h = root.child("thermal");
-    const std::string fallback = s.protocol.name == Protocol::seed000 ? "adiabatic" : "conduction";
-    s.heat_conduction = h.text("model", fallback, {"adiabatic", "conduction"}) == "conduction";
+    const ThermalModel fallback = s.protocol.name == Protocol::seed000 ? ThermalModel::adiabatic : ThermalModel::conduction;
+    s.thermal_model = h.choice("model", fallback);
     s.conductivity = h.number("conductivity", s.conductivity, 0.0, 1e4);
     h.finish();
   }
@@ -407,7 +407,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
       w.finish();
       if (wets) law.wetted = wetted;
     }
-    if (law.kind != Kind::frictionless && !s.heat_conduction) {
+    if (law.kind != Kind::frictionless && !s.heat_conduction()) {
       s.warnings.push_back("the frictional heat of contact.law " + law_name +
                            " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in "
                            "through the surface)");

@@ -79,6 +79,9 @@ struct ProtocolSpec {
 inline constexpr double kAccelerationShareOfRunIn = 0.25;
 
 enum class Physics { dry, lubricated };
+// Heat: adiabatic (seed 000: each point keeps the heat of its plastic work) or conducted through the
+// chip (Γ_B held at load.temperature, the contact face insulated).
+enum class ThermalModel { adiabatic, conduction };
 enum class Compressibility { none, linear, dowson_higginson };
 enum class FilmFill { gap, after_pressing };
 enum class CavitationModel { none, mass_conserving };
@@ -183,10 +186,10 @@ struct Scene {
   double duration = 2.5e-7;           // s (seed 000 Figs. 3–5)
   double average_from = 1.25e-7;      // s, μ is averaged over [average_from, duration]
   ProtocolSpec protocol;
-  // Heat: adiabatic (seed 000: each point keeps the heat of its plastic work) or conducted through
-  // the chip (Γ_B held at load.temperature, the contact face insulated). The default follows the
-  // protocol: conduction for press-slide, adiabatic for seed 000 (bench/RESULTS.md, the heat study).
-  bool heat_conduction = true;
+  // The default follows the protocol: conduction for press-slide, adiabatic for seed 000
+  // (bench/RESULTS.md, the heat study).
+  ThermalModel thermal_model = ThermalModel::conduction;
+  bool heat_conduction() const { return thermal_model == ThermalModel::conduction; }
   double conductivity = 50.0;  // W/(m K), plain carbon steel near room temperature (AISI 1045: ~50)
   LubricantSpec lubricant;
   // contact
@@ -210,6 +213,11 @@ struct Scene {
 template <>
 struct SceneChoice<Physics> {
   static constexpr std::array<NamedChoice<Physics>, 2> names{{{"dry", Physics::dry}, {"lubricated", Physics::lubricated}}};
+};
+template <>
+struct SceneChoice<ThermalModel> {
+  static constexpr std::array<NamedChoice<ThermalModel>, 2> names{
+      {{"adiabatic", ThermalModel::adiabatic}, {"conduction", ThermalModel::conduction}}};
 };
 template <>
 struct SceneChoice<Protocol> {
