@@ -41,6 +41,13 @@ grpc::Status caller_gone(const grpc::CallbackServerContext& context, int done, i
   return grpc::Status::OK;
 }
 
+// A refusal the client should retry: RESOURCE_EXHAUSTED with the hint wire::kRetryAfterKey, which
+// mufric's clients follow (a RESOURCE_EXHAUSTED without it, too many points, is not retried).
+grpc::Status retry_later(grpc::CallbackServerContext& context, std::string message) {
+  context.AddTrailingMetadata(wire::kRetryAfterKey, std::to_string(kRetryAfterMs));
+  return {grpc::StatusCode::RESOURCE_EXHAUSTED, std::move(message)};
+}
+
 }  // namespace
 
 grpc::Status batch_from_request(const EvaluateRequest& request, const InputSpace& inputs, long long max_points,
@@ -249,7 +256,6 @@ grpc::Status FrictionService::admit(grpc::CallbackServerContext& context, const 
   held = memory_.try_reserve(bytes);
   if (held) return grpc::Status::OK;
   ++counters_.refused_busy;
-  context.AddTrailingMetadata(wire::kRetryAfterKey, std::to_string(kRetryAfterMs));
   constexpr double kMB = 1024.0 * 1024.0;
   char text[256];
   std::snprintf(text, sizeof text,
@@ -257,7 +263,7 @@ grpc::Status FrictionService::admit(grpc::CallbackServerContext& context, const 
                 "taken (serve --max-memory-mb); retry after %d ms",
                 static_cast<double>(bytes) / kMB, static_cast<double>(memory_.in_use()) / kMB,
                 static_cast<double>(memory_.limit()) / kMB, kRetryAfterMs);
-  return {grpc::StatusCode::RESOURCE_EXHAUSTED, text};
+  return retry_later(context, text);
 }
 
 grpc::Status FrictionService::handle(grpc::CallbackServerContext& context, const EvaluateRequest& request,
@@ -408,10 +414,9 @@ grpc::ServerBidiReactor<EvaluateRequest, mufric::v1::EvaluateResponse>* Friction
   grpc::Status admitted = authorise(*context);
   if (admitted.ok() && limits_.max_streams > 0 && counters_.open_streams.load() >= limits_.max_streams) {
     ++counters_.refused_streams;
-    context->AddTrailingMetadata(wire::kRetryAfterKey, std::to_string(kRetryAfterMs));
-    admitted = {grpc::StatusCode::RESOURCE_EXHAUSTED,
-                std::to_string(limits_.max_streams) + " streams are open, the server's limit (serve --max-streams); "
-                "retry after " + std::to_string(kRetryAfterMs) + " ms, or send blocks over fewer streams"};
+    admitted = retry_later(*context, std::to_string(limits_.max_streams) +
+                                         " streams are open, the server's limit (serve --max-streams); retry after " +
+                                         std::to_string(kRetryAfterMs) + " ms, or send blocks over fewer streams");
   }
   return new StreamReactor(*this, *context, admitted);
 }
