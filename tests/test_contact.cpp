@@ -2,6 +2,7 @@
 // finite differences, and Hertz's line contact of an elastic cylinder on a rigid flat.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "micro/contact/adhesion_table.hpp"
+#include "micro/contact/interface_laws.hpp"
 #include "micro/contact/mortar_contact.hpp"
 #include "micro/solid/heat_conduction.hpp"
 #include "micro/spline/profile.hpp"
@@ -190,12 +192,23 @@ TEST(MortarContact, HertzLineContactOfACylinderOnARigidFlat) {
 
 // ---- Coulomb's law at the contact points --------------------------------------------------------
 
-InterfaceLaw coulomb(double adhesive_coefficient, double tangential_penalty = 0.0) {
-  InterfaceLaw law;
-  law.kind = InterfaceLaw::Kind::coulomb;
-  law.adhesive_coefficient = adhesive_coefficient;
-  law.tangential_penalty = tangential_penalty;
-  return law;
+ContactInterface with_law(std::shared_ptr<const InterfaceLaw> law, double tangential_penalty) {
+  return {.law = std::move(law), .tangential_penalty = tangential_penalty};
+}
+
+ContactInterface coulomb(double adhesive_coefficient, double tangential_penalty = 0.0) {
+  return with_law(std::make_shared<CoulombLaw>(adhesive_coefficient), tangential_penalty);
+}
+
+// The contact's points all at one chip state (k, T), given through the provider a run gives them by.
+std::shared_ptr<SampledPointStates> uniform_point_states(MortarContact& contact, double shear_strength, double temperature,
+                                                         double sliding_velocity = 1.0) {
+  const size_t points = contact.surface_positions().size();
+  auto states = std::make_shared<SampledPointStates>(points, sliding_velocity);
+  states->set_shear_strength(std::vector<double>(points, shear_strength));
+  states->set_temperature(std::vector<double>(points, temperature));
+  contact.set_point_states(states);
+  return states;
 }
 
 // The patch test's flat chip pressed uniformly onto a flat tool, its state committed, then slid
@@ -256,7 +269,7 @@ TEST(CoulombContact, SlipDissipatesMuPTimesTheSlipAndTheChipReceivesItsShare) {
   const int steps = 7;
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 28)),
                               std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
-  InterfaceLaw law = coulomb(mu_a, tangential);
+  ContactInterface law = coulomb(mu_a, tangential);
   law.heat_partition = partition;
   auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
                                                  penalty, 0, law);
@@ -297,13 +310,11 @@ TEST(CoulombContact, SlipDissipatesMuPTimesTheSlipAndTheChipReceivesItsShare) {
   EXPECT_NEAR(contact->dissipated_energy(), expected, 1e-6 * expected);
 }
 
-InterfaceLaw yield_limited(InterfaceLaw::Kind kind, double shear_factor, double adhesive_coefficient, double tangential) {
-  InterfaceLaw law;
-  law.kind = kind;
-  law.shear_factor = shear_factor;
-  law.adhesive_coefficient = adhesive_coefficient;
-  law.tangential_penalty = tangential;
-  return law;
+ContactInterface shear_factor_law(double shear_factor, double tangential) {
+  return with_law(std::make_shared<ShearFactorLaw>(shear_factor), tangential);
+}
+ContactInterface zorev_law(double shear_factor, double adhesive_coefficient, double tangential) {
+  return with_law(std::make_shared<ZorevLaw>(LawCoefficients{adhesive_coefficient, shear_factor}), tangential);
 }
 
 // The same slid flat chip under the shear-factor law, τ = m k in slip whatever the pressure, and
@@ -312,26 +323,29 @@ InterfaceLaw yield_limited(InterfaceLaw::Kind kind, double shear_factor, double 
 TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
   const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3, m = 0.5;
   struct Case {
-    InterfaceLaw::Kind kind;
+    ContactInterface law;
     double k;               // the chip's shear yield stress, uniform
     double expected_limit;  // the slip shear the law gives
   };
   const std::vector<Case> cases = {
-      {InterfaceLaw::Kind::shear_factor, 2e-4, m * 2e-4},
-      {InterfaceLaw::Kind::shear_factor, 2e-3, m * 2e-3},
-      {InterfaceLaw::Kind::zorev, 2e-3, mu_a * pressure},  // μ_a p = 3e-4 < m k = 1e-3: Coulomb branch
-      {InterfaceLaw::Kind::zorev, 2e-4, m * 2e-4}};        // m k = 1e-4 < μ_a p: the shear branch
+      {shear_factor_law(m, tangential), 2e-4, m * 2e-4},
+      {shear_factor_law(m, tangential), 2e-3, m * 2e-3},
+      {zorev_law(m, mu_a, tangential), 2e-3, mu_a * pressure},  // μ_a p = 3e-4 < m k = 1e-3: Coulomb branch
+      {zorev_law(m, mu_a, tangential), 2e-4, m * 2e-4}};        // m k = 1e-4 < μ_a p: the shear branch
   for (const auto& c : cases) {
     solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
     chip.fix_side(numerics::Side::bottom, 0);
     chip.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
     auto contact = std::make_shared<MortarContact>(chip.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                   penalty, 0, yield_limited(c.kind, m, mu_a, tangential));
+                                                   penalty, 0, c.law);
     const size_t points = contact->surface_positions().size();
     Eigen::VectorXd probe = Eigen::VectorXd::Zero(chip.dof_count());
-    EXPECT_THROW(contact->state(probe), Error);  // k not given yet
-    contact->set_shear_strength(std::vector<double>(points, c.k));
+    EXPECT_THROW(contact->state(probe), Error);  // no provider of k yet
+    auto states = std::make_shared<SampledPointStates>(points, 1.0);
+    contact->set_point_states(states);
+    EXPECT_THROW(contact->state(probe), Error);  // a provider, but k not given yet
+    states->set_shear_strength(std::vector<double>(points, c.k));
     chip.add_interaction(contact);
     const Eigen::VectorXd pressed = solid::test::solve_static(chip);
     contact->commit(pressed);
@@ -367,19 +381,15 @@ TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
     }
   }
   struct Case {
-    InterfaceLaw law;
+    ContactInterface law;
     double dry_limit, wet_limit;  // the slip shear of a dry and of a wetted point
   };
-  InterfaceLaw table;
-  table.kind = InterfaceLaw::Kind::table;
-  table.table = std::make_shared<const AdhesionTable>(AdhesionTable::read(table_path.string()));
-  table.tangential_penalty = tangential;
+  const auto table = std::make_shared<const AdhesionTable>(AdhesionTable::read(table_path.string()));
   const std::vector<Case> cases = {
-      {coulomb(mu_a, tangential), mu_a * pressure, mu_wet * pressure},
-      {yield_limited(InterfaceLaw::Kind::shear_factor, m, 0.0, tangential), m * k, m_wet * k},
-      {table, 0.4 * pressure, mu_wet * pressure}};
-  for (Case c : cases) {
-    c.law.wetted = WettedCoefficients{.adhesive_coefficient = mu_wet, .shear_factor = m_wet};
+      {with_law(std::make_shared<CoulombLaw>(mu_a, mu_wet), tangential), mu_a * pressure, mu_wet * pressure},
+      {with_law(std::make_shared<ShearFactorLaw>(m, m_wet), tangential), m * k, m_wet * k},
+      {with_law(std::make_shared<TableLaw>(table, mu_wet), tangential), 0.4 * pressure, mu_wet * pressure}};
+  for (const Case& c : cases) {
     solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
     chip.fix_side(numerics::Side::bottom, 0);
@@ -387,12 +397,11 @@ TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
     auto contact = std::make_shared<MortarContact>(chip.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
                                                    penalty, 0, c.law);
     const std::vector<Eigen::Vector2d> at = contact->surface_positions();
-    contact->set_shear_strength(std::vector<double>(at.size(), k));
-    contact->set_surface_temperature(std::vector<double>(at.size(), 300.0));
+    const auto states = uniform_point_states(*contact, k, 300.0);
     std::vector<char> wetted(at.size(), 0);
     for (size_t q = 0; q < at.size(); ++q) wetted[q] = at[q].x() < 0.5 * period ? 1 : 0;
-    EXPECT_THROW(contact->set_wetted(std::vector<char>(at.size() + 1, 1)), Error);
-    contact->set_wetted(wetted);
+    EXPECT_THROW(states->set_wetted(std::vector<char>(at.size() + 1, 1)), Error);
+    states->set_wetted(wetted);
     chip.add_interaction(contact);
     const Eigen::VectorXd pressed = solid::test::solve_static(chip);
     contact->commit(pressed);
@@ -410,7 +419,7 @@ TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
     EXPECT_NEAR(s.wetted_contact_length, wetted_length, 1e-12);
     EXPECT_GT(wetted_length, 0.0);
     EXPECT_LT(wetted_length, s.contact_length - 0.1);
-    contact->set_wetted({});
+    states->set_wetted({});
     const ContactState dry = contact->state(slid);
     for (size_t q = 0; q < dry.point_shear.size(); ++q) EXPECT_NEAR(dry.point_shear[q], -c.dry_limit, 1e-9 * c.dry_limit);
     EXPECT_EQ(dry.wetted_contact_length, 0.0);
@@ -426,10 +435,12 @@ TEST(YieldLimitedContact, ZorevTangentIsTheExactLinearisationOnBothBranches) {
                               std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
   const double mu_a = 0.3, m = 0.5;
   auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0,
-                                                 yield_limited(InterfaceLaw::Kind::zorev, m, mu_a, 50.0));
+                                                 zorev_law(m, mu_a, 50.0));
   std::vector<double> k;
   for (const auto& x : contact->surface_positions()) k.push_back(0.4 * (1.0 + std::sin(2 * std::numbers::pi * x.x())));
-  contact->set_shear_strength(k);
+  auto states = std::make_shared<SampledPointStates>(k.size(), 1.0);
+  states->set_shear_strength(k);
+  contact->set_point_states(states);
   problem.add_interaction(contact);
   const Eigen::VectorXd u = committed_then_slid(problem, *contact);
   const ContactState s = contact->state(u);
@@ -451,6 +462,137 @@ TEST(YieldLimitedContact, ZorevTangentIsTheExactLinearisationOnBothBranches) {
   ASSERT_GT(coulomb_branch, 0);
   ASSERT_GT(shear_branch, 0);
   solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "zorev contact", 1e-5);
+}
+
+// ---- Childs' smooth Zorev, and the registry every law joins -------------------------------------
+
+// Childs' limit against what it must be independently of its formula's code: Coulomb's μ_a P where
+// μ_a P ≪ m k, the yield shear m k where μ_a P ≫ m k, exactly m k (1 − e^(−x)) for n = 1 (written
+// out by hand), below min(μ_a P, m k) everywhere; its slope against central differences; Zorev's
+// corner approached as n grows; a wetted spot's wetted coefficients.
+TEST(ChildsLaw, BlendsCoulombIntoTheYieldShearWithTheSlopeItsLimitHas) {
+  const double mu_a = 0.3, m = 0.6, k = 400e6;
+  const double yield_shear = m * k;
+  ContactPointState point{.shear_strength = k};
+  for (const double n : {0.5, 1.0, 2.0, 5.0, 20.0}) {
+    const ChildsLaw law({mu_a, m}, n);
+    for (const double pressure : {1e3, 1e6, 1e8, 4e8, 8e8, 2e9, 1e10, 1e12}) {
+      point.pressure = pressure;
+      const SlipLimit limit = law.slip_limit(point);
+      EXPECT_LE(limit.shear, std::min(mu_a * pressure, yield_shear) * (1.0 + 1e-15)) << "n " << n << ", P " << pressure;
+      EXPECT_GT(limit.shear, 0.0);
+      const double step = 1e-6 * pressure;
+      point.pressure = pressure + step;
+      const double above = law.slip_limit(point).shear;
+      point.pressure = pressure - step;
+      const double below = law.slip_limit(point).shear;
+      EXPECT_NEAR(limit.dshear_dpressure, (above - below) / (2 * step), 1e-6 * mu_a) << "n " << n << ", P " << pressure;
+    }
+    // x = 1.25e-6: Coulomb's branch, below it by a share xⁿ/(2n) to first order.
+    point.pressure = 1e3;
+    const double x = mu_a * 1e3 / yield_shear;
+    EXPECT_NEAR(law.slip_limit(point).shear, mu_a * 1e3, (std::pow(x, n) / n + 1e-14) * mu_a * 1e3) << n;
+    EXPECT_NEAR(law.slip_limit(point).dshear_dpressure, mu_a, (2 * std::pow(x, n) + 1e-14) * mu_a) << n;
+    point.pressure = 1e12;  // x = 1250: the yield shear, flat in P
+    EXPECT_NEAR(law.slip_limit(point).shear, yield_shear, 1e-12 * yield_shear) << n;
+    EXPECT_LT(law.slip_limit(point).dshear_dpressure, 1e-12 * mu_a) << n;
+  }
+  const ChildsLaw exponential({mu_a, m}, 1.0);
+  point.pressure = 8e8;
+  EXPECT_NEAR(exponential.slip_limit(point).shear, yield_shear * (1.0 - std::exp(-mu_a * 8e8 / yield_shear)), 1e-9 * yield_shear);
+  // At Zorev's corner (μ_a P = m k) the blend is (1 − 1/e)^(1/n) of it: 0.977 at n = 20.
+  point.pressure = yield_shear / mu_a;
+  EXPECT_NEAR(ChildsLaw({mu_a, m}, 20.0).slip_limit(point).shear, std::pow(1.0 - std::exp(-1.0), 1.0 / 20.0) * yield_shear,
+              1e-12 * yield_shear);
+  // Away from the corner, n = 20 is Zorev's law.
+  const ZorevLaw zorev({mu_a, m});
+  for (const double pressure : {2e8, 1.2e9}) {
+    point.pressure = pressure;
+    EXPECT_NEAR(ChildsLaw({mu_a, m}, 20.0).slip_limit(point).shear, zorev.slip_limit(point).shear, 1e-3 * yield_shear);
+  }
+  // A wetted spot takes the wetted pair.
+  point.pressure = 1e12;
+  point.wetted = true;
+  EXPECT_NEAR(ChildsLaw({mu_a, m}, 2.0, {0.05, 0.1}).slip_limit(point).shear, 0.1 * k, 1e-12 * k);
+  // A chip without strength there carries no shear, and out-of-range coefficients are refused.
+  point.shear_strength = 0.0;
+  EXPECT_EQ(ChildsLaw({mu_a, m}, 2.0).slip_limit(point).shear, 0.0);
+  EXPECT_THROW(ChildsLaw({mu_a, m}, 0.1), Error);
+  EXPECT_THROW(ChildsLaw({mu_a, 1.5}, 2.0), Error);
+}
+
+// Childs' tangent against central differences on the rough pair, with points in stick and in slip on
+// the blend: k at each point is set from its pressure so that μ_a P/(m k) is 0.5, 1 or 2 (the
+// pressure depends on the gap alone, so k does not move it), where neither asymptote is the law.
+TEST(ChildsLaw, ContactTangentIsTheExactLinearisationOnTheBlend) {
+  const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
+  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
+                              std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
+  const double mu_a = 0.3, m = 0.5;
+  const auto law = std::make_shared<ChildsLaw>(LawCoefficients{mu_a, m}, 2.0);
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, with_law(law, 5.0));
+  const size_t points = contact->surface_positions().size();
+  auto states = std::make_shared<SampledPointStates>(points, 1.0);
+  states->set_shear_strength(std::vector<double>(points, 1.0));
+  contact->set_point_states(states);
+  problem.add_interaction(contact);
+  const Eigen::VectorXd u = committed_then_slid(problem, *contact);
+  const ContactState at_u = contact->state(u);
+  std::vector<double> k(points, 1.0);
+  const std::array<double, 3> blend{0.5, 1.0, 2.0};
+  for (size_t q = 0; q < points; ++q) {
+    if (at_u.point_pressure[q] > 0.0) k[q] = mu_a * at_u.point_pressure[q] / (m * blend[q % 3]);
+  }
+  states->set_shear_strength(k);
+  const StickSlip n = count_stick_slip(contact->state(u), [&](size_t q, double p) {
+    return law->slip_limit({.pressure = p, .shear_strength = k[q]}).shear;
+  });
+  ASSERT_GT(n.stick, 3);
+  ASSERT_GT(n.slip, 3);
+  solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "childs contact", 1e-5);
+}
+
+// Every registered law: a unique name found again by it, frictionless first (the default), the keys
+// it declares read by its reader (a reader reading an undeclared key is a logic error, so the scene's
+// warnings about other laws' keys are right), and a law whose name is the entry's.
+TEST(InterfaceLawRegistry, EveryLawIsFoundByItsNameAndReadsExactlyItsDeclaredKeys) {
+  const auto table_path = std::filesystem::temp_directory_path() / "mufric_registry_table.csv";
+  std::ofstream(table_path) << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],mu_a\n0,1,300,0.2\n1,1,300,0.2\n";
+  // Answers every key with a mid-range value (the table's path for a file) and records what was read.
+  struct RecordingKeys final : LawKeys {
+    std::string table;
+    std::vector<std::string> read;
+    double required_number(std::string_view key, double lo, double hi, std::string_view) override {
+      read.emplace_back(key);
+      return 0.5 * (lo + hi);
+    }
+    double number(std::string_view key, double, double lo, double hi) override { return required_number(key, lo, hi, ""); }
+    std::string required_file(std::string_view key, std::string_view) override {
+      read.emplace_back(key);
+      return table;
+    }
+    [[noreturn]] void fail(std::string_view key, const std::string& message) override {
+      throw Error(std::string(key) + ": " + message);
+    }
+  };
+  ASSERT_GE(interface_laws().size(), 6U);
+  EXPECT_EQ(interface_laws().front().name, "frictionless");
+  for (const auto& entry : interface_laws()) {
+    EXPECT_EQ(find_interface_law(entry.name), &entry);
+    RecordingKeys keys;
+    keys.table = table_path.string();
+    const auto law = entry.read(keys);
+    ASSERT_NE(law, nullptr) << entry.name;
+    EXPECT_EQ(law->name(), entry.name);
+    std::vector<std::string> declared(entry.keys.begin(), entry.keys.end());
+    std::sort(declared.begin(), declared.end());
+    std::sort(keys.read.begin(), keys.read.end());
+    EXPECT_EQ(keys.read, declared) << entry.name;
+    EXPECT_EQ(law->frictional(), entry.name != "frictionless");
+  }
+  EXPECT_EQ(find_interface_law("sticky"), nullptr);
+  EXPECT_NE(interface_law_names().find("frictionless, coulomb"), std::string::npos);
+  std::filesystem::remove(table_path);
 }
 
 // A rigid facet of slope α pressed uniformly onto a chip whose surface lies parallel to it (a sheared
@@ -580,15 +722,13 @@ TEST(AdhesionTable, ErrorsNameTheFileTheLineOrTheMissingGridPoint) {
 
 // A table law whose μ_a rises with pressure, μ_a = 0.2 + 100 p (pressures of order 1e-3 here), at one
 // velocity and temperature.
-InterfaceLaw table_law(double tangential) {
-  InterfaceLaw law;
-  law.kind = InterfaceLaw::Kind::table;
-  law.table = std::make_shared<const AdhesionTable>(std::vector<double>{0.0, 1e-2}, std::vector<double>{1.0},
-                                                    std::vector<double>{300.0}, std::vector<double>{0.2, 1.2}, "test");
-  law.sliding_velocity = 1.0;
-  law.tangential_penalty = tangential;
-  return law;
+// A table μ_a(p) linear from (0, μ_0) to (p_max, μ_max), at one velocity (1) and temperature (300).
+std::shared_ptr<const AdhesionTable> linear_table(double p_max, double mu_0, double mu_max) {
+  return std::make_shared<const AdhesionTable>(std::vector<double>{0.0, p_max}, std::vector<double>{1.0},
+                                               std::vector<double>{300.0}, std::vector<double>{mu_0, mu_max}, "test");
 }
+
+ContactInterface table_law(double tangential) { return with_law(std::make_shared<TableLaw>(linear_table(1e-2, 0.2, 1.2)), tangential); }
 
 // The flat chip slid beyond stick under the table law: τ = μ_a(p) p with μ_a at the point's pressure
 // (closed form); the law needs the chip's temperature at the contact before it can shear.
@@ -601,8 +741,11 @@ TEST(TableContact, AFlatChipSlidCarriesTheTablesMuTimesP) {
   problem.add_interaction(contact);
   problem.fix_side(numerics::Side::bottom, 0);
   problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  const size_t points = contact->surface_positions().size();
+  auto states = std::make_shared<SampledPointStates>(points, 1.0);
+  contact->set_point_states(states);
   EXPECT_THROW(contact->commit(Eigen::VectorXd::Zero(problem.dof_count())), Error);  // no temperature yet
-  contact->set_surface_temperature(std::vector<double>(contact->surface_positions().size(), 300.0));
+  states->set_temperature(std::vector<double>(points, 300.0));
   const Eigen::VectorXd pressed = solid::test::solve_static(problem);
   contact->commit(pressed);
   const double mu_a = 0.2 + 100.0 * pressure;
@@ -621,16 +764,15 @@ TEST(TableContact, TangentIsTheExactLinearisationWithAPressureDependentMu) {
   const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),
                               std::make_shared<solid::LinearElastic>(1e-2, 0.3, 1.0));
-  InterfaceLaw law = table_law(50.0);
   // Pressures here reach ~0.05: μ_a from 0.1 to 0.6 over them.
-  law.table = std::make_shared<const AdhesionTable>(std::vector<double>{0.0, 0.05}, std::vector<double>{1.0},
-                                                    std::vector<double>{300.0}, std::vector<double>{0.1, 0.6}, "test");
-  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0, law);
-  contact->set_surface_temperature(std::vector<double>(contact->surface_positions().size(), 300.0));
+  const auto table = linear_table(0.05, 0.1, 0.6);
+  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{tool_surface}, 50.0, 0,
+                                                 with_law(std::make_shared<TableLaw>(table), 50.0));
+  uniform_point_states(*contact, 0.0, 300.0);
   problem.add_interaction(contact);
   const Eigen::VectorXd u = committed_then_slid(problem, *contact);
   const StickSlip n =
-      count_stick_slip(contact->state(u), [&](size_t, double p) { return law.table->at(p, 1.0, 300.0).mu * p; });
+      count_stick_slip(contact->state(u), [&](size_t, double p) { return table->at(p, 1.0, 300.0).mu * p; });
   ASSERT_GT(n.stick, 3);
   ASSERT_GT(n.slip, 3);
   solid::test::expect_tangent_matches_finite_differences(problem, u, 1.0, "table contact", 1e-5);

@@ -4,26 +4,21 @@
 #include <unordered_map>
 
 #include "common/error.hpp"
+#include "micro/contact/interface_laws.hpp"
 
 namespace mufric::contact {
 
 double RigidTool::lowest_y() const { return surface.points().col(1).minCoeff(); }
 
 MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty, int points_per_span,
-                             InterfaceLaw law)
-    : tool_(std::move(tool)), law_(law), penalty_(penalty) {
+                             ContactInterface contact_interface)
+    : tool_(std::move(tool)), interface_(std::move(contact_interface)), penalty_(penalty) {
   if (!(penalty_ > 0.0)) throw Error("contact: the penalty factor must be positive");
-  if (law_.tangential_penalty == 0.0) law_.tangential_penalty = kTangentialPenaltyRatio * penalty_;
-  if (!(law_.tangential_penalty > 0.0)) throw Error("contact: the tangential penalty must be positive");
-  if (!(law_.adhesive_coefficient >= 0.0)) throw Error("contact: the adhesive coefficient must be >= 0");
-  if (!(law_.shear_factor >= 0.0 && law_.shear_factor <= 1.0)) throw Error("contact: the shear factor must be in [0, 1]");
-  if (!(law_.heat_partition >= 0.0 && law_.heat_partition <= 1.0)) throw Error("contact: the heat partition must be in [0, 1]");
-  if (law_.kind == InterfaceLaw::Kind::table && !law_.table) throw Error("contact: the table law needs its adhesion table");
-  if (law_.wetted && !(law_.wetted->adhesive_coefficient >= 0.0)) {
-    throw Error("contact: the wetted adhesive coefficient must be >= 0");
-  }
-  if (law_.wetted && !(law_.wetted->shear_factor >= 0.0 && law_.wetted->shear_factor <= 1.0)) {
-    throw Error("contact: the wetted shear factor must be in [0, 1]");
+  if (!interface_.law) interface_.law = std::make_shared<FrictionlessLaw>();
+  if (interface_.tangential_penalty == 0.0) interface_.tangential_penalty = kTangentialPenaltyRatio * penalty_;
+  if (!(interface_.tangential_penalty > 0.0)) throw Error("contact: the tangential penalty must be positive");
+  if (!(interface_.heat_partition >= 0.0 && interface_.heat_partition <= 1.0)) {
+    throw Error("contact: the heat partition must be in [0, 1]");
   }
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);
   // A periodic tool profile that is a graph over x lets every search be bounded (see search_window).
@@ -204,15 +199,19 @@ Eigen::Matrix2d MortarContact::unit_tangent_gradient(const PointGap& g) {
   return dt_dxi * g.parameter_gradient.transpose();
 }
 
+std::optional<std::string> MortarContact::missing_point_state() const {
+  const PointStateNeeds needs = interface_.law->needs();
+  if (!needs.any()) return std::nullopt;
+  const std::optional<std::string> missing =
+      states_ ? states_->missing(needs) : std::optional<std::string>("a provider of the contact points' state (set_point_states)");
+  if (!missing) return std::nullopt;
+  return "contact: the interfacial law " + std::string(interface_.law->name()) + " needs " + *missing;
+}
+
 MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g, double pressure) const {
   PointShear s;
-  if (law_.kind == InterfaceLaw::Kind::frictionless || pressure <= 0.0 || !g.evaluated) return s;
-  if (law_.needs_shear_strength() && shear_strength_.empty()) {
-    throw Error("contact: the interfacial law needs the chip's shear yield stress at the contact (set_shear_strength)");
-  }
-  if (law_.needs_temperature() && surface_temperature_.empty()) {
-    throw Error("contact: the interfacial law needs the chip's temperature at the contact (set_surface_temperature)");
-  }
+  if (!interface_.law->frictional() || pressure <= 0.0 || !g.evaluated) return s;
+  if (const auto missing = missing_point_state()) throw Error(*missing);
   // A point without an anchor (not searched at the last commit) starts stress-free where it is.
   if (!anchor_[q]) return s;
   // Tangential offset from the anchor along the tool, g_t = |C′(ξ)| (ξ − ξ_a): the arc length to
@@ -220,65 +219,26 @@ MortarContact::PointShear MortarContact::point_shear(size_t q, const PointGap& g
   const double speed = g.d1.norm();
   const double offset_parameter = g.parameter - *anchor_[q];
   const double offset = speed * offset_parameter;
-  const double trial = -law_.tangential_penalty * offset;
+  const double trial = -interface_.tangential_penalty * offset;
   s.trial = trial;
-  // The slip limit: μ_a P (Coulomb, or the table's μ_a(P, v, T)), m k (shear factor) or the lower of
-  // the first and the second (Zorev), with its slope in P for the tangent; a wetted spot's μ_a and m
-  // are the law's wetted coefficients.
-  const bool wet = law_.wetted && wetted(q);
-  const double adhesive_coefficient = wet ? law_.wetted->adhesive_coefficient : law_.adhesive_coefficient;
-  const double shear_factor = wet ? law_.wetted->shear_factor : law_.shear_factor;
-  double limit = adhesive_coefficient * pressure;
-  double limit_slope = adhesive_coefficient;
-  if (law_.kind == InterfaceLaw::Kind::table && !wet) {
-    const AdhesionTable::Value mu = law_.table->at(pressure, law_.sliding_velocity, surface_temperature_[q]);
-    limit = mu.mu * pressure;
-    limit_slope = mu.mu + pressure * mu.dmu_dpressure;
-  }
-  if (law_.needs_shear_strength()) {
-    const double yield_shear = shear_factor * shear_strength_[q];
-    if (law_.kind == InterfaceLaw::Kind::shear_factor || yield_shear < limit) {
-      limit = yield_shear;
-      limit_slope = 0.0;
-    }
-  }
+  // The law's slip limit at this point's state (its k, T and wetted flag as of the last accepted step).
+  ContactPointState point = states_ ? states_->state(q) : ContactPointState{};
+  point.pressure = pressure;
+  const SlipLimit slip = interface_.law->slip_limit(point);
+  const double limit = slip.shear;
   if (std::abs(trial) <= limit) {
     s.regime = PointShear::Regime::stick;
     s.shear = trial;
     // ∂g_t/∂x = (|C′| + (ξ − ξ_a) t·C″) ∂ξ/∂x.
     const double doffset_dxi = speed + offset_parameter * g.d2.dot(g.d1) / speed;
-    s.shear_gradient = -law_.tangential_penalty * doffset_dxi * g.parameter_gradient;
+    s.shear_gradient = -interface_.tangential_penalty * doffset_dxi * g.parameter_gradient;
   } else {
     s.regime = PointShear::Regime::slip;
     s.slip_sign = trial > 0.0 ? 1.0 : -1.0;
     s.shear = s.slip_sign * limit;
-    s.limit_slope = limit_slope;
+    s.limit_slope = slip.dshear_dpressure;
   }
   return s;
-}
-
-void MortarContact::set_surface_temperature(std::vector<double> temperature) {
-  if (temperature.size() != points_.size()) {
-    throw Error("contact: " + std::to_string(temperature.size()) + " temperatures for " + std::to_string(points_.size()) +
-                " surface points");
-  }
-  surface_temperature_ = std::move(temperature);
-}
-
-void MortarContact::set_wetted(std::vector<char> wetted) {
-  if (!wetted.empty() && wetted.size() != points_.size()) {
-    throw Error("contact: " + std::to_string(wetted.size()) + " wetted flags for " + std::to_string(points_.size()) +
-                " surface points");
-  }
-  wetted_ = std::move(wetted);
-}
-
-void MortarContact::set_shear_strength(std::vector<double> k) {
-  if (k.size() != points_.size()) {
-    throw Error("contact: " + std::to_string(k.size()) + " shear strengths for " + std::to_string(points_.size()) +
-                " surface points");
-  }
-  shear_strength_ = std::move(k);
 }
 
 std::vector<Eigen::Vector2d> MortarContact::surface_positions() const {
@@ -289,7 +249,7 @@ std::vector<Eigen::Vector2d> MortarContact::surface_positions() const {
 }
 
 void MortarContact::commit(const Eigen::VectorXd& u) {
-  if (law_.kind == InterfaceLaw::Kind::frictionless) return;
+  if (!interface_.law->frictional()) return;
   bool ok = true;
   int projections = 0;
   std::string reason;
@@ -309,9 +269,9 @@ void MortarContact::commit(const Eigen::VectorXd& u) {
       // Return map: the anchor follows so that −ε_t g_t is the slip shear. The slip it makes,
       // (|τ_trial| − |τ|)/ε_t, against the shear |τ| is the energy the point dissipates.
       step_dissipation_[q] = points_[q].weight * std::abs(s.shear) * (std::abs(s.trial) - std::abs(s.shear)) /
-                             law_.tangential_penalty;
+                             interface_.tangential_penalty;
       step_dissipated_energy_ += step_dissipation_[q];
-      anchor_[q] = g[q].parameter + s.shear / (law_.tangential_penalty * g[q].d1.norm());
+      anchor_[q] = g[q].parameter + s.shear / (interface_.tangential_penalty * g[q].d1.norm());
     } else {
       anchor_[q] = g[q].parameter;  // out of contact (or just touching): stress-free where it is
     }
@@ -325,7 +285,7 @@ Eigen::VectorXd MortarContact::frictional_heat(Eigen::Index node_count) const {
     if (step_dissipation_[q] == 0.0) continue;
     const auto& sp = points_[q];
     for (size_t k = 0; k < sp.nodes.size(); ++k) {
-      heat(sp.nodes[k]) += law_.heat_partition * step_dissipation_[q] * sp.values(static_cast<Eigen::Index>(k));
+      heat(sp.nodes[k]) += interface_.heat_partition * step_dissipation_[q] * sp.values(static_cast<Eigen::Index>(k));
     }
   }
   return heat;
@@ -333,13 +293,11 @@ Eigen::VectorXd MortarContact::frictional_heat(Eigen::Index node_count) const {
 
 bool MortarContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
                         std::string& reason) const {
-  if (law_.needs_shear_strength() && shear_strength_.empty()) {
-    reason = "contact: the interfacial law needs the chip's shear yield stress at the contact (set_shear_strength)";
-    return false;
-  }
-  if (law_.needs_temperature() && surface_temperature_.empty()) {
-    reason = "contact: the interfacial law needs the chip's temperature at the contact (set_surface_temperature)";
-    return false;
+  if (interface_.law->frictional()) {
+    if (const auto missing = missing_point_state()) {
+      reason = *missing;
+      return false;
+    }
   }
   bool ok = true;
   int projections = 0;

@@ -1,6 +1,6 @@
 #pragma once
 // Penalty contact between the chip's top surface and a rigid tool, frictionless or with an interface
-// law (below: Coulomb, shear factor, Zorev, an adhesion table; dry or wetted spots), in the mortar
+// law (interface_laws.hpp; dry or wetted spots), in the mortar
 // knot-to-surface form of seed 000 eq. (14)–(16) (Temizer, Wriggers & Hughes, CMAME 200, 2011;
 // Dimitri et al., CMAME 269, 2014): the normal gap of every surface quadrature point to its closest
 // point on the tool, g = (x_p − x_q)·n_p (positive when the chip penetrates the tool), is averaged
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "micro/contact/adhesion_table.hpp"
+#include "micro/contact/interface_law.hpp"
 #include "micro/solid/solid_problem.hpp"
 #include "micro/spline/closest_point.hpp"
 
@@ -21,11 +21,12 @@ namespace mufric::contact {
 // Penalty factor of seed 000 section 4, Pa/m.
 inline constexpr double kDefaultPenalty = 2e18;
 
-// The interfacial shear at the contact points (scene key contact.law). `frictionless` is seed 000's
-// model (μ from ploughing alone). `coulomb`: |τ| ≤ μ_a P at each contact point, stick regularised by
-// a tangential penalty with a return map (Wriggers, Computational Contact Mechanics, 2nd ed. 2006,
-// §5.2.2; Laursen 2002 §5.3): trial τ = −ε_t g_t from the point's tangential offset g_t to its
-// anchor on the tool, slip when |τ| > μ_a P, the anchor moved at each accepted step.
+// The interfacial shear at the contact points is an InterfaceLaw (interface_laws.hpp: frictionless,
+// Coulomb, shear factor, Zorev, an adhesion table, Childs), asked for each point's slip limit. Stick
+// is regularised by a tangential penalty with a return map (Wriggers, Computational Contact
+// Mechanics, 2nd ed. 2006, §5.2.2; Laursen 2002 §5.3): trial τ = −ε_t g_t from the point's tangential
+// offset g_t to its anchor on the tool, slip when |τ| exceeds the law's limit, the anchor moved at
+// each accepted step.
 // Stick's tangential penalty as a fraction of the normal one: a stuck point's offset τ/ε_t stays
 // sub-nanometre (0.5 nm at τ = 100 MPa, ε = 2e18), and Newton needs a third of the iterations it
 // needs at ε_t = ε (small default scene with μ_a = 0.1: 545 against 1299; μ within 0.6 %).
@@ -40,46 +41,12 @@ inline constexpr double kTangentialPenaltyRatio = 0.1;
 // (~20). The middle of that range is the default; the scene sets it (contact.heat_partition).
 inline constexpr double kDefaultHeatPartition = 0.5;
 
-// `shear-factor`: |τ| ≤ m k, k the chip's shear yield stress at the point (Johnson–Cook /√3, given by
-// the owner through set_shear_strength); `zorev`: |τ| ≤ min(μ_a P, m k), sliding where the pressure is
-// low and sticking to the yield shear where it is high (Zorev 1963, the chip–tool friction model of
-// cutting codes).
-// `table`: |τ| ≤ μ_a(P, v, T) P with μ_a from an AdhesionTable at the point's pressure, the scene's
-// sliding velocity and the chip's temperature there (given by the owner through set_surface_temperature).
-//
-// A contact spot the lubricant reaches (wetted: set by the owner through set_wetted) shears through a
-// boundary film instead of the bare metal junction: its law keeps its kind but takes the wetted
-// coefficients — μ_a for Coulomb, Zorev and the table (a wetted spot's μ_a is the film's constant,
-// the table being the dry junction's), m for shear-factor and Zorev (Williams & Tabor 1977, Wear 43:275,
-// and Williams 1977, J. Mech. Eng. Sci. 19:202: cutting fluids act by reaching the junctions through
-// capillaries and forming boundary films on them).
-// A straight cutting oil between AISI 4140 and a TiN-coated carbide pin brings μ to about 0.1,
-// independent of the sliding velocity, at ~3 GPa (dry: falling with the velocity to about 0.2) —
-// Claudin, Mondelin, Rech & Fromentin 2010, Int. J. Mach. Tools Manuf. 50:681; the boundary-lubrication
-// range of Bowden & Tabor (The Friction and Lubrication of Solids, 1950) brackets it.
-inline constexpr double kDefaultWettedAdhesiveCoefficient = 0.1;
-// Lubricated metal forming's friction factor, m ≈ 0.05–0.3 by ring compression (Kobayashi, Oh & Altan,
-// Metal Forming and the Finite-Element Method, 1989, sec. 5.4; Male & Cockcroft 1964): 0.2 is that of
-// a lubricated steel.
-inline constexpr double kDefaultWettedShearFactor = 0.2;
-struct WettedCoefficients {
-  double adhesive_coefficient = kDefaultWettedAdhesiveCoefficient;  // μ_a at a wetted spot
-  double shear_factor = kDefaultWettedShearFactor;                  // m at a wetted spot
-};
-
-struct InterfaceLaw {
-  enum class Kind { frictionless, coulomb, shear_factor, zorev, table };
-  Kind kind = Kind::frictionless;
-  double adhesive_coefficient = 0.0;  // μ_a (coulomb, zorev)
-  std::shared_ptr<const AdhesionTable> table;  // table
-  double sliding_velocity = 0.0;      // m/s, the table's v (table)
-  double shear_factor = 0.0;          // m (shear-factor, zorev)
-  double tangential_penalty = 0.0;    // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
+// The law and what the contact does around it, whatever the law: stick's regularisation and where
+// the frictional heat goes.
+struct ContactInterface {
+  std::shared_ptr<const InterfaceLaw> law;  // none: frictionless
+  double tangential_penalty = 0.0;          // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
   double heat_partition = kDefaultHeatPartition;  // β: the share of the interface's frictional heat the chip receives
-  // The coefficients at wetted spots (lubricated scenes); none: every spot takes the dry ones.
-  std::optional<WettedCoefficients> wetted;
-  bool needs_shear_strength() const { return kind == Kind::shear_factor || kind == Kind::zorev; }
-  bool needs_temperature() const { return kind == Kind::table; }
 };
 
 // The rigid tool: a curve whose outward normal, for a curve running in +x, points down (−y side),
@@ -104,7 +71,7 @@ struct ContactState {
   std::vector<double> point_x, point_weight, point_pressure, point_shear;
   std::vector<Eigen::Vector2d> point_position, point_normal;
   std::vector<std::optional<double>> point_gap;
-  // Per point, whether it takes the wetted law (set_wetted), and the reference length of the points
+  // Per point, whether it takes the law's wetted coefficients (its PointStateProvider says), and the reference length of the points
   // in contact that do.
   std::vector<char> point_wetted;
   double wetted_contact_length = 0.0;
@@ -114,13 +81,13 @@ class MortarContact final : public solid::BoundaryInteraction {
  public:
   // The chip surface is the patch's top side; `points_per_span` Gauss points per span.
   MortarContact(const solid::IgaSpace& space, RigidTool tool, double penalty = kDefaultPenalty, int points_per_span = 0,
-                InterfaceLaw law = {});
+                ContactInterface contact_interface = {});
 
   std::vector<std::vector<int>> coupled_nodes() const override;
   bool add(const Eigen::VectorXd& u, Eigen::VectorXd& force, solid::TangentAccumulator* tangent,
            std::string& reason) const override;
   // Slip makes the tangent unsymmetric; the frictionless one is symmetric.
-  bool symmetric_tangent() const override { return law_.kind == InterfaceLaw::Kind::frictionless; }
+  bool symmetric_tangent() const override { return !interface_.law->frictional(); }
   // Moves each contact point's anchor to where the accepted state leaves it (stick: kept; slip: the
   // return map's; out of contact: its current foot, so that a new contact starts stress-free).
   // Also adds up the energy each point dissipated by slipping in the step just accepted.
@@ -133,23 +100,17 @@ class MortarContact final : public solid::BoundaryInteraction {
   // The heat the chip receives from the last accepted step's slip, per node of the chip's space
   // (J per unit depth, node_count entries): β w_q D_q distributed with the surface basis R_b.
   Eigen::VectorXd frictional_heat(Eigen::Index node_count) const;
-  // The chip's shear yield stress k at each surface point (Pa, in the order of surface_positions()),
-  // for the laws that use it; held until set again (the owner refreshes it after each accepted step,
-  // so within a step k is that of the last accepted state).
-  void set_shear_strength(std::vector<double> k);
-  // The chip's temperature at each surface point (K, same order), for the table law; held until set again.
-  void set_surface_temperature(std::vector<double> temperature);
-  // Which surface points (same order) the lubricant reaches: those take the law's wetted
-  // coefficients. Held until set again, like k (the owner refreshes it after each accepted step);
-  // an empty vector: none is wetted.
-  void set_wetted(std::vector<char> wetted);
-  bool wetted(size_t point) const { return point < wetted_.size() && wetted_[point] != 0; }
+  // Where each point's state beyond its pressure comes from (the chip's k and T beneath it, whether the
+  // lubricant wets it): needed before the first step by a law whose needs() asks for k or T.
+  void set_point_states(std::shared_ptr<const PointStateProvider> states) { states_ = std::move(states); }
+  bool wetted(size_t point) const { return states_ && states_->state(point).wetted; }
   // Reference position of each surface quadrature point.
   std::vector<Eigen::Vector2d> surface_positions() const;
   ContactState state(const Eigen::VectorXd& u) const;
   const RigidTool& tool() const { return tool_; }
   double penalty() const { return penalty_; }
-  const InterfaceLaw& law() const { return law_; }
+  const InterfaceLaw& law() const { return *interface_.law; }
+  const ContactInterface& contact_interface() const { return interface_; }
 
  private:
   struct SurfacePoint {
@@ -175,9 +136,11 @@ class MortarContact final : public solid::BoundaryInteraction {
     double trial = 0.0;                                     // the trial shear −ε_t g_t, Pa (its slip: |trial| − |τ| over ε_t)
     Eigen::Vector2d shear_gradient = Eigen::Vector2d::Zero();  // stick: ∂τ/∂x
     double slip_sign = 0.0;                                 // slip: τ = slip_sign × the limit
-    double limit_slope = 0.0;  // slip: ∂(limit)/∂P, μ_a (+ P ∂μ_a/∂P for a table); 0 at m k (fixed in a step)
+    double limit_slope = 0.0;  // slip: ∂(limit)/∂P from the law (0 where it does not depend on P in a step)
   };
   PointShear point_shear(size_t q, const PointGap& g, double pressure) const;
+  // Why the law cannot be asked yet (its provider lacks what it needs); none when it can.
+  std::optional<std::string> missing_point_state() const;
   // The tool's unit tangent at a point's foot and its derivative with respect to the point's position.
   static Eigen::Vector2d unit_tangent(const PointGap& g) { return g.d1.normalized(); }
   static Eigen::Matrix2d unit_tangent_gradient(const PointGap& g);
@@ -196,13 +159,11 @@ class MortarContact final : public solid::BoundaryInteraction {
   spline::ProjectionOptions search_window(const Eigen::Vector2d& x) const;
 
   RigidTool tool_;
-  InterfaceLaw law_;
+  ContactInterface interface_;
+  std::shared_ptr<const PointStateProvider> states_;
   // Per surface point, the tool parameter where its tangential offset is zero (committed state);
   // none where the point was not searched at the last commit.
   std::vector<std::optional<double>> anchor_;
-  std::vector<double> shear_strength_;  // k per surface point (shear-factor, zorev)
-  std::vector<double> surface_temperature_;  // T per surface point, K (table)
-  std::vector<char> wetted_;  // per surface point: takes law_.wetted (empty: none does)
   std::vector<double> step_dissipation_;  // per surface point, J/m, in the last accepted step
   double step_dissipated_energy_ = 0.0, dissipated_energy_ = 0.0;
   std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once

@@ -317,8 +317,11 @@ coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_st
 struct LoadedChip {
   std::unique_ptr<solid::SolidProblem> problem;
   std::shared_ptr<contact::MortarContact> contact;
-  // For the interfacial laws that use the chip's shear yield stress: the bulk quadrature point nearest
-  // each contact surface point (reference positions), whose state gives k there.
+  // The contact points' state beyond their pressure, for the interface law: the chip's k and T
+  // beneath each point and whether the lubricant wets it, refreshed after every accepted step.
+  std::shared_ptr<contact::SampledPointStates> point_states;
+  // For the laws that use the chip's state: the bulk quadrature point nearest each contact surface
+  // point (reference positions), whose state gives k and T there.
   std::vector<size_t> surface_quadrature;
 };
 
@@ -338,19 +341,20 @@ void refresh_chip_state_at_contact(const Scene& scene, const LoadedChip& chip) {
                 std::sqrt(3.0));
     temperature.push_back(st.temperature);
   }
-  if (scene.interface_law.needs_shear_strength()) chip.contact->set_shear_strength(std::move(k));
-  if (scene.interface_law.needs_temperature()) chip.contact->set_surface_temperature(std::move(temperature));
+  const contact::PointStateNeeds needs = scene.contact_interface.law->needs();
+  if (needs.shear_strength) chip.point_states->set_shear_strength(std::move(k));
+  if (needs.temperature) chip.point_states->set_temperature(std::move(temperature));
 }
 
 // The contact points the lubricant wets after the last accepted step (their current positions in
 // `contact`, that step's state), for the law's wetted coefficients in the next step — lagged a step
-// like k and T.
+// like k and T. A frictionless law has none: its points report no wetted spot.
 void refresh_wetted_contact(const Scene& scene, const LoadedChip& chip, const coupling::LubricatedChip* lubricant,
                             const contact::ContactState& contact) {
-  if (lubricant == nullptr || !scene.interface_law.wetted) return;
+  if (lubricant == nullptr || !scene.contact_interface.law->frictional()) return;
   std::vector<char> wetted(contact.point_position.size(), 0);
   for (size_t q = 0; q < wetted.size(); ++q) wetted[q] = lubricant->wetted_at(contact.point_position[q].x()) ? 1 : 0;
-  chip.contact->set_wetted(std::move(wetted));
+  chip.point_states->set_wetted(std::move(wetted));
 }
 
 std::vector<size_t> nearest_quadrature_points(const solid::IgaSpace& space, const std::vector<Eigen::Vector2d>& at) {
@@ -393,9 +397,12 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
   solid::SolidProblem& problem = *chip.problem;
   chip.contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
                                                           scene.penalty, scene.contact_points_per_span,
-                                                          scene.interface_law);
+                                                          scene.contact_interface);
+  chip.point_states = std::make_shared<contact::SampledPointStates>(chip.contact->surface_positions().size(),
+                                                                    std::abs(scene.velocity));
+  chip.contact->set_point_states(chip.point_states);
   problem.add_interaction(chip.contact);
-  if (scene.interface_law.needs_shear_strength() || scene.interface_law.needs_temperature()) {
+  if (scene.contact_interface.law->needs().any()) {
     chip.surface_quadrature = nearest_quadrature_points(problem.space(), chip.contact->surface_positions());
     refresh_chip_state_at_contact(scene, chip);
   }
@@ -488,7 +495,7 @@ std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, c
                                                     .specific_heat = scene.material.specific_heat,
                                                     .held_side = numerics::Side::bottom,
                                                     .held_temperature = scene.temperature});
-  const bool frictional = scene.interface_law.kind != contact::InterfaceLaw::Kind::frictionless;
+  const bool frictional = scene.contact_interface.law->frictional();
   o.after_step = [&problem, conduction = heat.get(), contact = chip.contact.get(), frictional](
                      double, double dt, const Eigen::VectorXd& u, std::string& reason) {
     std::vector<solid::MaterialState> states = problem.states();

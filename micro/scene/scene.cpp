@@ -9,6 +9,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/units.hpp"
+#include "micro/contact/interface_laws.hpp"
 
 namespace mufric::scene {
 namespace {
@@ -143,6 +144,114 @@ SurfaceSpec read_surface(Section s, const std::string& base_directory) {
   out.mirror = s.boolean("mirror", false);
   s.finish();
   return out;
+}
+
+// The law's coefficient keys as the scene file spells them (contact.*, contact.wetted.*): reads for
+// contact::LawKeys, with the file, the key and the law named in every error. A law reads only the
+// keys its registry entry declares (a logic error otherwise: the scene's warnings about another
+// law's keys rest on those lists).
+class SceneLawKeys final : public contact::LawKeys {
+ public:
+  SceneLawKeys(Section& contact, Section& wetted, const contact::InterfaceLawEntry& law, const std::string& base_directory)
+      : contact_(contact), wetted_(wetted), law_(law), base_directory_(base_directory) {}
+  double required_number(std::string_view key, double lo, double hi, std::string_view example) override {
+    auto [section, name] = locate(key);
+    require(section, name, example);
+    return section.number(name, 0.0, lo, hi);
+  }
+  double number(std::string_view key, double fallback, double lo, double hi) override {
+    auto [section, name] = locate(key);
+    return section.number(name, fallback, lo, hi);
+  }
+  std::string required_file(std::string_view key, std::string_view example) override {
+    auto [section, name] = locate(key);
+    require(section, name, example);
+    std::string path = section.text(name, "", {});
+    if (std::filesystem::path(path).is_relative()) path = (std::filesystem::path(base_directory_) / path).string();
+    if (!std::filesystem::exists(path)) section.fail(name, "no such file '" + path + "'");
+    return path;
+  }
+  [[noreturn]] void fail(std::string_view key, const std::string& message) override {
+    auto [section, name] = locate(key);
+    section.fail(name, message);
+  }
+
+ private:
+  std::pair<Section&, std::string> locate(std::string_view key) {
+    if (std::find(law_.keys.begin(), law_.keys.end(), key) == law_.keys.end()) {
+      throw std::logic_error("contact law " + std::string(law_.name) + " reads contact." + std::string(key) +
+                             ", which its registry entry does not declare");
+    }
+    if (key.starts_with(kWettedPrefix)) return {wetted_, std::string(key.substr(kWettedPrefix.size()))};
+    return {contact_, std::string(key)};
+  }
+  void require(const Section& section, const std::string& name, std::string_view example) const {
+    if (!section.has(name)) {
+      section.fail(name, "required when contact.law is " + std::string(law_.name) + " (" + std::string(example) + ")");
+    }
+  }
+  static constexpr std::string_view kWettedPrefix = "wetted.";
+  Section& contact_;
+  Section& wetted_;
+  const contact::InterfaceLawEntry& law_;
+  const std::string& base_directory_;
+};
+
+// Another law's key that this one leaves unread is a warning, not an error: switching laws with
+// --set keeps a scene's other coefficients.
+void warn_about_other_laws_keys(Section& contact, Section& wetted, const contact::InterfaceLawEntry& law, Scene& s) {
+  for (const auto& other : contact::interface_laws()) {
+    for (const std::string_view key : other.keys) {
+      if (std::find(law.keys.begin(), law.keys.end(), key) != law.keys.end()) continue;
+      const bool nested = key.starts_with("wetted.");
+      Section& section = nested ? wetted : contact;
+      const std::string name(nested ? key.substr(std::string_view("wetted.").size()) : key);
+      if (!section.has(name)) continue;
+      section.take(name);
+      const std::string warning = "contact." + std::string(key) + " is read but has no effect: contact.law is " +
+                                  std::string(law.name);
+      if (std::find(s.warnings.begin(), s.warnings.end(), warning) == s.warnings.end()) s.warnings.push_back(warning);
+    }
+  }
+}
+
+// contact: the penalty, the interface law (read by its registry entry) and what the contact does
+// around any law (stick's tangential penalty, the heat partition).
+void read_contact(Section c, Scene& s, const std::string& base_directory) {
+  s.penalty = c.number("penalty", s.penalty, 1e3, 1e30);
+  // The interfacial law: frictionless is seed 000's model (μ from ploughing alone) and the default.
+  std::vector<std::string> names;
+  for (const auto& law : contact::interface_laws()) names.emplace_back(law.name);
+  const std::string law_name = c.text("law", names.front(), names);
+  const contact::InterfaceLawEntry& entry = *contact::find_interface_law(law_name);
+  const bool has_wetted = c.has("wetted");
+  Section wetted = c.child("wetted");
+  SceneLawKeys keys(c, wetted, entry, base_directory);
+  contact::ContactInterface& interface = s.contact_interface;
+  interface.law = entry.read(keys);
+  warn_about_other_laws_keys(c, wetted, entry, s);
+  wetted.finish();
+  const bool frictional = interface.law->frictional();
+  for (const char* key : {"tangential_penalty", "heat_partition"}) {
+    if (!frictional && c.has(key)) {
+      s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is " + law_name);
+    }
+  }
+  // Stick's regularisation: a tenth of the normal penalty by default (contact::kTangentialPenaltyRatio).
+  interface.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
+  // The share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
+  interface.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, 0.0, 1.0);
+  // Wetted spots take the law's wetted coefficients (contact::kDefaultWetted* say where the defaults
+  // come from); only a lubricated scene has a film to wet them.
+  if (has_wetted && frictional && s.physics != Physics::lubricated) {
+    s.warnings.push_back("contact.wetted is read but has no effect: the scene's physics is dry (no film wets a spot)");
+  }
+  if (frictional && !s.heat_conduction()) {
+    s.warnings.push_back("the frictional heat of contact.law " + law_name +
+                         " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in "
+                         "through the surface)");
+  }
+  c.finish();
 }
 
 }  // namespace
@@ -339,81 +448,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
     l.coupling_restarts = f.integer("coupling_restarts", l.coupling_restarts, 0, 100);
     f.finish();
   }
-  {
-    Section c = root.child("contact");
-    s.penalty = c.number("penalty", s.penalty, 1e3, 1e30);
-    // The interfacial law: frictionless is seed 000's model (μ from ploughing alone) and the default.
-    contact::InterfaceLaw& law = s.interface_law;
-    law.kind = c.choice("law", law.kind);
-    using Kind = contact::InterfaceLaw::Kind;
-    std::string law_name;
-    for (const auto& choice : SceneChoice<Kind>::names) {
-      if (choice.value == law.kind) law_name = choice.name;
-    }
-    const bool uses_mu = law.kind == Kind::coulomb || law.kind == Kind::zorev;
-    const bool uses_m = law.kind == Kind::shear_factor || law.kind == Kind::zorev;
-    if (uses_mu && !c.has("adhesive_coefficient")) {
-      c.fail("adhesive_coefficient", "required when contact.law is " + law_name + " (the interfacial mu_a, e.g. 0.1)");
-    }
-    const bool uses_table = law.kind == Kind::table;
-    if (uses_table && !c.has("table")) {
-      c.fail("table", "required when contact.law is table (a CSV of contact_pressure, sliding_velocity, temperature "
-                      "and mu_a over a full grid)");
-    }
-    if (c.has("table")) {
-      std::string path = c.text("table", "", {});
-      if (std::filesystem::path(path).is_relative()) path = (std::filesystem::path(base_directory) / path).string();
-      if (uses_table && !std::filesystem::exists(path)) c.fail("table", "no such file '" + path + "'");
-      try {
-        if (uses_table) law.table = std::make_shared<const contact::AdhesionTable>(contact::AdhesionTable::read(path));
-      } catch (const Error& e) {
-        c.fail("table", e.what());
-      }
-    }
-    law.sliding_velocity = std::abs(s.velocity);  // the table's v: the chip slides under the tool at it
-    if (uses_m && !c.has("shear_factor")) {
-      c.fail("shear_factor", "required when contact.law is " + law_name + " (m in tau = m k, 0 to 1, e.g. 0.5)");
-    }
-    const std::vector<std::pair<const char*, bool>> used = {
-        {"adhesive_coefficient", uses_mu},
-        {"shear_factor", uses_m},
-        {"table", uses_table},
-        {"tangential_penalty", law.kind != Kind::frictionless},
-        {"heat_partition", law.kind != Kind::frictionless}};
-    for (const auto& [key, in_use] : used) {
-      if (!in_use && c.has(key)) {
-        s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is " + law_name);
-      }
-    }
-    law.adhesive_coefficient = c.number("adhesive_coefficient", 0.0, 0.0, 5.0);
-    law.shear_factor = c.number("shear_factor", 0.0, 0.0, 1.0);
-    // Stick's regularisation: a tenth of the normal penalty by default (contact::kTangentialPenaltyRatio).
-    law.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
-    // The share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
-    law.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, 0.0, 1.0);
-    // Wetted spots (lubricated scenes with a frictional law): the law's coefficients where the film
-    // reaches a contact spot; the defaults are contact::kDefaultWetted* (their sources are there).
-    const bool wets = law.kind != Kind::frictionless && s.physics == Physics::lubricated;
-    if (c.has("wetted") && !wets) {
-      s.warnings.push_back(std::string("contact.wetted is read but has no effect: ") +
-                           (law.kind == Kind::frictionless ? "contact.law is frictionless"
-                                                           : "the scene's physics is dry (no film wets a spot)"));
-    }
-    {
-      Section w = c.child("wetted");
-      contact::WettedCoefficients wetted;
-      wetted.adhesive_coefficient = w.number("adhesive_coefficient", wetted.adhesive_coefficient, 0.0, 5.0);
-      wetted.shear_factor = w.number("shear_factor", wetted.shear_factor, 0.0, 1.0);
-      w.finish();
-      if (wets) law.wetted = wetted;
-    }
-    if (law.kind != Kind::frictionless && !s.heat_conduction()) {
-      s.warnings.push_back("the frictional heat of contact.law " + law_name +
-                           " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in "
-                           "through the surface)");
-    }
-    c.finish();
-  }
+  read_contact(root.child("contact"), s, base_directory);
   {
     Section v = root.child("solver");
     s.relative_tolerance = v.number("relative_tolerance", s.relative_tolerance, 1e-15, 1e-2);

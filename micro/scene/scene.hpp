@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "micro/contact/interface_laws.hpp"
 #include "micro/contact/mortar_contact.hpp"
 #include "micro/coupling/lubricated_chip.hpp"
 #include "micro/fluid/navier_stokes.hpp"
@@ -194,7 +195,8 @@ struct Scene {
   LubricantSpec lubricant;
   // contact
   double penalty = 2e18;              // Pa/m
-  contact::InterfaceLaw interface_law;  // frictionless unless contact.law says otherwise
+  // The interface law (frictionless unless contact.law says otherwise), stick's penalty, the heat partition.
+  contact::ContactInterface contact_interface{.law = std::make_shared<contact::FrictionlessLaw>()};
   // solver
   double relative_tolerance = 1e-9;
   int max_newton_iterations = 30;
@@ -243,15 +245,6 @@ template <>
 struct SceneChoice<numerics::LinearSolverKind> {
   static constexpr std::array<NamedChoice<numerics::LinearSolverKind>, 2> names{
       {{"lu", numerics::LinearSolverKind::lu}, {"cholesky", numerics::LinearSolverKind::cholesky}}};
-};
-template <>
-struct SceneChoice<contact::InterfaceLaw::Kind> {
-  static constexpr std::array<NamedChoice<contact::InterfaceLaw::Kind>, 5> names{
-      {{"frictionless", contact::InterfaceLaw::Kind::frictionless},
-       {"coulomb", contact::InterfaceLaw::Kind::coulomb},
-       {"shear-factor", contact::InterfaceLaw::Kind::shear_factor},
-       {"zorev", contact::InterfaceLaw::Kind::zorev},
-       {"table", contact::InterfaceLaw::Kind::table}}};
 };
 template <>
 struct SceneChoice<Compressibility> {
