@@ -21,8 +21,8 @@
 #include "common/units.hpp"
 #include "common/version.hpp"
 #include "common/wording.hpp"
-#include "micro/scene/dataset_sample.hpp"
-#include "micro/scene/micro_run.hpp"
+#include "micro/run/dataset_sample.hpp"
+#include "micro/run/measurement.hpp"
 #include "surrogate/accuracy.hpp"
 #include "surrogate/sampling.hpp"
 
@@ -67,7 +67,7 @@ void plan_command(const PlanOptions& o) {
     if (text != o.ranges.end() && !text->second.empty()) std::tie(input.lo, input.hi) = parse_range(text->second, input.kind(), flag);
   }
   const scene::Scene sc = scene::load_scene(o.scene_path, o.overrides);
-  scene::micro_evaluator(sc, box, 1);  // refuses a scene the dataset cannot drive, before anything is written
+  run::micro_evaluator(sc, box, 1);  // refuses a scene the dataset cannot drive, before anything is written
   const PlanDesign design = parse_plan_design(o.design);
   Dataset spec;
   spec.inputs = box;
@@ -146,7 +146,7 @@ void run_command(const RunOptions& o) {
   plan.scene_json = sc.effective.dump(2);
 
   const int threads = threads_per_job(o.jobs, o.threads);
-  const SampleEvaluator evaluate = scene::micro_evaluator(sc, plan.inputs, threads, o.sample_timeout);
+  const SampleEvaluator evaluate = run::micro_evaluator(sc, plan.inputs, threads, o.sample_timeout);
   GenerationOptions options;
   options.shard = parse_shard(o.shard);
   options.jobs = o.jobs;
@@ -177,7 +177,7 @@ void refine_command(const RefineCommandOptions& c) {
   // The samples: the micro-model with the database's scene, on the (possibly grown) box's inputs.
   o.make_evaluator = [&c](const Dataset& db) {
     const scene::Scene sc = run_scene("", {}, db, c.refine.db);
-    return scene::micro_evaluator(sc, db.inputs, threads_per_job(c.refine.jobs, c.threads), c.sample_timeout);
+    return run::micro_evaluator(sc, db.inputs, threads_per_job(c.refine.jobs, c.threads), c.sample_timeout);
   };
   o.on_box = [&o](const BoxGrowth& g) {
     if (!g.grown) {

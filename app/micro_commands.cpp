@@ -16,7 +16,7 @@
 #include "common/units.hpp"
 #include "common/wording.hpp"
 #include "micro/fluid/cavity.hpp"
-#include "micro/scene/micro_run.hpp"
+#include "micro/run/measurement.hpp"
 #include "micro/spline/profile.hpp"
 
 namespace mufric::app {
@@ -142,7 +142,7 @@ std::string mu_text(const std::optional<double>& mu) {
 class Progress {
  public:
   explicit Progress(size_t draws) : last_(draws, std::chrono::steady_clock::time_point{}) {}
-  void operator()(int draw, const scene::MicroStep& s, const scene::Scene& sc) {
+  void operator()(int draw, const run::MicroStep& s, const scene::Scene& sc) {
     const auto now = std::chrono::steady_clock::now();
     auto& last = last_[static_cast<size_t>(draw)];
     const size_t draws = last_.size();
@@ -170,7 +170,7 @@ std::string relative_percent(double value, double mu) {
   return text;
 }
 
-void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
+void print_summary(const run::MuMeasurement& m, const scene::Scene& sc) {
   const scene::ProtocolSpec& q = sc.protocol;
   if (m.completed && q.name == scene::Protocol::seed000) {
     const auto& r = m.draws.front().result;
@@ -240,12 +240,12 @@ void print_summary(const scene::MuMeasurement& m, const scene::Scene& sc) {
 int run_command(const RunCommandOptions& o) {
   const scene::Scene sc = load_scene(o);
   std::filesystem::create_directories(o.out);
-  scene::MeasureOptions options;
+  run::MeasureOptions options;
   options.vtu_directory = o.out;
-  Progress progress(scene::protocol_draws(sc).size());
+  Progress progress(run::protocol_draws(sc).size());
   if (!o.quiet) options.on_step = std::ref(progress);
   for (const auto& w : sc.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  scene::MuMeasurement m = scene::measure_mu(sc, options);
+  run::MuMeasurement m = run::measure_mu(sc, options);
   m.advisories.insert(m.advisories.begin(), sc.warnings.begin(), sc.warnings.end());
   write_file_atomically(o.out + "/result.json", m.to_json(sc).dump(2) + "\n");
   print_summary(m, sc);
@@ -267,7 +267,7 @@ void run_check(const RunCommandOptions& o) {
               "has %.3g GB\n", cost.memory_lower_bound_bytes / 1e6, scene::physical_memory_bytes() / 1e9);
   std::printf("  %s per measurement; the default scene takes about 30 s per draw on one core here, and a step's "
               "cost grows faster than the unknowns\n",
-              count_of(static_cast<long long>(scene::protocol_draws(sc).size()), "draw", "draws").c_str());
+              count_of(static_cast<long long>(run::protocol_draws(sc).size()), "draw", "draws").c_str());
   for (const auto& w : sc.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
@@ -309,7 +309,7 @@ int converge_command(const RunCommandOptions& o) {
   std::printf("| level | %s | dofs | mu | std error | change | wall [s] |\n|---|---|---|---|---|---|---|\n", what);
   std::optional<double> previous;
   for (int level = 0; level <= o.max_levels; ++level) {
-    const scene::MuMeasurement m = scene::measure_mu(sc);
+    const run::MuMeasurement m = run::measure_mu(sc);
     const auto& r = m.draws.front().result;
     if (!m.completed) {
       std::printf("| %d | %s | %d | failed | | | %.2f |\n", level, level_setting(sc, o.parameter).c_str(), r.dofs, m.wall_seconds);

@@ -5,13 +5,13 @@
 
 #include <string>
 
-#include "micro/scene/micro_run.hpp"
+#include "micro/run/measurement.hpp"
 
 namespace mufric::scene::test {
 
 // μ of a scene given as JSON, with the test failed (not stopped) when the measurement did not complete.
-inline MuMeasurement measure(const nlohmann::json& j, const std::string& name) {
-  MuMeasurement m = measure_mu(parse_scene(j, name));
+inline run::MuMeasurement measure(const nlohmann::json& j, const std::string& name) {
+  run::MuMeasurement m = run::measure_mu(parse_scene(j, name));
   EXPECT_TRUE(m.completed) << name << ": " << m.reason;
   return m;
 }

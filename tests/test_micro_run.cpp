@@ -13,11 +13,12 @@
 
 #include "common/error.hpp"
 #include "micro/coupling/partitioned.hpp"
-#include "micro/scene/dataset_sample.hpp"
-#include "micro/scene/micro_run.hpp"
+#include "micro/run/dataset_sample.hpp"
+#include "micro/run/measurement.hpp"
 #include "scene_test_support.hpp"
 
 namespace mufric::scene {
+using namespace mufric::run;  // the run and the measurement of the scenes these tests build
 namespace {
 
 using test::measure;

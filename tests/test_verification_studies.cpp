@@ -15,10 +15,11 @@
 #include <utility>
 #include <vector>
 
-#include "micro/scene/micro_run.hpp"
+#include "micro/run/measurement.hpp"
 #include "scene_test_support.hpp"
 
 namespace mufric::scene {
+using namespace mufric::run;  // the run and the measurement of the scenes these tests build
 namespace {
 
 using test::measure;

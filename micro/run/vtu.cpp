@@ -1,11 +1,11 @@
-#include "micro/scene/vtu.hpp"
+#include "micro/run/vtu.hpp"
 
 #include <iomanip>
 #include <sstream>
 
 #include "common/files.hpp"
 
-namespace mufric::scene {
+namespace mufric::run {
 namespace {
 
 constexpr int kSamplesPerElement = 4;  // sub-cells per element and direction
@@ -169,4 +169,4 @@ void write_contact_csv(const std::string& path, const contact::ContactState& con
   write_file_atomically(path, out.str());
 }
 
-}  // namespace mufric::scene
+}  // namespace mufric::run

@@ -1,13 +1,14 @@
-#include "micro/scene/dataset_sample.hpp"
+#include "micro/run/dataset_sample.hpp"
 
 #include <limits>
 
 #include <omp.h>
 
 #include "common/error.hpp"
-#include "micro/scene/micro_run.hpp"
+#include "micro/run/measurement.hpp"
 
-namespace mufric::scene {
+namespace mufric::run {
+using namespace scene;
 
 SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, int threads_per_sample,
                                 double sample_wall_seconds) {
@@ -63,4 +64,4 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
   };
 }
 
-}  // namespace mufric::scene
+}  // namespace mufric::run

@@ -8,7 +8,7 @@
 #include "micro/contact/mortar_contact.hpp"
 #include "micro/fluid/navier_stokes.hpp"
 
-namespace mufric::scene {
+namespace mufric::run {
 
 void write_chip_vtu(const std::string& path, const solid::SolidProblem& problem, const Eigen::VectorXd& u,
                     const contact::ContactState& contact);
@@ -21,4 +21,4 @@ void write_tool_vtu(const std::string& path, const spline::SplineCurve& tool);
 // tool's unit tangent t = (−normal_y, normal_x); Σ weight · traction is eq. 17's force on the chip.
 void write_contact_csv(const std::string& path, const contact::ContactState& contact);
 
-}  // namespace mufric::scene
+}  // namespace mufric::run
