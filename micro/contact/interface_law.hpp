@@ -55,6 +55,8 @@ class InterfaceLaw {
   virtual PointStateNeeds needs() const { return {}; }
   // Asked only where the point is in contact (P > 0) and the law is frictional.
   virtual SlipLimit slip_limit(const ContactPointState& point) const = 0;
+  // The same law with the same coefficients (two scenes read alike compare equal).
+  virtual bool same_as(const InterfaceLaw& other) const { return name() == other.name(); }
 };
 
 // Where a contact point's state comes from (the chip under it, the lubricant around it). Points are

@@ -28,6 +28,11 @@ CoefficientLaw::CoefficientLaw(LawCoefficients dry, LawCoefficients wetted) : dr
   check_coefficient(wetted_.shear_factor, kShearFactorRange, "wetted shear factor");
 }
 
+bool CoefficientLaw::same_as(const InterfaceLaw& other) const {
+  const auto* o = dynamic_cast<const CoefficientLaw*>(&other);
+  return o != nullptr && name() == other.name() && dry_ == o->dry_ && wetted_ == o->wetted_;
+}
+
 CoulombLaw::CoulombLaw(double adhesive_coefficient, double wetted_adhesive_coefficient)
     : CoefficientLaw({.adhesive_coefficient = adhesive_coefficient}, {.adhesive_coefficient = wetted_adhesive_coefficient}) {}
 
@@ -57,6 +62,11 @@ TableLaw::TableLaw(std::shared_ptr<const AdhesionTable> table, double wetted_adh
   if (!table_) throw Error("contact: the table law needs its adhesion table");
 }
 
+bool TableLaw::same_as(const InterfaceLaw& other) const {
+  const auto* o = dynamic_cast<const TableLaw*>(&other);
+  return o != nullptr && CoefficientLaw::same_as(other) && table_->source() == o->table_->source();
+}
+
 SlipLimit TableLaw::slip_limit(const ContactPointState& point) const {
   if (point.wetted) {
     const double mu = wetted().adhesive_coefficient;
@@ -69,6 +79,11 @@ SlipLimit TableLaw::slip_limit(const ContactPointState& point) const {
 ChildsLaw::ChildsLaw(LawCoefficients dry, double exponent, LawCoefficients wetted)
     : CoefficientLaw(dry, wetted), exponent_(exponent) {
   check_coefficient(exponent_, kChildsExponentRange, "Childs exponent");
+}
+
+bool ChildsLaw::same_as(const InterfaceLaw& other) const {
+  const auto* o = dynamic_cast<const ChildsLaw*>(&other);
+  return o != nullptr && CoefficientLaw::same_as(other) && exponent_ == o->exponent_;
 }
 
 SlipLimit ChildsLaw::slip_limit(const ContactPointState& point) const {

@@ -41,6 +41,7 @@ inline constexpr double kDefaultWettedShearFactor = 0.2;
 struct LawCoefficients {
   double adhesive_coefficient = 0.0;  // μ_a
   double shear_factor = 0.0;          // m
+  bool operator==(const LawCoefficients&) const = default;
 };
 inline constexpr LawCoefficients kDefaultWettedCoefficients{kDefaultWettedAdhesiveCoefficient, kDefaultWettedShearFactor};
 
@@ -57,6 +58,7 @@ class CoefficientLaw : public InterfaceLaw {
  public:
   const LawCoefficients& dry() const { return dry_; }
   const LawCoefficients& wetted() const { return wetted_; }
+  bool same_as(const InterfaceLaw& other) const override;
 
  protected:
   CoefficientLaw(LawCoefficients dry, LawCoefficients wetted);
@@ -102,6 +104,7 @@ class TableLaw final : public CoefficientLaw {
   std::string_view name() const override { return "table"; }
   PointStateNeeds needs() const override { return {.temperature = true}; }
   SlipLimit slip_limit(const ContactPointState& point) const override;
+  bool same_as(const InterfaceLaw& other) const override;
   const AdhesionTable& table() const { return *table_; }
 
  private:
@@ -119,6 +122,7 @@ class ChildsLaw final : public CoefficientLaw {
   std::string_view name() const override { return "childs"; }
   PointStateNeeds needs() const override { return {.shear_strength = true}; }
   SlipLimit slip_limit(const ContactPointState& point) const override;
+  bool same_as(const InterfaceLaw& other) const override;
   double exponent() const { return exponent_; }
 
  private:

@@ -47,6 +47,10 @@ struct ContactInterface {
   std::shared_ptr<const InterfaceLaw> law;  // none: frictionless
   double tangential_penalty = 0.0;          // ε_t, Pa/m; 0: kTangentialPenaltyRatio × the normal penalty
   double heat_partition = kDefaultHeatPartition;  // β: the share of the interface's frictional heat the chip receives
+  bool operator==(const ContactInterface& o) const {
+    const bool same_law = law && o.law ? law->same_as(*o.law) : law == o.law;
+    return same_law && tangential_penalty == o.tangential_penalty && heat_partition == o.heat_partition;
+  }
 };
 
 // The rigid tool: a curve whose outward normal, for a curve running in +x, points down (−y side),

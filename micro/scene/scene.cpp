@@ -133,15 +133,15 @@ SurfaceSpec read_surface(Section s, const std::string& base_directory) {
     out.synthetic.correlation_length =
         g.quantity("correlation_length", QuantityKind::length, out.synthetic.correlation_length, 1e-12, 1e-2);
     out.synthetic.samples = g.integer("samples", out.synthetic.samples, 16, 1 << 20);
-    out.synthetic.seed = static_cast<std::uint64_t>(g.integer("seed", 1, 0, 2147483647));
+    out.synthetic.seed = static_cast<std::uint64_t>(g.integer("seed", static_cast<int>(out.synthetic.seed), 0, 2147483647));
     g.finish();
   }
   Section fit = s.child("fit");
   out.degree = fit.integer("degree", out.degree, 1, spline::kMaxDegree);
   out.control_points = fit.integer("control_points", out.control_points, 4, 100000);
   fit.finish();
-  out.shift_fraction = s.number("shift", 0.0, -1.0, 1.0);
-  out.mirror = s.boolean("mirror", false);
+  out.shift_fraction = s.number("shift", out.shift_fraction, -1.0, 1.0);
+  out.mirror = s.boolean("mirror", out.mirror);
   s.finish();
   return out;
 }
@@ -297,174 +297,177 @@ void apply_override(nlohmann::json& scene, const std::string& assignment) {
   }
 }
 
-Scene parse_scene(const nlohmann::json& j, const std::string& source, const std::string& base_directory) {
-  Scene s;
-  s.source = source;
-  s.effective = j;
-  Section root(j, "", source);
-  s.physics = root.choice("physics", s.physics);
-  {
-    Section g = root.child("geometry");
-    s.interval = g.quantity("interval", QuantityKind::length, s.interval, 1e-9, 1e-2);
-    s.chip_height = g.quantity("chip_height", QuantityKind::length, s.chip_height, 1e-9, 1e-2);
-    s.initial_gap = g.quantity("initial_gap", QuantityKind::length, s.initial_gap, 0.0, 1e-3);
-    if (!g.has("chip_surface")) g.fail("chip_surface", "missing");
-    if (!g.has("tool_surface")) g.fail("tool_surface", "missing");
-    s.chip_surface = read_surface(g.child("chip_surface"), base_directory);
-    s.tool_surface = read_surface(g.child("tool_surface"), base_directory);
-    g.finish();
+namespace {
+
+// geometry: the periodic interval, the chip height, the initial gap and the two surfaces.
+void read_geometry(Section g, Scene& s, const std::string& base_directory) {
+  s.interval = g.quantity("interval", QuantityKind::length, s.interval, 1e-9, 1e-2);
+  s.chip_height = g.quantity("chip_height", QuantityKind::length, s.chip_height, 1e-9, 1e-2);
+  s.initial_gap = g.quantity("initial_gap", QuantityKind::length, s.initial_gap, 0.0, 1e-3);
+  if (!g.has("chip_surface")) g.fail("chip_surface", "missing");
+  if (!g.has("tool_surface")) g.fail("tool_surface", "missing");
+  s.chip_surface = read_surface(g.child("chip_surface"), base_directory);
+  s.tool_surface = read_surface(g.child("tool_surface"), base_directory);
+  g.finish();
+}
+
+// discretisation: the chip's IGA patch.
+void read_discretisation(Section d, Scene& s) {
+  s.degree = d.integer("degree", s.degree, 1, 6);
+  s.elements_x = d.integer("elements_x", s.elements_x, 4, 100000);
+  s.elements_y = d.integer("elements_y", s.elements_y, 1, 100000);
+  s.grading = d.number("grading", s.grading, 1.0, 6.0);
+  s.volumetric = d.choice("volumetric", s.volumetric);
+  s.contact_points_per_span = d.integer("contact_points_per_span", s.contact_points_per_span, 0, 20);
+  d.finish();
+}
+
+// material: Johnson–Cook and the thermal constants (seed 000 Table 1).
+void read_material(Section m, Scene& s) {
+  auto& p = s.material;
+  p.youngs_modulus = m.quantity("youngs_modulus", QuantityKind::pressure, p.youngs_modulus, 1e6, 1e13);
+  p.poisson_ratio = m.number("poisson_ratio", p.poisson_ratio, -0.99, 0.499);
+  p.density = m.number("density", p.density, 1.0, 1e5);
+  p.a = m.quantity("a", QuantityKind::pressure, p.a, 1.0, 1e11);
+  p.b = m.quantity("b", QuantityKind::pressure, p.b, 0.0, 1e11);
+  p.c = m.number("c", p.c, 0.0, 10.0);
+  p.n = m.number("n", p.n, 0.0, 5.0);
+  p.m = m.number("m", p.m, 0.01, 10.0);
+  p.reference_strain_rate = m.number("reference_strain_rate", p.reference_strain_rate, 1e-12, 1e12);
+  p.transition_temperature = m.quantity("transition_temperature", QuantityKind::temperature, p.transition_temperature, 0.0, 1e4);
+  p.melting_temperature = m.quantity("melting_temperature", QuantityKind::temperature, p.melting_temperature, 1.0, 1e4);
+  if (!(p.melting_temperature > p.transition_temperature)) m.fail("melting_temperature", "must exceed transition_temperature");
+  p.specific_heat = m.number("specific_heat", p.specific_heat, 1.0, 1e5);
+  p.heat_fraction = m.number("heat_fraction", p.heat_fraction, 0.0, 1.0);
+  m.finish();
+}
+
+// load: what drives Γ_B: a pressure or a vertical displacement, the sliding velocity, the temperature, the ramp.
+void read_load(Section l, Scene& s) {
+  if (l.has("pressure") == l.has("vertical_displacement")) {
+    l.fail("", "give exactly one of pressure or vertical_displacement");
   }
-  {
-    Section d = root.child("discretisation");
-    s.degree = d.integer("degree", s.degree, 1, 6);
-    s.elements_x = d.integer("elements_x", s.elements_x, 4, 100000);
-    s.elements_y = d.integer("elements_y", s.elements_y, 1, 100000);
-    s.grading = d.number("grading", s.grading, 1.0, 6.0);
-    s.volumetric = d.choice("volumetric", s.volumetric);
-    s.contact_points_per_span = d.integer("contact_points_per_span", s.contact_points_per_span, 0, 20);
-    d.finish();
-  }
-  {
-    Section m = root.child("material");
-    auto& p = s.material;
-    p.youngs_modulus = m.quantity("youngs_modulus", QuantityKind::pressure, p.youngs_modulus, 1e6, 1e13);
-    p.poisson_ratio = m.number("poisson_ratio", p.poisson_ratio, -0.99, 0.499);
-    p.density = m.number("density", p.density, 1.0, 1e5);
-    p.a = m.quantity("a", QuantityKind::pressure, p.a, 1.0, 1e11);
-    p.b = m.quantity("b", QuantityKind::pressure, p.b, 0.0, 1e11);
-    p.c = m.number("c", p.c, 0.0, 10.0);
-    p.n = m.number("n", p.n, 0.0, 5.0);
-    p.m = m.number("m", p.m, 0.01, 10.0);
-    p.reference_strain_rate = m.number("reference_strain_rate", p.reference_strain_rate, 1e-12, 1e12);
-    p.transition_temperature = m.quantity("transition_temperature", QuantityKind::temperature, p.transition_temperature, 0.0, 1e4);
-    p.melting_temperature = m.quantity("melting_temperature", QuantityKind::temperature, p.melting_temperature, 1.0, 1e4);
-    if (!(p.melting_temperature > p.transition_temperature)) m.fail("melting_temperature", "must exceed transition_temperature");
-    p.specific_heat = m.number("specific_heat", p.specific_heat, 1.0, 1e5);
-    p.heat_fraction = m.number("heat_fraction", p.heat_fraction, 0.0, 1.0);
-    m.finish();
-  }
-  {
-    Section l = root.child("load");
-    if (l.has("pressure") == l.has("vertical_displacement")) {
-      l.fail("", "give exactly one of pressure or vertical_displacement");
+  s.pressure_controlled = l.has("pressure");
+  // Physical ranges from the one table every command checks (common/units.hpp).
+  const PhysicalRange pressures = physical_range(QuantityKind::pressure);
+  const PhysicalRange speeds = physical_range(QuantityKind::velocity);
+  const PhysicalRange temperatures = physical_range(QuantityKind::temperature);
+  s.pressure = l.quantity("pressure", QuantityKind::pressure, s.pressure, pressures.lo, pressures.hi);
+  s.vertical_displacement = l.quantity("vertical_displacement", QuantityKind::length, s.vertical_displacement, -1e-3, 1e-3);
+  s.velocity = l.quantity("velocity", QuantityKind::velocity, s.velocity, -speeds.hi, speeds.hi);  // signed: direction
+  s.temperature = l.quantity("temperature", QuantityKind::temperature, s.temperature, temperatures.lo, temperatures.hi);
+  s.ramp = l.quantity("ramp", QuantityKind::time, s.ramp, 0.0, 1.0);
+  l.finish();
+}
+
+// time: the time integration and seed 000's averaging window.
+void read_time(Section t, Scene& s) {
+  s.scheme = t.choice("scheme", s.scheme);
+  s.spectral_radius = t.number("spectral_radius", s.spectral_radius, 0.0, 1.0);
+  s.dt = t.quantity("step", QuantityKind::time, s.dt, 1e-15, 1.0);
+  s.duration = t.quantity("duration", QuantityKind::time, s.duration, 1e-15, 10.0);
+  if (s.dt > s.duration) t.fail("step", "is longer than the duration");
+  s.max_dt = t.quantity("max_step", QuantityKind::time, s.dt, 1e-15, 1.0);
+  if (s.max_dt < s.dt) t.fail("max_step", "is shorter than time.step");
+  s.average_from = t.quantity("average_from", QuantityKind::time, 0.5 * s.duration, 0.0, kHuge);
+  if (s.average_from >= s.duration) t.fail("average_from", "must lie before the end of the run");
+  t.finish();
+}
+
+// protocol: what μ means (README "What μ means"): press-slide or seed 000's, and the draws.
+void read_protocol(Section p, Scene& s) {
+  auto& q = s.protocol;
+  q.name = p.choice("name", q.name);
+  q.press_hold = p.quantity("press_hold", QuantityKind::time, q.press_hold, 0.0, 1.0);
+  q.run_in = p.quantity("run_in", QuantityKind::length, q.run_in, 0.0, 1.0);
+  q.window = p.quantity("window", QuantityKind::length, q.window, 1e-12, 1.0);
+  q.step_distance = p.quantity("step_distance", QuantityKind::length, q.step_distance, 1e-12, 1.0);
+  q.phases = p.integer("phases", q.phases, 1, 1024);
+  q.realisations = p.integer("realisations", q.realisations, 1, 1024);
+  q.blocks = p.integer("blocks", q.blocks, 1, 100);
+  if (q.name == Protocol::press_slide) {
+    if (s.velocity == 0.0) p.fail("name", "press-slide averages over a sliding distance: load.velocity must not be zero");
+    if (s.scheme != solid::TimeScheme::generalized_alpha && s.pressure_controlled) {
+      p.fail("name", "press-slide under a pressure presses dynamically (the chip's inertia holds it until the contact "
+                     "closes): time.scheme must be generalized-alpha, or load the chip by vertical_displacement");
     }
-    s.pressure_controlled = l.has("pressure");
-    // Physical ranges from the one table every command checks (common/units.hpp).
-    const PhysicalRange pressures = physical_range(QuantityKind::pressure);
-    const PhysicalRange speeds = physical_range(QuantityKind::velocity);
-    const PhysicalRange temperatures = physical_range(QuantityKind::temperature);
-    s.pressure = l.quantity("pressure", QuantityKind::pressure, s.pressure, pressures.lo, pressures.hi);
-    s.vertical_displacement = l.quantity("vertical_displacement", QuantityKind::length, 0.0, -1e-3, 1e-3);
-    s.velocity = l.quantity("velocity", QuantityKind::velocity, s.velocity, -speeds.hi, speeds.hi);  // signed: direction
-    s.temperature = l.quantity("temperature", QuantityKind::temperature, s.temperature, temperatures.lo, temperatures.hi);
-    s.ramp = l.quantity("ramp", QuantityKind::time, s.ramp, 0.0, 1.0);
-    l.finish();
-  }
-  {
-    Section t = root.child("time");
-    s.scheme = t.choice("scheme", s.scheme);
-    s.spectral_radius = t.number("spectral_radius", s.spectral_radius, 0.0, 1.0);
-    s.dt = t.quantity("step", QuantityKind::time, s.dt, 1e-15, 1.0);
-    s.duration = t.quantity("duration", QuantityKind::time, s.duration, 1e-15, 10.0);
-    if (s.dt > s.duration) t.fail("step", "is longer than the duration");
-    s.max_dt = t.quantity("max_step", QuantityKind::time, s.dt, 1e-15, 1.0);
-    if (s.max_dt < s.dt) t.fail("max_step", "is shorter than time.step");
-    s.average_from = t.quantity("average_from", QuantityKind::time, 0.5 * s.duration, 0.0, kHuge);
-    if (s.average_from >= s.duration) t.fail("average_from", "must lie before the end of the run");
-    t.finish();
-  }
-  {
-    Section p = root.child("protocol");
-    auto& q = s.protocol;
-    q.name = p.choice("name", q.name);
-    q.press_hold = p.quantity("press_hold", QuantityKind::time, q.press_hold, 0.0, 1.0);
-    q.run_in = p.quantity("run_in", QuantityKind::length, q.run_in, 0.0, 1.0);
-    q.window = p.quantity("window", QuantityKind::length, q.window, 1e-12, 1.0);
-    q.step_distance = p.quantity("step_distance", QuantityKind::length, q.step_distance, 1e-12, 1.0);
-    q.phases = p.integer("phases", q.phases, 1, 1024);
-    q.realisations = p.integer("realisations", q.realisations, 1, 1024);
-    q.blocks = p.integer("blocks", q.blocks, 1, 100);
-    if (q.name == Protocol::press_slide) {
-      if (s.velocity == 0.0) p.fail("name", "press-slide averages over a sliding distance: load.velocity must not be zero");
-      if (s.scheme != solid::TimeScheme::generalized_alpha && s.pressure_controlled) {
-        p.fail("name", "press-slide under a pressure presses dynamically (the chip's inertia holds it until the contact "
-                       "closes): time.scheme must be generalized-alpha, or load the chip by vertical_displacement");
-      }
-      if (q.realisations > 1 && !s.tool_surface.is_synthetic()) {
-        p.fail("realisations", "realisations redraw a synthetic tool with other seeds; this tool is " +
-                                   std::string(s.tool_surface.flat ? "flat" : "a measured profile") +
-                                   " (use phases to average over its positions)");
-      }
-      if (q.step_distance > q.window) p.fail("step_distance", "is longer than the window");
-      const bool chip_drawable = s.chip_surface.is_synthetic();
-      q.draws = p.choice("draws", chip_drawable ? DrawnSurfaces::tools_and_chip : DrawnSurfaces::tools);
-      if (q.draws == DrawnSurfaces::tools_and_chip && !chip_drawable) {
-        p.fail("draws", "tools-and-chip draws the chip surface anew; this chip is " +
-                            std::string(s.chip_surface.flat ? "flat" : "a measured profile") + " (use tools)");
-      }
+    if (q.realisations > 1 && !s.tool_surface.is_synthetic()) {
+      p.fail("realisations", "realisations redraw a synthetic tool with other seeds; this tool is " +
+                                 std::string(s.tool_surface.flat ? "flat" : "a measured profile") +
+                                 " (use phases to average over its positions)");
     }
-    if (q.name == Protocol::seed000) q.draws = DrawnSurfaces::tools;  // one draw, the scene's own surfaces
-    p.finish();
-  }
-  {
-    Section h = root.child("thermal");
-    const ThermalModel fallback = s.protocol.name == Protocol::seed000 ? ThermalModel::adiabatic : ThermalModel::conduction;
-    s.thermal_model = h.choice("model", fallback);
-    s.conductivity = h.number("conductivity", s.conductivity, 0.0, 1e4);
-    h.finish();
-  }
-  {
-    Section f = root.child("lubricant");
-    auto& l = s.lubricant;
-    l.density = f.number("density", l.density, 1.0, 1e5);
-    l.viscosity = f.number("viscosity", l.viscosity, 1e-6, 1e6);
-    l.compressibility = f.choice("compressibility", l.compressibility);
-    l.bulk_modulus = f.quantity("bulk_modulus", QuantityKind::pressure, l.bulk_modulus, 1e6, 1e13);
-    l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
-    l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
-    l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
-    l.fill = f.choice("fill", s.protocol.name == Protocol::press_slide ? l.fill : FilmFill::gap);
-    if (l.fill == FilmFill::after_pressing && s.protocol.name != Protocol::press_slide) {
-      f.fail("fill", "after-pressing needs the press-slide protocol (seed 000's presses while sliding)");
+    if (q.step_distance > q.window) p.fail("step_distance", "is longer than the window");
+    const bool chip_drawable = s.chip_surface.is_synthetic();
+    q.draws = p.choice("draws", chip_drawable ? DrawnSurfaces::tools_and_chip : DrawnSurfaces::tools);
+    if (q.draws == DrawnSurfaces::tools_and_chip && !chip_drawable) {
+      p.fail("draws", "tools-and-chip draws the chip surface anew; this chip is " +
+                          std::string(s.chip_surface.flat ? "flat" : "a measured profile") + " (use tools)");
     }
-    l.cavitation = f.choice("cavitation", l.cavitation);
-    l.cavitation_pressure = f.quantity("cavitation_pressure", QuantityKind::pressure, l.cavitation_pressure, -1e9, 1e9);
-    l.leak = f.choice("leak", s.protocol.name == Protocol::press_slide ? l.leak : LeakModel::none);
-    l.leak_length = f.quantity("leak_length", QuantityKind::length, l.leak_length, 1e-9, 1.0);
-    l.contact_fade = f.number("contact_fade", l.contact_fade, 1.01, 100.0);
-    l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
-    l.robin_stiffness = f.number("robin_stiffness", l.robin_stiffness, 0.0, 1e25);
-    l.mesh_motion = f.choice("mesh_motion", l.mesh_motion);
-    l.mesh_stiffening = f.number("mesh_stiffening", l.mesh_stiffening, 0.0, 5.0);
-    l.acceleration = f.choice("acceleration", l.acceleration);
-    l.relaxation = f.number("relaxation", l.relaxation, 1e-6, 1.0);
-    l.reuse_steps = f.integer("reuse_steps", l.reuse_steps, 0, 100);
-    l.qr_filter = f.number("qr_filter", l.qr_filter, 0.0, 0.999);
-    l.coupling_tolerance = f.number("coupling_tolerance", l.coupling_tolerance, 1e-14, 1e-1);
-    l.traction_tolerance = f.number("traction_tolerance", l.traction_tolerance, 0.0, 1e-1);
-    l.volume_tolerance = f.number("volume_tolerance", l.volume_tolerance, 1e-14, 1.0);
-    l.max_coupling_iterations = f.integer("max_coupling_iterations", l.max_coupling_iterations, 1, 10000);
-    l.stall_iterations = f.integer("stall_iterations", l.stall_iterations, 0, 10000);
-    l.coupling_restarts = f.integer("coupling_restarts", l.coupling_restarts, 0, 100);
-    f.finish();
   }
-  read_contact(root.child("contact"), s, base_directory);
-  {
-    Section v = root.child("solver");
-    s.relative_tolerance = v.number("relative_tolerance", s.relative_tolerance, 1e-15, 1e-2);
-    s.max_newton_iterations = v.integer("max_newton_iterations", s.max_newton_iterations, 1, 1000);
-    s.max_cutbacks = v.integer("max_cutbacks", s.max_cutbacks, 0, 40);
-    // Cholesky by default: frictionless penalty contact, associative plasticity with the temperature
-    // frozen over a step and the mass term make the tangent symmetric positive definite (measured:
-    // symmetric to 1e-16); CHOLMOD halves the solve time against UMFPACK at 1800–3300 dofs
-    // (bench/RESULTS.md) and hands any tangent it finds indefinite to LU.
-    s.linear_solver = v.choice("linear_solver", s.linear_solver);
-    v.finish();
+  if (q.name == Protocol::seed000) q.draws = DrawnSurfaces::tools;  // one draw, the scene's own surfaces
+  p.finish();
+}
+
+// thermal: adiabatic or conducted heat.
+void read_thermal(Section h, Scene& s) {
+  const ThermalModel fallback = s.protocol.name == Protocol::seed000 ? ThermalModel::adiabatic : ThermalModel::conduction;
+  s.thermal_model = h.choice("model", fallback);
+  s.conductivity = h.number("conductivity", s.conductivity, 0.0, 1e4);
+  h.finish();
+}
+
+// lubricant: the lubricant in the pockets (read by lubricated runs only).
+void read_lubricant(Section f, Scene& s) {
+  auto& l = s.lubricant;
+  l.density = f.number("density", l.density, 1.0, 1e5);
+  l.viscosity = f.number("viscosity", l.viscosity, 1e-6, 1e6);
+  l.compressibility = f.choice("compressibility", l.compressibility);
+  l.bulk_modulus = f.quantity("bulk_modulus", QuantityKind::pressure, l.bulk_modulus, 1e6, 1e13);
+  l.elements_x = f.integer("elements_x", l.elements_x, 0, 100000);
+  l.elements_y = f.integer("elements_y", l.elements_y, 1, 1000);
+  l.min_film = f.quantity("min_film", QuantityKind::length, l.min_film, 1e-12, 1e-6);
+  l.fill = f.choice("fill", s.protocol.name == Protocol::press_slide ? l.fill : FilmFill::gap);
+  if (l.fill == FilmFill::after_pressing && s.protocol.name != Protocol::press_slide) {
+    f.fail("fill", "after-pressing needs the press-slide protocol (seed 000's presses while sliding)");
   }
-  root.finish();
-  if (s.physics == Physics::dry && j.contains("lubricant")) {
-    s.warnings.push_back("lubricant.* is read but has no effect: the scene's physics is dry (physics=lubricated to use it)");
-  }
+  l.cavitation = f.choice("cavitation", l.cavitation);
+  l.cavitation_pressure = f.quantity("cavitation_pressure", QuantityKind::pressure, l.cavitation_pressure, -1e9, 1e9);
+  l.leak = f.choice("leak", s.protocol.name == Protocol::press_slide ? l.leak : LeakModel::none);
+  l.leak_length = f.quantity("leak_length", QuantityKind::length, l.leak_length, 1e-9, 1.0);
+  l.contact_fade = f.number("contact_fade", l.contact_fade, 1.01, 100.0);
+  l.robin_weight = f.number("robin_weight", l.robin_weight, 0.0, 1e30);
+  l.robin_stiffness = f.number("robin_stiffness", l.robin_stiffness, 0.0, 1e25);
+  l.mesh_motion = f.choice("mesh_motion", l.mesh_motion);
+  l.mesh_stiffening = f.number("mesh_stiffening", l.mesh_stiffening, 0.0, 5.0);
+  l.acceleration = f.choice("acceleration", l.acceleration);
+  l.relaxation = f.number("relaxation", l.relaxation, 1e-6, 1.0);
+  l.reuse_steps = f.integer("reuse_steps", l.reuse_steps, 0, 100);
+  l.qr_filter = f.number("qr_filter", l.qr_filter, 0.0, 0.999);
+  l.coupling_tolerance = f.number("coupling_tolerance", l.coupling_tolerance, 1e-14, 1e-1);
+  l.traction_tolerance = f.number("traction_tolerance", l.traction_tolerance, 0.0, 1e-1);
+  l.volume_tolerance = f.number("volume_tolerance", l.volume_tolerance, 1e-14, 1.0);
+  l.max_coupling_iterations = f.integer("max_coupling_iterations", l.max_coupling_iterations, 1, 10000);
+  l.stall_iterations = f.integer("stall_iterations", l.stall_iterations, 0, 10000);
+  l.coupling_restarts = f.integer("coupling_restarts", l.coupling_restarts, 0, 100);
+  f.finish();
+}
+
+// solver: Newton's tolerances and the linear solver.
+void read_solver(Section v, Scene& s) {
+  s.relative_tolerance = v.number("relative_tolerance", s.relative_tolerance, 1e-15, 1e-2);
+  s.max_newton_iterations = v.integer("max_newton_iterations", s.max_newton_iterations, 1, 1000);
+  s.max_cutbacks = v.integer("max_cutbacks", s.max_cutbacks, 0, 40);
+  // Cholesky by default: frictionless penalty contact, associative plasticity with the temperature
+  // frozen over a step and the mass term make the tangent symmetric positive definite (measured:
+  // symmetric to 1e-16); CHOLMOD halves the solve time against UMFPACK at 1800–3300 dofs
+  // (bench/RESULTS.md) and hands any tangent it finds indefinite to LU.
+  s.linear_solver = v.choice("linear_solver", s.linear_solver);
+  v.finish();
+}
+
+// A scene whose stiffness and quadrature state alone exceed the machine's memory, refused before it
+// starts with the estimate (`mufric micro check` prints it).
+void refuse_a_scene_that_cannot_fit(const Scene& s) {
   const SceneCost cost = estimate_scene_cost(s);
   if (cost.memory_lower_bound_bytes > physical_memory_bytes()) {
     char text[320];
@@ -473,8 +476,33 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
                   "quadrature state alone, more than this machine's %.3g GB (`mufric micro check` prints the estimate)",
                   s.elements_x, s.elements_y, s.degree, cost.dofs, cost.memory_lower_bound_bytes / 1e9,
                   physical_memory_bytes() / 1e9);
-    throw Error(source + ": discretisation: " + text);
+    throw Error(s.source + ": discretisation: " + text);
   }
+}
+
+}  // namespace
+
+Scene parse_scene(const nlohmann::json& j, const std::string& source, const std::string& base_directory) {
+  Scene s;
+  s.source = source;
+  s.effective = j;
+  Section root(j, "", source);
+  s.physics = root.choice("physics", s.physics);
+  read_geometry(root.child("geometry"), s, base_directory);
+  read_discretisation(root.child("discretisation"), s);
+  read_material(root.child("material"), s);
+  read_load(root.child("load"), s);
+  read_time(root.child("time"), s);
+  read_protocol(root.child("protocol"), s);
+  read_thermal(root.child("thermal"), s);
+  read_lubricant(root.child("lubricant"), s);
+  read_contact(root.child("contact"), s, base_directory);
+  read_solver(root.child("solver"), s);
+  root.finish();
+  if (s.physics == Physics::dry && j.contains("lubricant")) {
+    s.warnings.push_back("lubricant.* is read but has no effect: the scene's physics is dry (physics=lubricated to use it)");
+  }
+  refuse_a_scene_that_cannot_fit(s);
   return s;
 }
 

@@ -18,6 +18,13 @@
 
 namespace mufric::scene {
 
+// Defaults below are written as a scene file's units give them (scale × value, as parse_quantity
+// computes: "10um" is 10 × 1e-6, one ulp from the literal 10e-6), so that a scene file stating a
+// default reads to the very same value (tested: Scene.ShippedScenesStateTheBuiltInDefaults…).
+constexpr double micrometres(double x) { return 1e-6 * x; }
+constexpr double nanometres(double x) { return 1e-9 * x; }
+constexpr double nanoseconds(double x) { return 1e-9 * x; }
+
 // A choice a scene file spells as a word ("lubricated", "iqn-ils"): parsed once into its enum, and
 // spelled back from the same table (SceneChoice<E>::names, below the enums) in messages and results.
 template <class E>
@@ -46,6 +53,7 @@ struct SurfaceSpec {
   bool mirror = false;             // x → −x (a reflected profile, for symmetry studies)
   // Drawn from `synthetic` (a seed draws another of the same statistics), not measured or flat.
   bool is_synthetic() const { return csv.empty() && !flat; }
+  bool operator==(const SurfaceSpec&) const = default;
 };
 
 // How μ is measured (README "What μ means"). Seed 000's protocol ramps the pressure while the chip
@@ -64,18 +72,19 @@ struct ProtocolSpec {
   // press-slide: the pressure rises over load.ramp with Γ_B held in x, then stays for press_hold
   // before Γ_B starts to slide; its velocity rises linearly to load.velocity over the first
   // kAccelerationShareOfRunIn of the run-in distance.
-  double press_hold = 25e-9;      // s
+  double press_hold = nanoseconds(25);  // s
   // Defaults from the studies in bench/RESULTS.md ("What mu means"): the tool-to-tool scatter of μ
   // dominates the phase-to-phase one, so realisations, not phases; a run-in of 2.5 tool correlation
   // lengths and a window of 3.
   double run_in = 2e-6;           // m of sliding before the window (discarded)
-  double window = 2.5e-6;         // m of sliding over which μ is averaged
-  double step_distance = 25e-9;   // m, the longest step while sliding (dt = step_distance / |v|)
+  double window = micrometres(2.5);  // m of sliding over which μ is averaged
+  double step_distance = nanometres(25);  // m, the longest step while sliding (dt = step_distance / |v|)
   int phases = 1;                 // tool shifts by k/phases of the interval, k = 0…phases−1
   int realisations = 4;           // synthetic tools with seeds seed, seed+1, … (same statistics)
   // With tools_and_chip, realisation r also draws the chip with seed chip_seed + r (a synthetic chip).
   DrawnSurfaces draws = DrawnSurfaces::tools_and_chip;
   int blocks = 4;                 // equal-distance blocks of the window, for the drift check
+  bool operator==(const ProtocolSpec&) const = default;
 };
 inline constexpr double kAccelerationShareOfRunIn = 0.25;
 
@@ -150,14 +159,15 @@ struct LubricantSpec {
   // Restarts of a step's interface iteration after a solver failed on an accelerated iterate,
   // before the step fails and is cut back (CouplingOptions::max_restarts).
   int coupling_restarts = 0;
+  bool operator==(const LubricantSpec&) const = default;
 };
 
 struct Scene {
   std::string source;  // file name, for messages
   Physics physics = Physics::dry;
   // geometry
-  double interval = 10e-6;      // m, the periodic width (seed 000: 1e-5 m)
-  double chip_height = 5e-6;    // m, from the mean chip surface down to Γ_B
+  double interval = micrometres(10);   // m, the periodic width (seed 000: 1e-5 m)
+  double chip_height = micrometres(5);  // m, from the mean chip surface down to Γ_B
   double initial_gap = 0.0;     // m, smallest vertical distance tool–chip at t = 0
   SurfaceSpec chip_surface, tool_surface;
   // discretisation
@@ -176,16 +186,16 @@ struct Scene {
   double vertical_displacement = 0.0; // m, instead of a pressure (for comparisons with other codes)
   double velocity = 100.0 / 60.0;     // m/s, horizontal, of Γ_B (chip moving in +x against a fixed tool)
   double temperature = 773.15;        // K, initial
-  double ramp = 2.5e-8;               // s, the vertical load rises linearly over this time
+  double ramp = nanoseconds(25);      // s, the vertical load rises linearly over this time
   // time
   solid::TimeScheme scheme = solid::TimeScheme::generalized_alpha;
   // ρ∞ 0.5: damps the chip's thickness vibration that the pressure ramp excites, which with 0.8 still
   // rang through the averaging window, and gave μ closest to the small-step runs (bench/RESULTS.md).
   double spectral_radius = 0.5;
   double dt = 1e-9;                   // s, the first step
-  double max_dt = 1e-9;               // s, the longest step the step-size control may take
-  double duration = 2.5e-7;           // s (seed 000 Figs. 3–5)
-  double average_from = 1.25e-7;      // s, μ is averaged over [average_from, duration]
+  double max_dt = dt;                 // s, the longest step the step-size control may take (absent: time.step)
+  double duration = nanoseconds(250);  // s (seed 000 Figs. 3–5)
+  double average_from = 0.5 * duration;  // s, μ is averaged over [average_from, duration] (absent: its second half)
   ProtocolSpec protocol;
   // The default follows the protocol: conduction for press-slide, adiabatic for seed 000
   // (bench/RESULTS.md, the heat study).
@@ -209,6 +219,8 @@ struct Scene {
   // unknown keys are errors), so it cannot say more or less than the run used.
   nlohmann::json effective;
   std::vector<std::string> warnings;  // keys read but without effect (lubricant.* in a dry scene)
+  // Every value alike, the file's words (effective, source) and the warnings included.
+  bool operator==(const Scene&) const = default;
 };
 
 // The words of the scene file, in the order its error messages list them.

@@ -76,6 +76,7 @@ struct JohnsonCookParameters {
   double melting_temperature = 1773.15;    // K (1500 °C)
   double specific_heat = 450.0;            // J/(kg K)
   double heat_fraction = 0.9;              // share of plastic work turned into heat (Taylor–Quinney)
+  bool operator==(const JohnsonCookParameters&) const = default;
 };
 
 // Yield stress of eq. (5)–(6) of seed 000. The rate factor is 1 + C ln(max(ε̇/ε̇0, 1)): the log

@@ -41,6 +41,7 @@ struct RoughnessSpec {
   double correlation_length = 1e-6;   // m, λ above
   int samples = 512;
   std::uint64_t seed = 1;
+  bool operator==(const RoughnessSpec&) const = default;
 };
 Profile synthetic_rough_profile(const RoughnessSpec& spec);
 
