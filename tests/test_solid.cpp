@@ -541,8 +541,9 @@ TEST(GeneralizedAlpha, VibratingBarFollowsTheAmplificationMatrixAndKeepsItsPerio
 // stored full and factorised by LU.
 class ShearFollowingNormalSprings : public BoundaryInteraction {
  public:
-  ShearFollowingNormalSprings(std::vector<int> nodes, double stiffness, double ratio)
-      : nodes_(std::move(nodes)), stiffness_(stiffness), ratio_(ratio) {}
+  // `declares_symmetric`: says its tangent is symmetric whatever it adds (a broken interaction).
+  ShearFollowingNormalSprings(std::vector<int> nodes, double stiffness, double ratio, bool declares_symmetric = false)
+      : nodes_(std::move(nodes)), stiffness_(stiffness), ratio_(ratio), declares_symmetric_(declares_symmetric) {}
   std::vector<std::vector<int>> coupled_nodes() const override {
     std::vector<std::vector<int>> groups;
     for (const int node : nodes_) groups.push_back({node});
@@ -560,7 +561,7 @@ class ShearFollowingNormalSprings : public BoundaryInteraction {
     }
     return true;
   }
-  bool symmetric_tangent() const override { return false; }
+  bool symmetric_tangent() const override { return declares_symmetric_; }
   // The same forces as a dense matrix A (force = A u), for the independent solve.
   void add_to(Eigen::MatrixXd& a) const {
     for (const int node : nodes_) {
@@ -572,6 +573,7 @@ class ShearFollowingNormalSprings : public BoundaryInteraction {
  private:
   std::vector<int> nodes_;
   double stiffness_, ratio_;
+  bool declares_symmetric_;
 };
 
 SolidProblem loaded_block() {
@@ -588,6 +590,28 @@ std::vector<int> top_nodes(const SolidProblem& problem) {
     if (problem.space().node_position(node).y() > 1.0 - 1e-12) nodes.push_back(node);
   }
   return nodes;
+}
+
+// An interaction that declares a symmetric tangent has its upper triangle dropped; the accumulator
+// still checks that what it drops mirrors what it keeps. The springs' (x, y) entry has no mirror
+// image: assembling them as symmetric is refused, naming the cause; with ratio 0 (only diagonal
+// entries) they are symmetric and assemble; and the frictionless contact's real tangent passes.
+TEST(UnsymmetricTangent, AnInteractionThatCallsItsUnsymmetricTangentSymmetricIsRefused) {
+  SolidProblem broken = loaded_block();
+  broken.add_interaction(std::make_shared<ShearFollowingNormalSprings>(top_nodes(broken), 150.0, 0.4, true));
+  ASSERT_EQ(broken.tangent_storage(), MatrixStorage::lower_symmetric);
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(broken.dof_count(), 1e-3);
+  try {
+    broken.assemble(u, 1.0, true);
+    ADD_FAILURE() << "an unsymmetric tangent declared symmetric was assembled";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("declares a symmetric tangent added an unsymmetric one"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(broken.assemble(u, 1.0, false));  // no tangent asked: nothing dropped
+  SolidProblem diagonal = loaded_block();
+  diagonal.add_interaction(std::make_shared<ShearFollowingNormalSprings>(top_nodes(diagonal), 150.0, 0.0, true));
+  EXPECT_TRUE(diagonal.assemble(u, 1.0, true).ok);
 }
 
 TEST(UnsymmetricTangent, IsStoredFullAndSolvedByLuToTheDenseSolution) {

@@ -4,6 +4,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <tuple>
 
 #include "common/error.hpp"
@@ -94,13 +96,36 @@ SolidProblem::SolidProblem(IgaSpace space, std::shared_ptr<const Material> mater
   build_pattern();
 }
 
+namespace {
+// A weight in [0.5, 1.5) for the unordered pair {row, col} (Fibonacci hashing, Knuth TAOCP vol. 3 §6.4).
+double pair_weight(int row, int col) {
+  const auto lo = static_cast<std::uint64_t>(std::min(row, col)), hi = static_cast<std::uint64_t>(std::max(row, col));
+  const std::uint64_t hash = ((hi << 32) | lo) * 0x9E3779B97F4A7C15ULL;
+  return 0.5 + static_cast<double>(hash >> 11) * 0x1.0p-53;
+}
+}  // namespace
+
 void TangentAccumulator::add(int row, int col, double value) {
-  if (storage_ == numerics::MatrixStorage::lower_symmetric && row < col) return;
+  if (storage_ == numerics::MatrixStorage::lower_symmetric && row != col) {
+    const double weighted = pair_weight(row, col) * value;
+    (row < col ? upper_ : lower_) += weighted;
+    magnitude_ += std::abs(weighted);
+    if (row < col) return;
+  }
   const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
   const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
   const int* at = std::lower_bound(begin, end, row);
   if (at == end || *at != row) throw Error("tangent: entry (" + std::to_string(row) + ", " + std::to_string(col) + ") is not in the pattern");
   matrix_.valuePtr()[at - matrix_.innerIndexPtr()] += value;
+}
+
+std::optional<std::string> TangentAccumulator::asymmetry() const {
+  if (storage_ != numerics::MatrixStorage::lower_symmetric) return std::nullopt;
+  if (std::abs(upper_ - lower_) <= kSymmetryTolerance * magnitude_) return std::nullopt;
+  char text[200];
+  std::snprintf(text, sizeof text, "weighted sums of its off-diagonal entries %.17g above and %.17g below the diagonal",
+                upper_, lower_);
+  return std::string(text);
 }
 
 void SolidProblem::commit_interactions(const Eigen::VectorXd& u) {
@@ -561,9 +586,15 @@ SolidProblem::Assembly SolidProblem::assemble(const Eigen::VectorXd& u, double d
   }
   TangentAccumulator accumulator(out.tangent, storage);
   for (const auto& interaction : interactions_) {
+    accumulator.begin_interaction();
     if (!interaction->add(u, out.internal, with_tangent ? &accumulator : nullptr, out.reason)) {
       out.ok = false;
       break;
+    }
+    if (const auto why = accumulator.asymmetry()) {
+      // A programming error, not a hard step: the lower triangle kept would be another matrix.
+      throw Error("tangent: a boundary interaction that declares a symmetric tangent added an unsymmetric one (" + *why +
+                  "); it must say symmetric_tangent() false");
     }
   }
   out.seconds_interactions = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
