@@ -137,63 +137,132 @@ void TimeIntegrator::accept() {
   trial_.valid = false;
 }
 
-TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
-  Attempt at;
+Eigen::VectorXd TimeIntegrator::predictor(double t0, double dt) const {
+  // The last accepted increment scaled to this step (linear extrapolation, as Abaqus/Standard's
+  // default EXTRAPOLATION=LINEAR); on the first step, constant velocity (dynamic) or the last state
+  // (quasi-static). In the pressure ramp of the default scene this cut the Newton iterations of the
+  // first 60 ns from 910 to 533 against constant velocity (generalized-α's velocity oscillates about
+  // the sliding velocity; the increment is what the chip actually did). A repeated trial of the same
+  // step (a coupled step) starts from the last trial's solution.
   const bool dynamic = options_.scheme == TimeScheme::generalized_alpha;
-  const double am = alpha_m(), af = alpha_f(), b = beta();
-  const double t1 = t0 + dt;
-  const auto& constrained = problem_.constrained();
-  // Predictor: the last accepted increment scaled to this step (linear extrapolation, as
-  // Abaqus/Standard's default EXTRAPOLATION=LINEAR); on the first step, constant velocity (dynamic)
-  // or the last state (quasi-static). In the pressure ramp of the default scene this cut the Newton
-  // iterations of the first 60 ns from 910 to 533 against constant velocity (generalized-α's
-  // velocity oscillates about the sliding velocity; the increment is what the chip actually did).
-  // A repeated trial of the same step (a coupled step) starts from the last trial's solution.
   const bool repeat = trial_.valid && trial_.t0 == t0 && trial_.dt == dt;
   Eigen::VectorXd u1 = repeat           ? trial_.u
                        : last_dt_ > 0.0 ? Eigen::VectorXd(u_ + (dt / last_dt_) * last_increment_)
                        : dynamic        ? Eigen::VectorXd(u_ + dt * v_)
                                         : u_;
-  problem_.apply_dirichlet(t1, u1);
-  const Eigen::VectorXd f_ext1 = problem_.external(t1), f_ext0 = problem_.external(t0);
-  const numerics::MatrixStorage storage = problem_.tangent_storage();
-  const numerics::Symmetry symmetry = problem_.tangent_symmetry();
-  const SparseMatrix* mass = dynamic ? &problem_.mass() : nullptr;
-  const SparseMatrix* tangent_mass = dynamic ? &problem_.mass(storage) : nullptr;
-  const double mass_factor = dynamic ? (1.0 - am) / (b * dt * dt) : 0.0;
-  const double stiffness_factor = dynamic ? 1.0 - af : 1.0;
+  problem_.apply_dirichlet(t0 + dt, u1);
+  return u1;
+}
 
-  // The residual G(u1) and the quantities that come with it.
-  struct Evaluation {
-    SolidProblem::Assembly assembly;
-    Eigen::VectorXd residual, a1;
-    double norm = 0.0, scale = 0.0;
-  };
+TimeIntegrator::StepSystem TimeIntegrator::step_system(double t0, double dt) const {
+  StepSystem sys;
+  sys.dynamic = options_.scheme == TimeScheme::generalized_alpha;
+  sys.dt = dt;
+  sys.t1 = t0 + dt;
+  sys.f_ext1 = problem_.external(sys.t1);
+  sys.f_ext0 = problem_.external(t0);
+  sys.storage = problem_.tangent_storage();
+  sys.symmetry = problem_.tangent_symmetry();
+  sys.mass = sys.dynamic ? &problem_.mass() : nullptr;
+  sys.tangent_mass = sys.dynamic ? &problem_.mass(sys.storage) : nullptr;
+  sys.mass_factor = sys.dynamic ? (1.0 - alpha_m()) / (beta() * dt * dt) : 0.0;
+  sys.stiffness_factor = sys.dynamic ? 1.0 - alpha_f() : 1.0;
+  return sys;
+}
+
+TimeIntegrator::Evaluation TimeIntegrator::evaluate(const StepSystem& sys, const Eigen::VectorXd& u, bool with_tangent,
+                                                    const std::vector<MaterialState>* guesses) {
+  Evaluation e;
+  const auto start = std::chrono::steady_clock::now();
+  e.assembly = problem_.assemble(u, sys.dt, with_tangent, guesses);
+  report_.seconds_assembly += seconds_since(start);
+  report_.seconds_contact += e.assembly.seconds_interactions;
+  ++report_.assemblies;
+  if (!e.assembly.ok) return e;
+  const double dt = sys.dt, am = alpha_m(), af = alpha_f(), b = beta();
+  if (sys.dynamic) {
+    e.a1 = (u - u_ - dt * v_ - dt * dt * (0.5 - b) * a_) / (b * dt * dt);
+    const Eigen::VectorXd inertia = sys.mass->selfadjointView<Eigen::Lower>() * ((1.0 - am) * e.a1 + am * a_);
+    e.residual = inertia + (1.0 - af) * e.assembly.internal + af * f_int_ - (1.0 - af) * sys.f_ext1 - af * sys.f_ext0;
+    e.scale = std::max({e.assembly.internal.norm(), sys.f_ext1.norm(), inertia.norm()});
+  } else {
+    e.residual = e.assembly.internal - sys.f_ext1;
+    e.scale = std::max(e.assembly.internal.norm(), sys.f_ext1.norm());
+  }
+  e.norm = free_norm(e.residual, problem_.constrained());
+  return e;
+}
+
+bool TimeIntegrator::factorize_tangent(const StepSystem& sys, MovableSparseMatrix k, std::string& reason) {
+  if (sys.stiffness_factor != 1.0) k *= sys.stiffness_factor;
+  if (sys.dynamic) {
+    // Same pattern as the tangent: add value arrays.
+    Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
+        sys.mass_factor * Eigen::Map<const Eigen::VectorXd>(sys.tangent_mass->valuePtr(), sys.tangent_mass->nonZeros());
+  }
+  problem_.constrain(k);
+  if (solver_.factorize(k, sys.storage, sys.symmetry)) return true;
+  reason = solver_.reason();
+  return false;
+}
+
+double TimeIntegrator::forcing_term(int iteration, double norm, double previous_norm, double tolerance) {
+  // Eisenstat & Walker 1996 (SIAM J. Sci. Comput. 17:16), choice 2: γ (‖G_k‖/‖G_{k−1}‖)², capped,
+  // and never asking the Krylov solve for more than half the Newton tolerance.
+  double forcing = kMaxForcing;
+  if (iteration > 0 && previous_norm > 0.0) forcing = std::min(kMaxForcing, kForcingGamma * std::pow(norm / previous_norm, 2));
+  return std::min(std::max(forcing, 0.5 * tolerance / norm), kMaxForcing);
+}
+
+TimeIntegrator::LineSearch TimeIntegrator::line_search(const StepSystem& sys, const Eigen::VectorXd& u,
+                                                       const Eigen::VectorXd& delta, double norm, bool with_tangent,
+                                                       const std::vector<MaterialState>* guesses, StepRecord& record) {
+  // Backtracking on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction, with the quadratic
+  // model's minimiser kept in [0.1 s, 0.5 s] (Dennis & Schnabel 1983, Algorithm A6.3.1).
+  // Trials are evaluated with their tangent: the accepted one is the next iteration's
+  // linearisation. Most trials are accepted (the full step usually, and the last of a line search
+  // always); evaluating line-search trials without a tangent and the accepted point again with one
+  // cost more (128 x 24 default scene: 199 reduced trials, 155 of them accepted).
+  const double phi0 = norm * norm;
+  LineSearch ls{evaluate(sys, u + delta, with_tangent, guesses), 1.0, with_tangent};
+  if (!options_.line_search) return ls;
+  for (int r = 0; r < kLineSearchMaxReductions; ++r) {
+    const double phi1 = ls.trial.assembly.ok ? ls.trial.norm * ls.trial.norm : std::numeric_limits<double>::infinity();
+    if (phi1 <= (1.0 - 2.0 * kLineSearchSufficientDecrease * ls.step) * phi0) break;
+    const double s = ls.step;
+    const double minimiser = std::isfinite(phi1) ? phi0 * s * s / (phi1 - phi0 + 2.0 * phi0 * s) : 0.1 * s;
+    ls.step = std::clamp(minimiser, 0.1 * s, 0.5 * s);
+    ls.trial = evaluate(sys, u + ls.step * delta, true, guesses);
+    ls.has_tangent = true;
+    ++record.line_search_reductions;
+  }
+  return ls;
+}
+
+void TimeIntegrator::keep_trial(double t0, double dt, Eigen::VectorXd u1, Evaluation&& solved, const StepRecord& record) {
+  trial_.t0 = t0;
+  trial_.dt = dt;
+  trial_.valid = true;
+  trial_.u = std::move(u1);
+  trial_.a = std::move(solved.a1);
+  trial_.internal = std::move(solved.assembly.internal);
+  trial_.residual = std::move(solved.residual);
+  trial_.states = std::move(solved.assembly.states);
+  trial_.stresses = std::move(solved.assembly.stresses);
+  trial_.newton_iterations += record.newton_iterations;
+  trial_.last_newton_iterations = record.newton_iterations;
+  trial_.line_search_reductions += record.line_search_reductions;
+  trial_.residual_norm = record.residual;
+}
+
+TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
+  Attempt at;
+  Eigen::VectorXd u1 = predictor(t0, dt);
+  const StepSystem sys = step_system(t0, dt);
   // The material states of the last evaluation in this step: first guesses for the next one's
   // return maps (a Johnson-Cook update then needs fewer of its own Newton iterations).
   const std::vector<MaterialState>* last_states = nullptr;
-  auto evaluate = [&](const Eigen::VectorXd& u, bool with_tangent) {
-    Evaluation e;
-    const auto start = std::chrono::steady_clock::now();
-    e.assembly = problem_.assemble(u, dt, with_tangent, last_states);
-    report_.seconds_assembly += seconds_since(start);
-    report_.seconds_contact += e.assembly.seconds_interactions;
-    ++report_.assemblies;
-    if (!e.assembly.ok) return e;
-    if (dynamic) {
-      e.a1 = (u - u_ - dt * v_ - dt * dt * (0.5 - b) * a_) / (b * dt * dt);
-      const Eigen::VectorXd inertia = mass->selfadjointView<Eigen::Lower>() * ((1.0 - am) * e.a1 + am * a_);
-      e.residual = inertia + (1.0 - af) * e.assembly.internal + af * f_int_ - (1.0 - af) * f_ext1 - af * f_ext0;
-      e.scale = std::max({e.assembly.internal.norm(), f_ext1.norm(), inertia.norm()});
-    } else {
-      e.residual = e.assembly.internal - f_ext1;
-      e.scale = std::max(e.assembly.internal.norm(), f_ext1.norm());
-    }
-    e.norm = free_norm(e.residual, constrained);
-    return e;
-  };
-
-  Evaluation current = evaluate(u1, true);
+  Evaluation current = evaluate(sys, u1, true, last_states);
   last_states = &current.assembly.states;  // `current` is reassigned in place: the pointer stays valid
   double force_scale = 0.0;
   const auto tolerance_at = [&](double scale) { return options_.relative_tolerance * scale + 1e-300; };
@@ -211,7 +280,7 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     force_scale = std::max(force_scale, current.scale);
     const double tolerance = tolerance_at(force_scale);
     if (trace_newton()) {
-      std::fprintf(stderr, "newton t %.4g dt %.3g it %d residual %.6e tolerance %.3e\n", t1, dt, it, current.norm, tolerance);
+      std::fprintf(stderr, "newton t %.4g dt %.3g it %d residual %.6e tolerance %.3e\n", sys.t1, dt, it, current.norm, tolerance);
     }
     at.record.residual = current.norm;
     at.record.newton_iterations = it;
@@ -226,21 +295,10 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     const auto start = std::chrono::steady_clock::now();
     // In the quadratic phase the tangent hardly changes between iterations: the last factorisation
     // serves once more (a chord step), and any sign of trouble brings a fresh one.
-    const bool reuse = solver_.factorizes_by_lu(symmetry) && factorized && last_full_step &&
+    const bool reuse = solver_.factorizes_by_lu(sys.symmetry) && factorized && last_full_step &&
                        current.norm < kReuseFactorizationBelow * previous_norm;
     if (!reuse) {
-      MovableSparseMatrix k = std::move(current.assembly.tangent);
-      if (stiffness_factor != 1.0) k *= stiffness_factor;
-      if (dynamic) {
-        // Same pattern as the tangent: add value arrays.
-        Eigen::Map<Eigen::VectorXd>(k.valuePtr(), k.nonZeros()) +=
-            mass_factor * Eigen::Map<const Eigen::VectorXd>(tangent_mass->valuePtr(), tangent_mass->nonZeros());
-      }
-      problem_.constrain(k);
-      if (!solver_.factorize(k, storage, symmetry)) {
-        at.reason = solver_.reason();
-        return at;
-      }
+      if (!factorize_tangent(sys, std::move(current.assembly.tangent), at.reason)) return at;
       factorized = true;
     }
     // In the quadratic phase, e_{k+1} ≈ C e_k² with C ≈ e_k / e_{k−1}² predicts whether the full step
@@ -249,44 +307,23 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
     const bool expect_convergence = it > 0 && last_full_step && current.norm < 0.1 * previous_norm &&
                                     std::pow(current.norm / previous_norm, 2) * current.norm <
                                         kPredictedConvergenceMargin * tolerance;
-    double forcing = kMaxForcing;
-    if (it > 0 && previous_norm > 0.0) forcing = std::min(kMaxForcing, kForcingGamma * std::pow(current.norm / previous_norm, 2));
-    forcing = std::max(forcing, 0.5 * tolerance / current.norm);
+    const double forcing = forcing_term(it, current.norm, previous_norm, tolerance);
     previous_norm = current.norm;
-    const Eigen::VectorXd delta = solver_.solve(rhs, std::min(forcing, kMaxForcing));
+    const Eigen::VectorXd delta = solver_.solve(rhs, forcing);
     report_.seconds_solve += seconds_since(start);
-    // Line search on φ(s) = ‖G(u + sδ)‖², φ'(0) = −2φ(0) for a Newton direction.
-    const double phi0 = current.norm * current.norm;
-    double s = 1.0;
-    // Trials are evaluated with their tangent: the accepted one is the next iteration's
-    // linearisation. Most trials are accepted (the full step usually, and the last of a line search
-    // always); evaluating line-search trials without a tangent and the accepted point again with one
-    // cost more (128 x 24 default scene: 199 reduced trials, 155 of them accepted).
-    Evaluation trial = evaluate(u1 + delta, !expect_convergence);
-    bool trial_has_tangent = !expect_convergence;
-    if (options_.line_search) {
-      for (int r = 0; r < kLineSearchMaxReductions; ++r) {
-        const double phi1 = trial.assembly.ok ? trial.norm * trial.norm : std::numeric_limits<double>::infinity();
-        if (phi1 <= (1.0 - 2.0 * kLineSearchSufficientDecrease * s) * phi0) break;
-        const double minimiser = std::isfinite(phi1) ? phi0 * s * s / (phi1 - phi0 + 2.0 * phi0 * s) : 0.1 * s;
-        s = std::clamp(minimiser, 0.1 * s, 0.5 * s);
-        trial = evaluate(u1 + s * delta, true);
-        trial_has_tangent = true;
-        ++at.record.line_search_reductions;
-      }
-    }
-    if (trace_newton()) std::fprintf(stderr, "newton   step length %.3g after %d reductions\n", s, at.record.line_search_reductions);
-    u1 += s * delta;
-    const bool stagnated = s * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
-                           trial.norm <= 1e3 * tolerance;
-    last_full_step = s == 1.0;
-    const double next_tolerance = tolerance_at(std::max(force_scale, trial.scale));
-    if (trial_has_tangent || stagnated || !trial.assembly.ok || trial.norm <= next_tolerance) {
-      current = std::move(trial);  // evaluated at the new u1 (with its tangent unless it will not be needed)
+    LineSearch ls = line_search(sys, u1, delta, current.norm, !expect_convergence, last_states, at.record);
+    if (trace_newton()) std::fprintf(stderr, "newton   step length %.3g after %d reductions\n", ls.step, at.record.line_search_reductions);
+    u1 += ls.step * delta;
+    const bool stagnated = ls.step * delta.norm() <= kNewtonStagnationIncrement * std::max(u1.norm(), 1e-300) &&
+                           ls.trial.norm <= 1e3 * tolerance;
+    last_full_step = ls.step == 1.0;
+    const double next_tolerance = tolerance_at(std::max(force_scale, ls.trial.scale));
+    if (ls.has_tangent || stagnated || !ls.trial.assembly.ok || ls.trial.norm <= next_tolerance) {
+      current = std::move(ls.trial);  // evaluated at the new u1 (with its tangent unless it will not be needed)
     } else {
       // The prediction failed: the same point with its tangent, the trial's states as exact guesses.
-      last_states = &trial.assembly.states;
-      current = evaluate(u1, true);
+      last_states = &ls.trial.assembly.states;
+      current = evaluate(sys, u1, true, last_states);
       last_states = &current.assembly.states;
       ++report_.unpredicted_convergence;
     }
@@ -296,22 +333,9 @@ TimeIntegrator::Attempt TimeIntegrator::solve(double t0, double dt) {
       break;
     }
   }
-  // The solved trial, accepted by accept().
-  trial_.t0 = t0;
-  trial_.dt = dt;
-  trial_.valid = true;
-  trial_.u = std::move(u1);
-  trial_.a = std::move(current.a1);
-  trial_.internal = std::move(current.assembly.internal);
-  trial_.residual = std::move(current.residual);
-  trial_.states = std::move(current.assembly.states);
-  trial_.stresses = std::move(current.assembly.stresses);
-  trial_.newton_iterations += at.record.newton_iterations;
-  trial_.last_newton_iterations = at.record.newton_iterations;
-  trial_.line_search_reductions += at.record.line_search_reductions;
-  trial_.residual_norm = at.record.residual;
+  keep_trial(t0, dt, std::move(u1), std::move(current), at.record);
   at.ok = true;
-  at.record.time = t1;
+  at.record.time = sys.t1;
   at.record.dt = dt;
   return at;
 }

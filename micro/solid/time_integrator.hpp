@@ -155,7 +155,38 @@ class TimeIntegrator {
     int last_newton_iterations = 0;                          // of the last trial alone
     double residual_norm = 0.0;
   };
-  Attempt solve(double t0, double dt);  // into trial_
+  // What stays fixed over one step's Newton iterations.
+  struct StepSystem {
+    bool dynamic = false;
+    double dt = 0.0, t1 = 0.0;
+    Eigen::VectorXd f_ext0, f_ext1;
+    numerics::MatrixStorage storage = numerics::MatrixStorage::lower_symmetric;
+    numerics::Symmetry symmetry = numerics::Symmetry::symmetric;
+    const SparseMatrix* mass = nullptr;          // dynamic: M (lower triangle)
+    const SparseMatrix* tangent_mass = nullptr;  // dynamic: M in the tangent's storage
+    double mass_factor = 0.0, stiffness_factor = 1.0;  // K_eff = stiffness_factor K + mass_factor M
+  };
+  // The residual G(u1) and what comes with it.
+  struct Evaluation {
+    SolidProblem::Assembly assembly;
+    Eigen::VectorXd residual, a1;
+    double norm = 0.0, scale = 0.0;
+  };
+  struct LineSearch {
+    Evaluation trial;   // at u + step δ
+    double step = 1.0;
+    bool has_tangent = false;
+  };
+  Attempt solve(double t0, double dt);  // into trial_: Newton's loop over the steps below
+  Eigen::VectorXd predictor(double t0, double dt) const;
+  StepSystem step_system(double t0, double dt) const;
+  Evaluation evaluate(const StepSystem& sys, const Eigen::VectorXd& u, bool with_tangent,
+                      const std::vector<MaterialState>* guesses);
+  bool factorize_tangent(const StepSystem& sys, MovableSparseMatrix k, std::string& reason);
+  static double forcing_term(int iteration, double norm, double previous_norm, double tolerance);
+  LineSearch line_search(const StepSystem& sys, const Eigen::VectorXd& u, const Eigen::VectorXd& delta, double norm,
+                         bool with_tangent, const std::vector<MaterialState>* guesses, StepRecord& record);
+  void keep_trial(double t0, double dt, Eigen::VectorXd u1, Evaluation&& solved, const StepRecord& record);
   void accept();                        // trial_ becomes the state
   Attempt step(double t0, double dt);   // solve + accept, or the coupled step
   Trial trial_;
