@@ -34,10 +34,10 @@ struct Block {
   // The field that carries a named model input, or nullptr for a name the wire does not carry:
   //   if (auto field = Block::field_for(name)) block.*field = values;
   static const double* Block::*field_for(std::string_view name) {
-    if (name == "contact_pressure") return &Block::contact_pressure;
-    if (name == "sliding_velocity") return &Block::sliding_velocity;
-    if (name == "temperature") return &Block::temperature;
-    if (name == "fibre_angle") return &Block::fibre_angle;
+    if (name == input_name::contact_pressure) return &Block::contact_pressure;
+    if (name == input_name::sliding_velocity) return &Block::sliding_velocity;
+    if (name == input_name::temperature) return &Block::temperature;
+    if (name == input_name::fibre_angle) return &Block::fibre_angle;
     return nullptr;
   }
 };

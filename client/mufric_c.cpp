@@ -15,8 +15,9 @@ struct mufric_client {
   mufric::Extrapolation extrapolation = mufric::Extrapolation::model_default;
   // The model's training box in mufric_evaluate's argument order, read once at open (mufric_box,
   // the outside flags); an input the model does not take is not used, with a box of [0, 0].
-  static constexpr std::array<std::string_view, 4> input_names{"contact_pressure", "sliding_velocity", "temperature",
-                                                               "fibre_angle"};
+  static constexpr std::array<std::string_view, 4> input_names{
+      mufric::input_name::contact_pressure, mufric::input_name::sliding_velocity, mufric::input_name::temperature,
+      mufric::input_name::fibre_angle};
   std::array<bool, 4> used{};
   std::array<mufric::InputSpec, 4> box{};
   bool has_patch_scatter = false;  // read at open too

@@ -48,9 +48,9 @@ std::string input_space_difference(const InputSpace& a, std::string_view a_sourc
 
 // The default parameter box of seed 000 section 4: p 300–1300 MPa, v 22.5–200 m/min, T 25–900 °C.
 inline InputSpace default_friction_box() {
-  return {{"contact_pressure", "Pa", 300e6, 1300e6},
-          {"sliding_velocity", "m/s", 22.5 / 60.0, 200.0 / 60.0},
-          {"temperature", "K", 25.0 + 273.15, 900.0 + 273.15}};
+  return {{std::string(input_name::contact_pressure), "Pa", 300e6, 1300e6},
+          {std::string(input_name::sliding_velocity), "m/s", 22.5 / 60.0, 200.0 / 60.0},
+          {std::string(input_name::temperature), "K", 25.0 + 273.15, 900.0 + 273.15}};
 }
 
 }  // namespace mufric

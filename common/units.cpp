@@ -166,10 +166,11 @@ std::string format_human(double value_si, QuantityKind kind, int precision) {
 }
 
 const std::vector<KnownInput>& known_inputs() {
-  static const std::vector<KnownInput> inputs{{"contact_pressure", QuantityKind::pressure, "--p"},
-                                              {"sliding_velocity", QuantityKind::velocity, "--v"},
-                                              {"temperature", QuantityKind::temperature, "--T"},
-                                              {"fibre_angle", QuantityKind::angle, "--angle"}};
+  static const std::vector<KnownInput> inputs{
+      {input_name::contact_pressure, QuantityKind::pressure, "--p", "load.pressure"},
+      {input_name::sliding_velocity, QuantityKind::velocity, "--v", "load.velocity"},
+      {input_name::temperature, QuantityKind::temperature, "--T", "load.temperature"},
+      {input_name::fibre_angle, QuantityKind::angle, "--angle", ""}};  // the empirical FRP law's, no scene
   return inputs;
 }
 

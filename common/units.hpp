@@ -36,13 +36,26 @@ std::string format_human(double value_si, QuantityKind kind, int precision = 4);
 std::string_view human_unit(QuantityKind kind);
 double si_to_human(double value_si, QuantityKind kind);
 
+// The names of the model inputs mufric knows, spelled once: known_inputs() and every file that maps
+// an input to something of its own (a wire field, a client's array, a CSV column) use these.
+namespace input_name {
+inline constexpr std::string_view contact_pressure = "contact_pressure";
+inline constexpr std::string_view sliding_velocity = "sliding_velocity";
+inline constexpr std::string_view temperature = "temperature";
+inline constexpr std::string_view fibre_angle = "fibre_angle";
+}  // namespace input_name
+
 // The model inputs mufric knows, the one table of them: in their usual order (the C ABI's argument
-// order, a dataset's columns), each with its kind of quantity and the command-line flag that gives
-// its value or range (predict, dataset plan).
+// order, a dataset's columns), each with its kind of quantity (so its SI unit), the command-line
+// flag that gives its value or range (predict, dataset plan), the scene key a micro-model dataset
+// sets it through (empty: no scene has it), and whether the wire and the clients carry it (a served
+// model's inputs must; a law coefficient that a calibration integrates out need not).
 struct KnownInput {
   std::string_view name;
   QuantityKind kind;
   std::string_view flag;
+  std::string_view scene_key;
+  bool on_the_wire = true;
 };
 const std::vector<KnownInput>& known_inputs();
 // The known input of that name; nullptr if mufric does not know it.

@@ -14,11 +14,11 @@ static_assert(static_cast<int>(Extrapolation::refuse) == v1::EXTRAPOLATION_REFUS
 static_assert(static_cast<int>(PointStatus::out_of_box) == v1::POINT_STATUS_OUT_OF_BOX);
 
 const google::protobuf::RepeatedField<double>* input_array(const v1::EvaluateRequest& request, std::string_view name) {
-  if (name == "contact_pressure") return &request.contact_pressure();
-  if (name == "sliding_velocity") return &request.sliding_velocity();
-  if (name == "temperature") return &request.temperature();
-  if (name == "fibre_angle") return &request.fibre_angle();
-  return nullptr;
+  if (name == input_name::contact_pressure) return &request.contact_pressure();
+  if (name == input_name::sliding_velocity) return &request.sliding_velocity();
+  if (name == input_name::temperature) return &request.temperature();
+  if (name == input_name::fibre_angle) return &request.fibre_angle();
+  return nullptr;  // not on the wire (KnownInput::on_the_wire; tested to agree)
 }
 
 google::protobuf::RepeatedField<double>* mutable_input_array(v1::EvaluateRequest& request, std::string_view name) {

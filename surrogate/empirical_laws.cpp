@@ -55,8 +55,8 @@ std::string CoulombLaw::summary() const {
 MlrLaw::MlrLaw(std::vector<MlrRow> rows, std::string source, InputSpace inputs)
     : FrictionModel(std::move(inputs)), rows_(std::move(rows)), source_(std::move(source)) {
   if (rows_.empty()) throw Error("MLR law: no fibre angles");
-  if (this->inputs().size() != 3 || this->inputs()[0].name != "contact_pressure" ||
-      this->inputs()[1].name != "sliding_velocity" || this->inputs()[2].name != "fibre_angle") {
+  if (this->inputs().size() != 3 || this->inputs()[0].name != input_name::contact_pressure ||
+      this->inputs()[1].name != input_name::sliding_velocity || this->inputs()[2].name != input_name::fibre_angle) {
     throw Error("MLR law: inputs must be contact_pressure, sliding_velocity, fibre_angle");
   }
   for (auto& row : rows_) {
@@ -76,9 +76,9 @@ MlrLaw::MlrLaw(std::vector<MlrRow> rows, std::string source, InputSpace inputs)
 }
 
 InputSpace MlrLaw::seed001_box() {
-  return {{"contact_pressure", "Pa", 0.0, 200e6},
-          {"sliding_velocity", "m/s", 1.0 / 60.0, 15.0 / 60.0},
-          {"fibre_angle", "rad", 0.0, std::numbers::pi}};
+  return {{std::string(input_name::contact_pressure), "Pa", 0.0, 200e6},
+          {std::string(input_name::sliding_velocity), "m/s", 1.0 / 60.0, 15.0 / 60.0},
+          {std::string(input_name::fibre_angle), "rad", 0.0, std::numbers::pi}};
 }
 
 MlrLaw MlrLaw::seed001_table2() {
@@ -166,9 +166,9 @@ std::string MlrLaw::summary() const {
 
 MlrLaw fit_mlr_law(const std::string& csv_path, MlrFitReport* report) {
   const CsvTable table = read_csv_table(csv_path);
-  const auto angle = table.si_column("fibre_angle");
-  const auto pressure = table.si_column("contact_pressure");
-  const auto velocity = table.si_column("sliding_velocity");
+  const auto angle = table.si_column(std::string(input_name::fibre_angle));
+  const auto pressure = table.si_column(std::string(input_name::contact_pressure));
+  const auto velocity = table.si_column(std::string(input_name::sliding_velocity));
   const auto mu = table.si_column("mu");
   std::map<long long, std::vector<size_t>> groups;  // angle in 1e-9 deg steps → rows
   for (size_t i = 0; i < angle.size(); ++i) {

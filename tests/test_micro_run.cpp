@@ -101,6 +101,50 @@ TEST(Scene, ShippedScenesStateTheBuiltInDefaultsExceptTheirDeclaredChoices) {
   }
 }
 
+// Each known input with a scene key sets that key to its SI value to the last bit (the awkward
+// doubles too: %.17g reads back exactly), through the scene's own reader, so the key's checks apply
+// (a pressure above the physical range is refused naming the key); an input without a scene key is
+// refused by a micro-model dataset, naming the inputs a scene sets.
+TEST(Scene, AKnownInputsSceneKeySetsItsValueToTheLastBit) {
+  const Scene base = parse_scene(small_scene(), "s");
+  const double pressure = 0.1 + 7.2e8 / 3.0, speed = 1.0 / 3.0 + 1e-9, temperature = 600.0 + 1.0 / 7.0;
+  std::vector<SceneValue> values;
+  for (const KnownInput& input : known_inputs()) {
+    if (input.scene_key.empty()) continue;
+    const double v = input.name == input_name::contact_pressure   ? pressure
+                     : input.name == input_name::sliding_velocity ? speed
+                                                                   : temperature;
+    values.push_back({input.scene_key, v, input.kind});
+  }
+  ASSERT_EQ(values.size(), 3U);
+  const Scene set = scene_with_values(base, values);
+  EXPECT_EQ(set.pressure, pressure);
+  EXPECT_EQ(set.velocity, speed);
+  EXPECT_EQ(set.temperature, temperature);
+  EXPECT_EQ(set.interval, base.interval);  // the rest as it was
+  EXPECT_EQ(set.contact_interface, base.contact_interface);
+  try {
+    scene_with_values(base, {{"load.pressure", 2e11, QuantityKind::pressure}});
+    ADD_FAILURE() << "a pressure above the physical range was set";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("load.pressure"), std::string::npos) << e.what();
+  }
+  nlohmann::json dimensionless = small_scene();
+  apply_override(dimensionless, "contact.law=\"shear-factor\"");
+  apply_override(dimensionless, "contact.shear_factor=0.5");
+  const Scene sheared = scene_with_values(parse_scene(dimensionless, "s"), {{"contact.shear_factor", 0.3, QuantityKind::dimensionless}});
+  EXPECT_EQ(dynamic_cast<const contact::ShearFactorLaw&>(*sheared.contact_interface.law).dry().shear_factor, 0.3);
+  const InputSpace with_angle = {{"contact_pressure", "Pa", 3e8, 1e9}, {"sliding_velocity", "m/s", 1, 2},
+                                 {"temperature", "K", 300, 900}, {"fibre_angle", "rad", 0, 1}};
+  try {
+    micro_evaluator(base, with_angle, 1);
+    ADD_FAILURE() << "fibre_angle was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'fibre_angle' has no counterpart"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("contact_pressure, sliding_velocity, temperature"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scene, ErrorsNameTheKey) {
   const nlohmann::json j = default_scene_json();
   EXPECT_NO_THROW(parse_scene(j, "scene.json"));

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "common/units.hpp"
+#include "client/friction_client.hpp"
 #include "proto/wire_codec.hpp"
 
 namespace mufric {
@@ -71,23 +72,30 @@ TEST(WireCodec, ABadFieldIsNamed) {
   EXPECT_NE(wire::decode_options(wire, back).find("mu_tolerance"), std::string::npos);
 }
 
-// Every input the models know has its array on the wire, and the two accessors agree.
-TEST(WireCodec, EveryKnownInputHasItsArray) {
+// Every input the one table says is on the wire has its array there and its field in the client's
+// block, and one that is not has neither; the two wire accessors agree.
+TEST(WireCodec, EveryKnownInputOnTheWireHasItsArrayAndItsClientField) {
   v1::EvaluateRequest wire;
   double value = 1.0;
-  for (const std::string& name : known_input_names()) {
-    auto* array = wire::mutable_input_array(wire, name);
-    ASSERT_NE(array, nullptr) << name;
+  std::vector<std::string> carried;
+  for (const KnownInput& input : known_inputs()) {
+    auto* array = wire::mutable_input_array(wire, input.name);
+    EXPECT_EQ(array != nullptr, input.on_the_wire) << input.name;
+    EXPECT_EQ(client::Block::field_for(input.name) != nullptr, input.on_the_wire) << input.name;
+    if (array == nullptr) continue;
     array->Add(value);
     value += 1.0;
+    carried.emplace_back(input.name);
   }
+  ASSERT_GE(carried.size(), 4U);
   value = 1.0;
-  for (const std::string& name : known_input_names()) {
+  for (const std::string& name : carried) {
     ASSERT_EQ(wire::input_array(wire, name)->size(), 1) << name;
     EXPECT_EQ(wire::input_array(wire, name)->Get(0), value) << name;
     value += 1.0;
   }
   EXPECT_EQ(wire::input_array(wire, "pressure"), nullptr);
+  EXPECT_EQ(client::Block::field_for("pressure"), nullptr);
 }
 
 }  // namespace

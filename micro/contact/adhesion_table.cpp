@@ -66,9 +66,9 @@ AdhesionTable::AdhesionTable(std::vector<double> pressures, std::vector<double> 
 
 AdhesionTable AdhesionTable::read(const std::string& path) {
   const CsvTable table = read_csv_table(path);
-  const std::vector<double> p = table.si_column("contact_pressure", QuantityKind::pressure);
-  const std::vector<double> v = table.si_column("sliding_velocity", QuantityKind::velocity);
-  const std::vector<double> t = table.si_column("temperature", QuantityKind::temperature);
+  const std::vector<double> p = table.si_column(std::string(input_name::contact_pressure), QuantityKind::pressure);
+  const std::vector<double> v = table.si_column(std::string(input_name::sliding_velocity), QuantityKind::velocity);
+  const std::vector<double> t = table.si_column(std::string(input_name::temperature), QuantityKind::temperature);
   const std::vector<double> mu = table.si_column("mu_a");
   if (mu.empty()) throw Error(path + ": no rows");
   const std::vector<double> p_axis = grid_axis(p), v_axis = grid_axis(v), t_axis = grid_axis(t);

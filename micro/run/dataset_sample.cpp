@@ -1,5 +1,6 @@
 #include "micro/run/dataset_sample.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #include <omp.h>
@@ -16,34 +17,36 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     throw Error(scene.source + ": load.vertical_displacement: a dataset varies the contact pressure, so the scene must "
                                "give load.pressure");
   }
-  int pressure = -1, velocity = -1, temperature = -1;
-  for (size_t j = 0; j < inputs.size(); ++j) {
-    const std::string& name = inputs[j].name;
-    if (name == "contact_pressure") {
-      pressure = static_cast<int>(j);
-    } else if (name == "sliding_velocity") {
-      velocity = static_cast<int>(j);
-    } else if (name == "temperature") {
-      temperature = static_cast<int>(j);
-    } else {
-      throw Error("input '" + name + "' has no counterpart in a micro-model scene (it sets contact_pressure, "
-                  "sliding_velocity and temperature)");
+  // Each input sets the scene key the one table of inputs gives it (KnownInput::scene_key).
+  std::vector<const KnownInput*> known;
+  std::string settable;
+  for (const KnownInput& k : known_inputs()) {
+    if (!k.scene_key.empty()) settable += (settable.empty() ? "" : ", ") + std::string(k.name);
+  }
+  for (const InputSpec& input : inputs) {
+    const KnownInput* k = find_known_input(input.name);
+    if (k == nullptr || k->scene_key.empty()) {
+      throw Error("input '" + input.name + "' has no counterpart in a micro-model scene (the inputs a scene sets: " +
+                  settable + ")");
+    }
+    known.push_back(k);
+  }
+  for (const std::string_view required : {input_name::contact_pressure, input_name::sliding_velocity, input_name::temperature}) {
+    if (std::none_of(known.begin(), known.end(), [&](const KnownInput* k) { return k->name == required; })) {
+      throw Error("a micro-model dataset needs the inputs contact_pressure, sliding_velocity and temperature");
     }
   }
-  if (pressure < 0 || velocity < 0 || temperature < 0) {
-    throw Error("a micro-model dataset needs the inputs contact_pressure, sliding_velocity and temperature");
-  }
-  return [scene, pressure, velocity, temperature, threads_per_sample, sample_wall_seconds](const SampleRequest& request) {
+  // The scene is read again at every plan point, so every check of the scene applies to its values.
+  scene_with_values(scene, {});
+  return [scene, known, threads_per_sample, sample_wall_seconds](const SampleRequest& request) {
     omp_set_num_threads(std::max(threads_per_sample, 1));  // this thread's parallel regions
-    const Eigen::VectorXd& x = request.x;
-    Scene s = scene;
+    std::vector<SceneValue> values;
+    for (size_t j = 0; j < known.size(); ++j) values.push_back({known[j]->scene_key, request.x(static_cast<Eigen::Index>(j)), known[j]->kind});
+    Scene s = scene_with_values(scene, values);
     if (request.seeds) {  // the row's own surfaces (a measured or flat surface has no seed and stays)
       s.tool_surface.synthetic.seed = request.seeds->tool;
       s.chip_surface.synthetic.seed = request.seeds->chip;
     }
-    s.pressure = x(pressure);
-    s.velocity = x(velocity);
-    s.temperature = x(temperature);
     // The sample's draws (tool phases, realisations) share its cores.
     MeasureOptions options;
     options.threads = std::max(threads_per_sample, 1);

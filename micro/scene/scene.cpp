@@ -485,6 +485,7 @@ void refuse_a_scene_that_cannot_fit(const Scene& s) {
 Scene parse_scene(const nlohmann::json& j, const std::string& source, const std::string& base_directory) {
   Scene s;
   s.source = source;
+  s.base_directory = base_directory;
   s.effective = j;
   Section root(j, "", source);
   s.physics = root.choice("physics", s.physics);
@@ -540,6 +541,23 @@ Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& 
                            const std::string& base_directory) {
   for (const auto& assignment : overrides) apply_override(json, assignment);
   return parse_scene(json, source, base_directory);
+}
+
+Scene scene_with_values(const Scene& scene, const std::vector<SceneValue>& values) {
+  nlohmann::json json = scene.effective;
+  for (const auto& [key, value, kind] : values) {
+    // Written to the last bit: %.17g reads back to the same double, and an SI unit scales by 1.
+    char text[64];
+    std::snprintf(text, sizeof text, "%.17g", value);
+    std::string assignment = std::string(key) + "=";
+    if (kind == QuantityKind::dimensionless) {
+      assignment += text;
+    } else {
+      assignment += "\"" + std::string(text) + std::string(si_unit(kind)) + "\"";
+    }
+    apply_override(json, assignment);
+  }
+  return parse_scene(json, scene.source, scene.base_directory);
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {

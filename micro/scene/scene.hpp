@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/units.hpp"
+
 #include "micro/contact/interface_laws.hpp"
 #include "micro/contact/mortar_contact.hpp"
 #include "micro/coupling/lubricated_chip.hpp"
@@ -164,6 +166,7 @@ struct LubricantSpec {
 
 struct Scene {
   std::string source;  // file name, for messages
+  std::string base_directory = ".";  // where the file's relative paths resolve (a re-read with overrides needs it)
   Physics physics = Physics::dry;
   // geometry
   double interval = micrometres(10);   // m, the periodic width (seed 000: 1e-5 m)
@@ -319,6 +322,16 @@ nlohmann::json default_scene_json();
 // A scene's JSON with "key=value" overrides applied, parsed.
 Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& overrides, const std::string& source,
                            const std::string& base_directory = ".");
+// The scene read again from its own words with SI values set at scene keys ("load.pressure" to 8e8):
+// how a dataset sets a plan point's inputs, whatever scene key an input names (common/units.hpp's
+// KnownInput::scene_key). Every check of the scene applies to the new values.
+struct SceneValue {
+  std::string_view key;  // e.g. load.pressure, contact.shear_factor
+  double si;             // the value in SI
+  QuantityKind kind;     // dimensionless: written as a number, else with its SI unit
+};
+Scene scene_with_values(const Scene& scene, const std::vector<SceneValue>& values);
+
 // A scene file (or, for an empty path, the default scene) with "key=value" overrides applied.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides);
 
