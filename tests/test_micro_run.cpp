@@ -64,7 +64,7 @@ void leaf_keys(const nlohmann::json& j, const std::string& prefix, std::vector<s
 
 // The defaults of absent keys have one source, the Scene's member initialisers (and the few rules
 // that follow other keys: time.max_step ← time.step, thermal.model and lubricant.fill/leak ← the
-// protocol, contact.tangential_penalty ← contact.penalty). The shipped scene files restate them for
+// protocol; contact.tangential_penalty ← contact.penalty, in MortarContact). The shipped scene files restate them for
 // the user who copies one, so each stated value is held to that source: removing it changes nothing,
 // unless the key is one a scene must give or one of the few the default scene deliberately chooses
 // (listed here with why). A changed built-in default fails here until the files follow it.
@@ -185,7 +185,10 @@ TEST(Scene, ErrorsNameTheKey) {
   const auto* coulomb_law = dynamic_cast<const contact::CoulombLaw*>(with_friction.contact_interface.law.get());
   ASSERT_NE(coulomb_law, nullptr);
   EXPECT_DOUBLE_EQ(coulomb_law->dry().adhesive_coefficient, 0.15);
-  EXPECT_DOUBLE_EQ(with_friction.contact_interface.tangential_penalty, contact::kTangentialPenaltyRatio * with_friction.penalty);
+  EXPECT_EQ(with_friction.contact_interface.tangential_penalty, 0.0);  // the contact's default, applied there
+  apply_override(coulomb, "contact.tangential_penalty=2e17");
+  EXPECT_EQ(parse_scene(coulomb, "s").contact_interface.tangential_penalty, 2e17);
+  apply_override(coulomb, "contact.tangential_penalty=null");
   apply_override(coulomb, "contact.adhesive_coefficient=-0.1");
   EXPECT_NE(error_of(coulomb).find("contact.adhesive_coefficient: "), std::string::npos) << error_of(coulomb);
   apply_override(coulomb, "contact.adhesive_coefficient=0.15");

@@ -15,6 +15,12 @@
 
 namespace mufric::contact {
 
+// The range every reader and constructor holds a coefficient to (one source for both).
+struct CoefficientRange {
+  double lo, hi;
+  bool contains(double x) const { return x >= lo && x <= hi; }
+};
+
 // The state of one contact point as a law sees it. The contact supplies the pressure; the rest comes
 // from the PointStateProvider the contact's owner attaches (the chip beneath the point, the lubricant
 // around it), as of the last accepted step: within a step the law's inputs are frozen, so a step's

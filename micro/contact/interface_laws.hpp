@@ -16,11 +16,6 @@
 
 namespace mufric::contact {
 
-// The range every reader and constructor holds a coefficient to (one source for both).
-struct CoefficientRange {
-  double lo, hi;
-  bool contains(double x) const { return x >= lo && x <= hi; }
-};
 inline constexpr CoefficientRange kAdhesiveCoefficientRange{0.0, 5.0};  // μ_a
 inline constexpr CoefficientRange kShearFactorRange{0.0, 1.0};          // m: τ = m k, at most the yield shear
 // Childs' n: 1 is the exponential blend; at 20 the blend is within 2.3 % of Zorev's corner

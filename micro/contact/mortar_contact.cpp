@@ -17,7 +17,7 @@ MortarContact::MortarContact(const solid::IgaSpace& space, RigidTool tool, doubl
   if (!interface_.law) interface_.law = std::make_shared<FrictionlessLaw>();
   if (interface_.tangential_penalty == 0.0) interface_.tangential_penalty = kTangentialPenaltyRatio * penalty_;
   if (!(interface_.tangential_penalty > 0.0)) throw Error("contact: the tangential penalty must be positive");
-  if (!(interface_.heat_partition >= 0.0 && interface_.heat_partition <= 1.0)) {
+  if (!kHeatPartitionRange.contains(interface_.heat_partition)) {
     throw Error("contact: the heat partition must be in [0, 1]");
   }
   seeds_ = std::make_shared<const spline::ProjectionSeeds>(tool_.surface);

@@ -40,6 +40,7 @@ inline constexpr double kTangentialPenaltyRatio = 0.1;
 // J. Tribol. 106:145): 0.33–0.71 for a steel chip (~50 W/(m K)) on WC–Co (~50–100) or a TiN coating
 // (~20). The middle of that range is the default; the scene sets it (contact.heat_partition).
 inline constexpr double kDefaultHeatPartition = 0.5;
+inline constexpr CoefficientRange kHeatPartitionRange{0.0, 1.0};
 
 // The law and what the contact does around it, whatever the law: stick's regularisation and where
 // the frictional heat goes.

@@ -237,10 +237,12 @@ void read_contact(Section c, Scene& s, const std::string& base_directory) {
       s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is " + law_name);
     }
   }
-  // Stick's regularisation: a tenth of the normal penalty by default (contact::kTangentialPenaltyRatio).
-  interface.tangential_penalty = c.number("tangential_penalty", contact::kTangentialPenaltyRatio * s.penalty, 1e3, 1e30);
+  // Stick's regularisation; absent, 0: the contact's default, a tenth of the normal penalty
+  // (contact::kTangentialPenaltyRatio, applied in one place, MortarContact).
+  interface.tangential_penalty = c.number("tangential_penalty", 0.0, 1e3, 1e30);
   // The share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
-  interface.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, 0.0, 1.0);
+  interface.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, contact::kHeatPartitionRange.lo,
+                                      contact::kHeatPartitionRange.hi);
   // Wetted spots take the law's wetted coefficients (contact::kDefaultWetted* say where the defaults
   // come from); only a lubricated scene has a film to wet them.
   if (has_wetted && frictional && s.physics != Physics::lubricated) {
