@@ -146,6 +146,13 @@ SurfaceSpec read_surface(Section s, const std::string& base_directory) {
   return out;
 }
 
+// Where a law's key lives: "x" in the contact section, "wetted.x" as x in its wetted subsection.
+std::pair<Section&, std::string> law_key_section(std::string_view key, Section& contact, Section& wetted) {
+  constexpr std::string_view kWettedPrefix = "wetted.";
+  if (key.starts_with(kWettedPrefix)) return {wetted, std::string(key.substr(kWettedPrefix.size()))};
+  return {contact, std::string(key)};
+}
+
 // The law's coefficient keys as the scene file spells them (contact.*, contact.wetted.*): reads for
 // contact::LawKeys, with the file, the key and the law named in every error. A law reads only the
 // keys its registry entry declares (a logic error otherwise: the scene's warnings about another
@@ -182,15 +189,13 @@ class SceneLawKeys final : public contact::LawKeys {
       throw std::logic_error("contact law " + std::string(law_.name) + " reads contact." + std::string(key) +
                              ", which its registry entry does not declare");
     }
-    if (key.starts_with(kWettedPrefix)) return {wetted_, std::string(key.substr(kWettedPrefix.size()))};
-    return {contact_, std::string(key)};
+    return law_key_section(key, contact_, wetted_);
   }
   void require(const Section& section, const std::string& name, std::string_view example) const {
     if (!section.has(name)) {
       section.fail(name, "required when contact.law is " + std::string(law_.name) + " (" + std::string(example) + ")");
     }
   }
-  static constexpr std::string_view kWettedPrefix = "wetted.";
   Section& contact_;
   Section& wetted_;
   const contact::InterfaceLawEntry& law_;
@@ -203,9 +208,7 @@ void warn_about_other_laws_keys(Section& contact, Section& wetted, const contact
   for (const auto& other : contact::interface_laws()) {
     for (const std::string_view key : other.keys) {
       if (std::find(law.keys.begin(), law.keys.end(), key) != law.keys.end()) continue;
-      const bool nested = key.starts_with("wetted.");
-      Section& section = nested ? wetted : contact;
-      const std::string name(nested ? key.substr(std::string_view("wetted.").size()) : key);
+      auto [section, name] = law_key_section(key, contact, wetted);
       if (!section.has(name)) continue;
       section.take(name);
       const std::string warning = "contact." + std::string(key) + " is read but has no effect: contact.law is " +
