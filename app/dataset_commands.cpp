@@ -3,6 +3,7 @@
 // as the sample evaluator, and progress is printed.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -43,6 +44,17 @@ std::pair<double, double> parse_range(const std::string& text, QuantityKind kind
   return {lo, hi};
 }
 
+// The inputs a micro-model scene can set besides p, v, T: the interface law's coefficients.
+std::vector<const KnownInput*> law_coefficient_inputs() {
+  std::vector<const KnownInput*> coefficients;
+  const InputSpace box = default_friction_box();
+  for (const KnownInput& input : known_inputs()) {
+    const bool in_box = std::any_of(box.begin(), box.end(), [&](const InputSpec& s) { return s.name == input.name; });
+    if (!input.scene_key.empty() && !in_box) coefficients.push_back(&input);
+  }
+  return coefficients;
+}
+
 void print_box(const InputSpace& box) {
   for (const auto& input : box) {
     std::printf("  %-17s %s .. %s\n", input.name.c_str(), format_human(input.lo, input.kind()).c_str(),
@@ -65,6 +77,14 @@ void plan_command(const PlanOptions& o) {
     const std::string flag(find_known_input(input.name)->flag);
     const auto text = o.ranges.find(flag);
     if (text != o.ranges.end() && !text->second.empty()) std::tie(input.lo, input.hi) = parse_range(text->second, input.kind(), flag);
+  }
+  // A law coefficient given a range becomes an input of the plan, after p, v, T (a calibration's θ).
+  for (const KnownInput* coefficient : law_coefficient_inputs()) {
+    const auto text = o.ranges.find(std::string(coefficient->flag));
+    if (text == o.ranges.end() || text->second.empty()) continue;
+    InputSpec input{std::string(coefficient->name), std::string(si_unit(coefficient->kind)), 0.0, 0.0};
+    std::tie(input.lo, input.hi) = parse_range(text->second, coefficient->kind, text->first);
+    box.push_back(input);
   }
   const scene::Scene sc = scene::load_scene(o.scene_path, o.overrides);
   run::micro_evaluator(sc, box, 1);  // refuses a scene the dataset cannot drive, before anything is written
@@ -322,7 +342,7 @@ void add_dataset_commands(CLI::App& app) {
   CLI::App* dataset = app.get_subcommand("dataset");
 
   auto p = std::make_shared<PlanOptions>();
-  auto* plan = dataset->add_subcommand("plan", "A sampling plan over the (p, v, T) box for micro-model runs");
+  auto* plan = dataset->add_subcommand("plan", "A sampling plan over the (p, v, T) box, and any law coefficient given a range, for micro-model runs");
   plan->add_option("--out", p->out, "Plan file to write (HDF5, a dataset with no samples yet)")->required();
   plan->add_option("--samples", p->samples, "Number of points")->capture_default_str()->check(CLI::Range(1LL, 10000000LL));
   plan->add_option("--design", p->design, "sobol, lhs (Latin hypercube) or random")->capture_default_str();
@@ -332,6 +352,13 @@ void add_dataset_commands(CLI::App& app) {
     plan->add_option(flag, p->ranges[flag],
                      "Range of " + input.name + ", e.g. " + format_human(input.lo, input.kind()) + ":" +
                          format_human(input.hi, input.kind()) + " (default: that, seed 000's box)");
+  }
+  for (const KnownInput* coefficient : law_coefficient_inputs()) {  // --shear-factor, ...
+    const std::string flag(coefficient->flag);
+    plan->add_option(flag, p->ranges[flag],
+                     "Vary the interface law's " + std::string(coefficient->name) + " (" + std::string(coefficient->scene_key) +
+                         ") over lo:hi, e.g. 0.2:0.9, as an input after p, v, T (a calibration campaign); the scene's "
+                         "law must read it");
   }
   plan->add_option("--scene", p->scene_path, "Scene file (JSON) stored with the plan; default: the default dry scene")
       ->check(CLI::ExistingFile);

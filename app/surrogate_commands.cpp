@@ -393,7 +393,8 @@ void add_predict(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("predict", "Friction coefficients with their confidence intervals, human units");
   cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), a shipped model's name (dry_default), or grpc://host:port/model")->required();
-  for (const KnownInput& input : known_inputs()) {  // --p, --v, --T, --angle
+  for (const KnownInput& input : known_inputs()) {  // --p, --v, --T, --angle: what a client carries
+    if (!input.on_the_wire) continue;
     const std::string flag(input.flag);
     cmd->add_option(flag, o->values[flag],
                     "The " + std::string(input.name) + " with its unit, e.g. " + std::string(example_quantity(input.kind)));
@@ -422,7 +423,7 @@ void add_predict(CLI::App& app) {
     PredictPoints points;
     if (from_csv) {
       for (const KnownInput& input : known_inputs()) {
-        if (!o->values[std::string(input.flag)].empty()) throw Error(std::string(input.flag) + " and --csv exclude each other");
+        if (input.on_the_wire && !o->values[std::string(input.flag)].empty()) throw Error(std::string(input.flag) + " and --csv exclude each other");
       }
       points = points_from_csv(o->csv, inputs);
     } else {
@@ -437,6 +438,7 @@ void add_predict(CLI::App& app) {
         points.columns.push_back({parse_quantity(text, input.kind(), flag)});
       }
       for (const KnownInput& known : known_inputs()) {
+        if (!known.on_the_wire) continue;
         const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == known.name; });
         if (!used && !o->values[std::string(known.flag)].empty()) {
           throw Error(std::string(known.flag) + " was given but the model has no input " + std::string(known.name));

@@ -103,7 +103,11 @@ class InProcessClient final : public FrictionClient {
   InProcessClient(const std::string& path, const Options& options)
       : path_(path),
         model_(options.isolate_file_parsing ? load_model_isolated(path) : load_model(path)),
-        unanswered_{options.fill, options.fallback_mu} {}
+        unanswered_{options.fill, options.fallback_mu} {
+    if (const std::string why = servable_inputs_violation(input_names(model_->inputs())); !why.empty()) {
+      throw Error("model '" + path + "' cannot be evaluated through a client: " + why);
+    }
+  }
 
   Answer evaluate(const Block& block, const EvaluationRequest& request) override {
     // Several threads of the caller at once (std::thread, MPI + threads: an OpenMP caller is caught

@@ -30,6 +30,13 @@ struct InputSpec {
 
 using InputSpace = std::vector<InputSpec>;
 
+// The inputs' names, in their order.
+inline std::vector<std::string> input_names(const InputSpace& inputs) {
+  std::vector<std::string> names;
+  for (const InputSpec& input : inputs) names.push_back(input.name);
+  return names;
+}
+
 // The same inputs in the same order, with the same units and boxes.
 inline bool same_input_space(const InputSpace& a, const InputSpace& b) {
   if (a.size() != b.size()) return false;

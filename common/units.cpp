@@ -170,8 +170,24 @@ const std::vector<KnownInput>& known_inputs() {
       {input_name::contact_pressure, QuantityKind::pressure, "--p", "load.pressure"},
       {input_name::sliding_velocity, QuantityKind::velocity, "--v", "load.velocity"},
       {input_name::temperature, QuantityKind::temperature, "--T", "load.temperature"},
-      {input_name::fibre_angle, QuantityKind::angle, "--angle", ""}};  // the empirical FRP law's, no scene
+      {input_name::fibre_angle, QuantityKind::angle, "--angle", ""},  // the empirical FRP law's, no scene
+      {input_name::adhesive_coefficient, QuantityKind::dimensionless, "--adhesive-coefficient", "contact.adhesive_coefficient", false},
+      {input_name::shear_factor, QuantityKind::dimensionless, "--shear-factor", "contact.shear_factor", false},
+      {input_name::childs_exponent, QuantityKind::dimensionless, "--childs-exponent", "contact.childs_exponent", false}};
   return inputs;
+}
+
+std::string servable_inputs_violation(const std::vector<std::string>& input_names) {
+  for (const std::string& name : input_names) {
+    const KnownInput* known = find_known_input(name);
+    if (known == nullptr) return "its input '" + name + "' is not one mufric's wire and clients carry";
+    if (!known->on_the_wire) {
+      return "its input '" + name +
+             "' is a coefficient of the interface law, which a served model must not leave open: calibrate it against "
+             "measured friction (mufric calibrate) and serve the calibrated model";
+    }
+  }
+  return "";
 }
 
 const KnownInput* find_known_input(std::string_view input_name) {

@@ -43,13 +43,18 @@ inline constexpr std::string_view contact_pressure = "contact_pressure";
 inline constexpr std::string_view sliding_velocity = "sliding_velocity";
 inline constexpr std::string_view temperature = "temperature";
 inline constexpr std::string_view fibre_angle = "fibre_angle";
+// The interface law's coefficients (micro/contact/interface_laws.hpp), inputs of a calibration campaign.
+inline constexpr std::string_view adhesive_coefficient = "adhesive_coefficient";
+inline constexpr std::string_view shear_factor = "shear_factor";
+inline constexpr std::string_view childs_exponent = "childs_exponent";
 }  // namespace input_name
 
 // The model inputs mufric knows, the one table of them: in their usual order (the C ABI's argument
 // order, a dataset's columns), each with its kind of quantity (so its SI unit), the command-line
 // flag that gives its value or range (predict, dataset plan), the scene key a micro-model dataset
 // sets it through (empty: no scene has it), and whether the wire and the clients carry it (a served
-// model's inputs must; a law coefficient that a calibration integrates out need not).
+// model's inputs must; a law coefficient that a calibration integrates out need not, and a model
+// that still has one is not served: servable_inputs_violation).
 struct KnownInput {
   std::string_view name;
   QuantityKind kind;
@@ -62,8 +67,11 @@ const std::vector<KnownInput>& known_inputs();
 const KnownInput* find_known_input(std::string_view input_name);
 // The kind of a named model input (contact_pressure → pressure, ...); dimensionless if unknown.
 QuantityKind kind_of_input(std::string_view input_name);
-// known_inputs()' names: contact_pressure, sliding_velocity, temperature, fibre_angle.
+// known_inputs()' names: contact_pressure, sliding_velocity, temperature, fibre_angle, and the law's coefficients.
 const std::vector<std::string>& known_input_names();
+// Whether a model with inputs of these names can be served (every input on the wire): "" if so, else
+// why not, naming the first input that is not, and what to do about it.
+std::string servable_inputs_violation(const std::vector<std::string>& input_names);
 
 // Where a quantity of a kind can physically lie (SI), the one table every command checks against
 // (dataset plan, scene files, training data, queries): pressure 0–100 GPa (no contact pressure

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "common/dataset_file.hpp"
+#include "common/error.hpp"
 #include "surrogate/model_file.hpp"
 
 namespace mufric::server {
@@ -64,6 +65,9 @@ int ModelRegistry::refresh(Rescan rescan) {
     served->version = sha256.substr(0, kVersionDigits);
     try {
       served->model = load_model_isolated(entry.path().string());
+      if (const std::string why = servable_inputs_violation(input_names(served->model->inputs())); !why.empty()) {
+        throw Error("not served: " + why);
+      }
     } catch (const std::exception& e) {
       log_("warning", "refused model file " + entry.path().string() + ": " + e.what() +
                           " (the previous version, if any, keeps serving)");

@@ -164,11 +164,7 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
                                      Evaluation& out, long long& clamped) const {
   const Eigen::Index n = scaled_train_.rows();
   const Eigen::Index d = scaled_train_.cols();
-  // Query coordinates in the same scaled space as the training inputs: ((x − lo)/width)/l.
-  const Eigen::MatrixXd q = ((x.middleRows(first, count).rowwise() - box_lo_).array().rowwise() *
-                             inverse_box_width_.array())
-                                .matrix() *
-                            state_.hyper.length_scales.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd q = scaled_queries(x.middleRows(first, count));
   const bool need_std = what.std || what.ci_level > 0.0;
   if (!need_std && !what.gradient) {
     // Mean only: correlations and dot product per query, in L1, no kernel block stored.
@@ -242,6 +238,80 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
       }
       out.std(first + b) = state_.y_scale * std::sqrt(variance);
     }
+  }
+}
+
+Eigen::MatrixXd GaussianProcess::scaled_queries(const Eigen::MatrixXd& x) const {
+  return ((x.rowwise() - box_lo_).array().rowwise() * inverse_box_width_.array()).matrix() *
+         state_.hyper.length_scales.cwiseInverse().asDiagonal();
+}
+
+Eigen::VectorXd GaussianProcess::latent_mean(const Eigen::MatrixXd& x) const {
+  require_query_columns(x);
+  const Eigen::MatrixXd q = scaled_queries(x);
+  Eigen::ArrayXd correlation(scaled_train_.rows());
+  Eigen::VectorXd mean(x.rows());
+  for (Eigen::Index b = 0; b < x.rows(); ++b) {
+    correlations_with_training(q.row(b), correlation);
+    mean(b) = mean_from_correlations(correlation.data());
+  }
+  return mean;
+}
+
+Eigen::MatrixXd GaussianProcess::whitened_correlations(const Eigen::MatrixXd& scaled) const {
+  const Eigen::Index n = scaled_train_.rows();
+  Eigen::MatrixXd correlations(n, scaled.rows());
+  Eigen::ArrayXd correlation(n);
+  for (Eigen::Index j = 0; j < scaled.rows(); ++j) {
+    correlations_with_training(scaled.row(j), correlation);
+    correlations.col(j) = correlation.matrix();
+  }
+  return inverse_factor_.triangularView<Eigen::Lower>() * correlations;
+}
+
+Eigen::RowVectorXd GaussianProcess::unexplained_trend(const Eigen::MatrixXd& whitened) const {
+  if (!state_.mean_estimated) return {};
+  return (1.0 - state_.hyper.signal_variance * (trend_direction_.transpose() * whitened).array()).matrix();
+}
+
+Eigen::MatrixXd GaussianProcess::latent_covariance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) const {
+  require_query_columns(a);
+  require_query_columns(b);
+  const bool same = &a == &b;
+  const Eigen::MatrixXd qa = scaled_queries(a);
+  const Eigen::MatrixXd qb = same ? qa : scaled_queries(b);
+  const Eigen::MatrixXd va = whitened_correlations(qa);
+  const Eigen::MatrixXd vb = same ? va : whitened_correlations(qb);
+  const double s2 = state_.hyper.signal_variance;
+  Eigen::MatrixXd covariance(a.rows(), b.rows());
+  for (Eigen::Index j = 0; j < b.rows(); ++j) {
+    for (Eigen::Index i = 0; i < a.rows(); ++i) {
+      const double r2 = (qa.row(i) - qb.row(j)).squaredNorm();
+      covariance(i, j) = s2 * std::exp(std::max(-0.5 * r2, kMinimumExponent));
+    }
+  }
+  covariance.noalias() -= (s2 * s2) * va.transpose() * vb;
+  if (state_.mean_estimated) {
+    covariance.noalias() += unexplained_trend(va).transpose() * unexplained_trend(vb) / trend_precision_;
+  }
+  return state_.y_scale * state_.y_scale * covariance;
+}
+
+Eigen::MatrixXd GaussianProcess::latent_covariance(const Eigen::MatrixXd& x) const { return latent_covariance(x, x); }
+
+Eigen::VectorXd GaussianProcess::latent_variance(const Eigen::MatrixXd& x) const {
+  require_query_columns(x);
+  const Eigen::MatrixXd v = whitened_correlations(scaled_queries(x));
+  const double s2 = state_.hyper.signal_variance;
+  Eigen::ArrayXd variance = s2 - s2 * s2 * v.colwise().squaredNorm().transpose().array();
+  if (state_.mean_estimated) variance += unexplained_trend(v).transpose().array().square() / trend_precision_;
+  return state_.y_scale * state_.y_scale * variance.matrix();
+}
+
+void GaussianProcess::require_query_columns(const Eigen::MatrixXd& x) const {
+  if (x.cols() != scaled_train_.cols()) {
+    throw Error("Gaussian process: points have " + std::to_string(x.cols()) + " columns for " +
+                std::to_string(scaled_train_.cols()) + " inputs");
   }
 }
 

@@ -154,6 +154,17 @@ class GaussianProcess final : public FrictionModel {
   static Eigen::VectorXd std_from_log_variance(const GaussianProcess& log_variance, const QueryBatch& x,
                                                double std_relative_tolerance = 0.0);
 
+  // The latent mean's posterior at SI points (rows; unclamped, anywhere): its mean and the covariance
+  // between two sets of points, μ units (R&W eqs. 2.23–2.24 with k(a, b) for k(x*, x*), plus an
+  // estimated mean's covariance (1 − 1ᵀK⁻¹k_a)(1 − 1ᵀK⁻¹k_b) / 1ᵀK⁻¹1 under State::mean_estimated;
+  // Sacks et al. 1989), without the learned noise or micro_std_error: the interval of the mean,
+  // jointly. A calibration's likelihood needs it whole: the emulator's errors at nearby
+  // measurements are correlated, and a diagonal would count them as independent evidence.
+  Eigen::VectorXd latent_mean(const Eigen::MatrixXd& x) const;
+  Eigen::MatrixXd latent_covariance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) const;
+  Eigen::MatrixXd latent_covariance(const Eigen::MatrixXd& x) const;  // of x with itself
+  Eigen::VectorXd latent_variance(const Eigen::MatrixXd& x) const;    // its diagonal alone
+
   // The model file's groups under `group` ("/gp"; the patch scatter's under "/gp/patch_scatter").
   void write_group(h5::Writer& out, const std::string& group) const;
   static GaussianProcess read_group(const h5::Reader& in, InputSpace inputs, const std::string& group);
@@ -171,6 +182,13 @@ class GaussianProcess final : public FrictionModel {
   void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
                       Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block, Evaluation& out, long long& clamped) const;
 
+  // ((x − lo)/width)/l per row: the space the training inputs are scaled to.
+  Eigen::MatrixXd scaled_queries(const Eigen::MatrixXd& x) const;
+  void require_query_columns(const Eigen::MatrixXd& x) const;
+  // L⁻¹ k̂ for each row's correlations k̂ with the training inputs (n × rows), from scaled queries.
+  Eigen::MatrixXd whitened_correlations(const Eigen::MatrixXd& scaled) const;
+  // 1 − σ² uᵀV per column of a whitened V (an estimated mean's share); empty without one.
+  Eigen::RowVectorXd unexplained_trend(const Eigen::MatrixXd& whitened) const;
   // exp(−½ |s_i − q|²) for every scaled training input s_i and a scaled query q.
   void correlations_with_training(const Eigen::RowVectorXd& scaled_query, Eigen::Ref<Eigen::ArrayXd> correlation) const;
   // μ = ȳ + Σ_i w_i k_i in one fixed summation order, whatever the request, batch or alignment: asking

@@ -889,6 +889,85 @@ TEST_F(Cli, DatasetErrorsNameTheFlag) {
   EXPECT_NE(r.output.find("--shard '2/2'"), std::string::npos) << r.output;
 }
 
+// A calibration campaign's model (inputs p, v and a shear factor m, trained on a smooth synthetic μ),
+// measurements made at m* = 0.55: `calibrate` finds m* inside its 95 % credible interval, writes the
+// same posterior from the same seed, and refuses a row outside the box, a bad prior and chains too
+// short to judge, each naming the cause; such a model is not served until it is calibrated.
+TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
+  auto synthetic_mu = [](double p_mpa, double v_m_min, double m) {
+    const double ps = (p_mpa - 300.0) / 1000.0, vs = (v_m_min - 22.5) / 177.5;
+    return 0.1 + 0.5 * m * (1.0 - 0.3 * ps) - 0.05 * vs;
+  };
+  {
+    std::ofstream train(path("campaign.csv"));
+    train << "contact_pressure[MPa],sliding_velocity[m/min],shear_factor,mu\n";
+    for (int i = 0; i < 64; ++i) {  // a 4 × 4 × 4 grid over the box
+      const double p = 300.0 + 1000.0 * (i % 4) / 3.0, v = 22.5 + 177.5 * ((i / 4) % 4) / 3.0, m = 0.2 + 0.7 * (i / 16) / 3.0;
+      train << p << "," << v << "," << m << "," << synthetic_mu(p, v, m) << "\n";
+    }
+    std::ofstream measured(path("measured.csv"));
+    measured << "# synthetic: the campaign's mu at shear_factor 0.55, stated SD 0.01\n"
+             << "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd\n";
+    for (const auto& [p, v] : std::vector<std::pair<double, double>>{{400, 30}, {600, 120}, {800, 60}, {1000, 180}, {1200, 90}, {500, 150}}) {
+      measured << p << "," << v << "," << synthetic_mu(p, v, 0.55) << ",0.01\n";
+    }
+  }
+  CommandResult r = run("train --data " + path("campaign.csv") + " --out " + path("campaign.h5") + " --restarts 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run("predict --model " + path("campaign.h5") + " --p 800MPa --v 100m/min");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("'shear_factor' is a coefficient of the interface law"), std::string::npos) << r.output;
+
+  const std::string calibrate = "calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") +
+                                " --walkers 12 --burn-in 300 --steps 1200 --seed 5 --out ";
+  r = run(calibrate + path("posterior.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::istringstream lines(r.output);
+  std::string line;
+  double lo = 0.0, hi = 0.0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("shear_factor ", 0) != 0) continue;
+    std::istringstream fields(line);
+    std::string name, dots;
+    double mean = 0.0, sd = 0.0;
+    fields >> name >> mean >> sd >> lo >> dots >> hi;
+  }
+  EXPECT_LE(lo, 0.55) << r.output;
+  EXPECT_GE(hi, 0.55) << r.output;
+  EXPECT_LT(hi - lo, 0.1) << r.output;  // six measurements of SD 0.01 pin m down
+  EXPECT_NE(r.output.find("split-R^"), std::string::npos);
+  const std::string posterior = read_text(path("posterior.csv"));
+  EXPECT_NE(posterior.find("\nshear_factor\n"), std::string::npos);
+  ASSERT_EQ(run(calibrate + path("again.csv")).exit_code, 0);
+  EXPECT_EQ(read_text(path("again.csv")), posterior) << "the same seed, the same posterior";
+
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --steps 8 --burn-in 0 --out " +
+          path("short.csv"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("the posterior is not usable, nothing written: shear_factor"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(path("short.csv")));
+
+  std::ofstream(path("outside.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd\n800,100,0.4,0.01\n1500,100,0.4,0.01\n";
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("outside.csv"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("outside.csv line 3: contact_pressure 1500MPa lies outside the model's box 300MPa – 1300MPa"), std::string::npos) << r.output;
+  std::ofstream(path("priors.json")) << R"({"parameters": {"shear_factor": {"uniform": [0.9, 0.2]}}})";
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --priors " + path("priors.json"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("parameters.shear_factor.uniform"), std::string::npos) << r.output;
+}
+
+// A plan varies a law coefficient as an input when the scene's law reads it, and refuses otherwise.
+TEST_F(Cli, DatasetPlanVariesALawCoefficientTheScenesLawReads) {
+  CommandResult r = run("dataset plan --out " + path("p.h5") + " --samples 4 --shear-factor 0.2:0.9" + kTinyScene);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("contact.shear_factor, which has no effect"), std::string::npos) << r.output;
+  r = run("dataset plan --out " + path("p.h5") + " --samples 4 --shear-factor 0.2:0.9 --set contact.law=\\\"shear-factor\\\" "
+          "--set contact.shear_factor=0.5" + kTinyScene);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("shear_factor"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, DatasetRefineRunsWhereTheSurrogateIsUncertain) {
   ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 6 --p 700MPa:1300MPa" + kTinyScene).exit_code, 0);
   ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5")).exit_code, 0);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <algorithm>
 #include <numbers>
 #include <set>
@@ -106,34 +107,64 @@ TEST(Scene, ShippedScenesStateTheBuiltInDefaultsExceptTheirDeclaredChoices) {
 // (a pressure above the physical range is refused naming the key); an input without a scene key is
 // refused by a micro-model dataset, naming the inputs a scene sets.
 TEST(Scene, AKnownInputsSceneKeySetsItsValueToTheLastBit) {
-  const Scene base = parse_scene(small_scene(), "s");
-  const double pressure = 0.1 + 7.2e8 / 3.0, speed = 1.0 / 3.0 + 1e-9, temperature = 600.0 + 1.0 / 7.0;
+  nlohmann::json childs = small_scene();  // a law that reads every coefficient in the table
+  apply_override(childs, "contact.law=\"childs\"");
+  apply_override(childs, "contact.adhesive_coefficient=0.4");
+  apply_override(childs, "contact.shear_factor=0.5");
+  apply_override(childs, "contact.childs_exponent=2");
+  const Scene base = parse_scene(childs, "s");
+  const std::map<std::string_view, double> value_of{{input_name::contact_pressure, 0.1 + 7.2e8 / 3.0},
+                                                     {input_name::sliding_velocity, 1.0 / 3.0 + 1e-9},
+                                                     {input_name::temperature, 600.0 + 1.0 / 7.0},
+                                                     {input_name::adhesive_coefficient, 0.3 + 1.0 / 30.0},
+                                                     {input_name::shear_factor, 0.6 + 1.0 / 7000.0},
+                                                     {input_name::childs_exponent, 3.0 + 1.0 / 3.0}};
   std::vector<SceneValue> values;
   for (const KnownInput& input : known_inputs()) {
     if (input.scene_key.empty()) continue;
-    const double v = input.name == input_name::contact_pressure   ? pressure
-                     : input.name == input_name::sliding_velocity ? speed
-                                                                   : temperature;
-    values.push_back({input.scene_key, v, input.kind});
+    ASSERT_EQ(value_of.count(input.name), 1U) << input.name << ": a new input with a scene key needs its value here";
+    values.push_back({input.scene_key, value_of.at(input.name), input.kind});
   }
-  ASSERT_EQ(values.size(), 3U);
+  ASSERT_EQ(values.size(), 6U);
   const Scene set = scene_with_values(base, values);
-  EXPECT_EQ(set.pressure, pressure);
-  EXPECT_EQ(set.velocity, speed);
-  EXPECT_EQ(set.temperature, temperature);
+  EXPECT_EQ(set.pressure, value_of.at(input_name::contact_pressure));
+  EXPECT_EQ(set.velocity, value_of.at(input_name::sliding_velocity));
+  EXPECT_EQ(set.temperature, value_of.at(input_name::temperature));
+  const auto& law = dynamic_cast<const contact::ChildsLaw&>(*set.contact_interface.law);
+  EXPECT_EQ(law.dry().adhesive_coefficient, value_of.at(input_name::adhesive_coefficient));
+  EXPECT_EQ(law.dry().shear_factor, value_of.at(input_name::shear_factor));
+  EXPECT_EQ(law.exponent(), value_of.at(input_name::childs_exponent));
   EXPECT_EQ(set.interval, base.interval);  // the rest as it was
-  EXPECT_EQ(set.contact_interface, base.contact_interface);
+  EXPECT_EQ(set.contact_interface.heat_partition, base.contact_interface.heat_partition);
   try {
     scene_with_values(base, {{"load.pressure", 2e11, QuantityKind::pressure}});
     ADD_FAILURE() << "a pressure above the physical range was set";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("load.pressure"), std::string::npos) << e.what();
   }
-  nlohmann::json dimensionless = small_scene();
-  apply_override(dimensionless, "contact.law=\"shear-factor\"");
-  apply_override(dimensionless, "contact.shear_factor=0.5");
-  const Scene sheared = scene_with_values(parse_scene(dimensionless, "s"), {{"contact.shear_factor", 0.3, QuantityKind::dimensionless}});
-  EXPECT_EQ(dynamic_cast<const contact::ShearFactorLaw&>(*sheared.contact_interface.law).dry().shear_factor, 0.3);
+  // A campaign that varies a coefficient the scene's law does not read would run the same scene at
+  // every value: refused, naming the key; one outside the law's range is refused by the law's reader.
+  const InputSpace with_shear_factor = {{"contact_pressure", "Pa", 3e8, 1e9}, {"sliding_velocity", "m/s", 1, 2},
+                                        {"temperature", "K", 300, 900}, {"shear_factor", "1", 0.2, 0.9}};
+  EXPECT_NO_THROW(micro_evaluator(base, with_shear_factor, 1));
+  nlohmann::json coulomb = small_scene();
+  apply_override(coulomb, "contact.law=\"coulomb\"");
+  apply_override(coulomb, "contact.adhesive_coefficient=0.3");
+  try {
+    micro_evaluator(parse_scene(coulomb, "s"), with_shear_factor, 1);
+    ADD_FAILURE() << "a shear factor was varied under Coulomb's law";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("contact.shear_factor, which has no effect: contact.law is coulomb"), std::string::npos)
+        << e.what();
+  }
+  InputSpace beyond = with_shear_factor;
+  beyond.back().hi = 1.5;
+  try {
+    micro_evaluator(base, beyond, 1);
+    ADD_FAILURE() << "a shear factor of 1.5 was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("shear_factor"), std::string::npos) << e.what();
+  }
   const InputSpace with_angle = {{"contact_pressure", "Pa", 3e8, 1e9}, {"sliding_velocity", "m/s", 1, 2},
                                  {"temperature", "K", 300, 900}, {"fibre_angle", "rad", 0, 1}};
   try {

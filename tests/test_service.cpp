@@ -544,6 +544,31 @@ TEST_F(Service, AModelReplacedWithTheSameSizeAndTimeIsLoaded) {
   EXPECT_EQ(served_version(logged.registry, "coulomb"), file_version(other));
 }
 
+// A campaign's model with a law coefficient among its inputs is no friction law a meso code can call:
+// the registry refuses it (its μ would depend on a value the wire cannot carry), and the in-process
+// client says why; both name the input.
+TEST_F(Service, AModelWithALawCoefficientAmongItsInputsIsNotServed) {
+  TrainingSet data = test::smooth_training_set(20, 3);
+  data.inputs.back() = {"shear_factor", "1", 0.2, 0.9};
+  for (Eigen::Index i = 0; i < data.x.rows(); ++i) data.x(i, 2) = 0.2 + 0.7 * static_cast<double>(i) / 19.0;
+  GpTrainingOptions options;
+  options.optimise = false;
+  const fs::path campaign = dir_ / "campaign.h5";
+  save_model(campaign.string(), train_gaussian_process(data, options));
+  LoggedRegistry logged(dir_);
+  logged.registry.refresh();
+  EXPECT_EQ(served_version(logged.registry, "campaign"), "(not served)");
+  EXPECT_NE(logged.log.find("not served: its input 'shear_factor' is a coefficient of the interface law"), std::string::npos)
+      << logged.log;
+  EXPECT_NE(served_version(logged.registry, "coulomb"), "(not served)");  // the others are
+  try {
+    client::connect(campaign.string());
+    ADD_FAILURE() << "the campaign's model was opened";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'shear_factor'"), std::string::npos) << e.what();
+  }
+}
+
 // Regression: deleting a served file stopped its model (an rm-then-cp deploy answered NOT_FOUND
 // for 12 s). The loaded version keeps serving, and the log says so, until a new file replaces it.
 TEST_F(Service, ADeletedModelFileKeepsServingUntilANewFileReplacesIt) {

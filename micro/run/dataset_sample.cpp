@@ -36,8 +36,23 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
       throw Error("a micro-model dataset needs the inputs contact_pressure, sliding_velocity and temperature");
     }
   }
-  // The scene is read again at every plan point, so every check of the scene applies to its values.
-  scene_with_values(scene, {});
+  // The scene is read again at every plan point, so every check of the scene applies to its values:
+  // the box's two corners are read now, before a plan is written. A key the scene's law leaves
+  // unread (a shear factor under Coulomb's law) would make a campaign of identical runs: refused.
+  for (const bool upper : {false, true}) {
+    std::vector<SceneValue> corner;
+    for (size_t j = 0; j < known.size(); ++j) corner.push_back({known[j]->scene_key, upper ? inputs[j].hi : inputs[j].lo, known[j]->kind});
+    const Scene read = scene_with_values(scene, corner);
+    for (const KnownInput* k : known) {
+      const std::string unread = std::string(k->scene_key) + " is read but has no effect";
+      for (const std::string& warning : read.warnings) {
+        if (warning.rfind(unread, 0) == 0) {
+          throw Error("input '" + std::string(k->name) + "' sets " + std::string(k->scene_key) + ", which has no effect" +
+                      warning.substr(unread.size()) + " (choose a law that reads it with --set contact.law=...)");
+        }
+      }
+    }
+  }
   return [scene, known, threads_per_sample, sample_wall_seconds](const SampleRequest& request) {
     omp_set_num_threads(std::max(threads_per_sample, 1));  // this thread's parallel regions
     std::vector<SceneValue> values;

@@ -1,0 +1,168 @@
+// `mufric calibrate`: the posterior of an interface law's coefficients given measured friction,
+// through the GP of a campaign that varied them (surrogate/calibration.hpp).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/units.hpp"
+#include "surrogate/calibration.hpp"
+#include "surrogate/model_file.hpp"
+
+namespace mufric::app {
+namespace {
+
+struct CalibrateOptions {
+  std::string model, data, priors, out;
+  std::vector<std::string> parameters;
+  bool discrepancy = false;
+  EnsembleOptions sampler;
+};
+
+std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
+  std::unique_ptr<FrictionModel> model = load_model_isolated(model_path_from_uri(path));
+  auto* gp = dynamic_cast<GaussianProcess*>(model.get());
+  if (gp == nullptr) {
+    throw Error("--model " + path + ": a calibration needs a Gaussian-process model of a campaign (this one is '" +
+                std::string(model->kind()) + "')");
+  }
+  model.release();
+  return std::shared_ptr<const GaussianProcess>(gp);
+}
+
+// Every input of the model that the measurements do not give.
+std::vector<std::string> unmeasured_inputs(const GaussianProcess& model, const Measurements& data) {
+  std::vector<std::string> names;
+  for (const InputSpec& input : model.inputs()) {
+    if (std::find(data.condition_names.begin(), data.condition_names.end(), input.name) == data.condition_names.end()) {
+      names.push_back(input.name);
+    }
+  }
+  return names;
+}
+
+void print_summary(const CalibrationProblem& problem, const CalibrationResult& result, double seconds) {
+  std::printf("%-26s %10s %10s %23s %8s %8s\n", "parameter", "mean", "sd", "95 % credible interval", "split-R^", "ESS");
+  for (const ParameterSummary& s : result.summary) {
+    char interval[64];
+    std::snprintf(interval, sizeof interval, "%.4g .. %.4g", s.lo95, s.hi95);
+    std::printf("%-26s %10.4g %10.4g %23s %8.3f %8.0f\n", s.name.c_str(), s.mean, s.sd, interval, s.split_rhat,
+                s.effective_sample_size);
+  }
+  std::printf("%d walkers x %d steps after %d burn-in, seed %llu; acceptance %.2f; %.1f s\n", result.options.walkers,
+              result.options.steps, result.options.burn_in_steps, static_cast<unsigned long long>(result.options.seed),
+              result.acceptance, seconds);
+  if (problem.discrepancy()) {
+    std::printf("discrepancy_amplitude in mu units, discrepancy_length_scale in widths of the model's box\n");
+  }
+}
+
+void write_posterior(const std::string& path, const CalibrationProblem& problem, const CalibrationResult& result,
+                     const CalibrateOptions& o) {
+  std::ostringstream text;
+  text << "# posterior samples of mufric calibrate (every walker's kept states, natural units)\n";
+  text << "# model " << o.model << ", measurements " << o.data << (o.priors.empty() ? "" : ", priors " + o.priors)
+       << ", seed " << o.sampler.seed << "\n";
+  const auto& names = problem.coordinate_names();
+  for (size_t j = 0; j < names.size(); ++j) text << (j ? "," : "") << names[j];
+  text << "\n";
+  char number[32];
+  for (Eigen::Index i = 0; i < result.samples.rows(); ++i) {
+    for (Eigen::Index j = 0; j < result.samples.cols(); ++j) {
+      std::snprintf(number, sizeof number, "%.17g", result.samples(i, j));
+      text << (j ? "," : "") << number;
+    }
+    text << "\n";
+  }
+  write_file_atomically(path, text.str());
+}
+
+void calibrate_command(const CalibrateOptions& o) {
+  const auto emulator = load_emulator(o.model);
+  const Measurements data = read_measurements(o.data);
+  CalibrationPriors priors;
+  if (!o.priors.empty()) {
+    const std::optional<std::string> text = read_whole_file(o.priors);
+    if (!text) throw Error("--priors " + o.priors + ": cannot be read");
+    priors = parse_calibration_priors(*text, o.priors);
+  }
+  if (o.discrepancy) priors.discrepancy = true;
+  const std::vector<std::string> parameters = o.parameters.empty() ? unmeasured_inputs(*emulator, data) : o.parameters;
+  const CalibrationProblem problem(emulator, data, parameters, priors);
+  std::printf("calibrating %zu coefficient(s) against %lld measurements (%s), discrepancy %s\n", parameters.size(),
+              static_cast<long long>(data.mu.size()), o.data.c_str(), priors.discrepancy ? "on" : "off");
+  for (Eigen::Index k = 0; k < problem.parameter_count(); ++k) {
+    std::printf("  prior of %s: %s\n", parameters[static_cast<size_t>(k)].c_str(), problem.prior_of(k).describe().c_str());
+  }
+  std::fflush(stdout);
+  const auto started = std::chrono::steady_clock::now();
+  int reported = 0;
+  const CalibrationResult result = calibrate(problem, o.sampler, [&reported](int done, int total) {
+    const int tenth = done * 10 / total;
+    if (tenth > reported) {
+      reported = tenth;
+      std::fprintf(stderr, "calibrate: %d %% of the steps (%d of %d)\n", tenth * 10, done, total);
+    }
+  });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  print_summary(problem, result, seconds);
+  if (!result.convergence_failure.empty()) {
+    throw Error("the posterior is not usable, nothing written: " + result.convergence_failure);
+  }
+  if (!o.out.empty()) {
+    write_posterior(o.out, problem, result, o);
+    std::printf("wrote %s (%lld samples)\n", o.out.c_str(), static_cast<long long>(result.samples.rows()));
+  }
+}
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app) {
+  auto o = std::make_shared<CalibrateOptions>();
+  auto* cmd = app.add_subcommand(
+      "calibrate", "Posterior of the interface law's coefficients given measured friction, through a campaign's GP");
+  cmd->add_option("--model", o->model,
+                  "GP model of a campaign whose inputs are the measurements' conditions and the law's coefficients\n"
+                  "(a plan with e.g. --shear-factor 0.2:0.9, run and trained)")
+      ->required();
+  cmd->add_option("--data", o->data,
+                  "Measurements: CSV with the conditions as columns with units, mu and mu_sd (the measurement's\n"
+                  "standard deviation), e.g. contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--calibrate", o->parameters,
+                  "The model inputs to calibrate (default: every input the measurements do not give)")
+      ->delimiter(',');
+  cmd->add_option("--priors", o->priors,
+                  "Priors (JSON): {\"parameters\": {\"shear_factor\": {\"uniform\": [0.2, 0.9]}},\n"
+                  "\"discrepancy\": {\"enabled\": true, \"amplitude\": {\"half_normal\": [0.05]}, \"length_scale\":\n"
+                  "{\"log_normal\": [0.5, 0.7]}}}; priors: uniform [lo, hi], normal [mean, sd], log_normal [median,\n"
+                  "sd of log], half_normal [scale]. Default: uniform over the model's box, no discrepancy")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--discrepancy", o->discrepancy,
+                "Add the model discrepancy delta(x), a zero-mean GP over the conditions (Kennedy & O'Hagan 2001)");
+  cmd->add_option("--walkers", o->sampler.walkers, "Ensemble walkers (Goodman & Weare 2010)")
+      ->capture_default_str()
+      ->check(CLI::Range(4, 100000));
+  cmd->add_option("--burn-in", o->sampler.burn_in_steps, "Steps discarded")->capture_default_str()->check(CLI::Range(0, 10000000));
+  cmd->add_option("--steps", o->sampler.steps, "Steps kept")->capture_default_str()->check(CLI::Range(4, 10000000));
+  cmd->add_option("--seed", o->sampler.seed, "Seed: the same seed, data and model give the same posterior, bit for bit")
+      ->capture_default_str();
+  cmd->add_option("--out", o->out, "Write the posterior samples here (CSV, one column per parameter)");
+  cmd->footer(
+      "y_i = mu(x_i, theta) + delta(x_i) + eps_i: the GP's interval of the mean, the measurement's SD and\n"
+      "(with --discrepancy) delta in the likelihood. Prints each parameter's mean, SD, 95 % credible interval,\n"
+      "split-R^ and effective sample size; exit status 2, naming the parameter and the cause, when the chains\n"
+      "fail the limits (split-R^ <= 1.05, ESS >= 400, steps >= 20 autocorrelation times), or a measurement\n"
+      "lies outside the model's box (naming its line).");
+  cmd->callback([o] { calibrate_command(*o); });
+}
+
+}  // namespace mufric::app
