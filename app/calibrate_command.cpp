@@ -21,7 +21,7 @@ namespace {
 
 struct CalibrateOptions {
   std::string model, data, priors, out;
-  std::vector<std::string> parameters;
+  std::vector<std::string> parameters, fixed;
   bool discrepancy = false;
   EnsembleOptions sampler;
 };
@@ -35,6 +35,22 @@ std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
   }
   model.release();
   return std::shared_ptr<const GaussianProcess>(gp);
+}
+
+// --fix NAME=VALUE: the input held at one value, as a condition every measurement shares.
+void fix_input(Measurements& data, const std::string& assignment) {
+  const auto equals = assignment.find('=');
+  if (equals == std::string::npos) throw Error("--fix '" + assignment + "': give NAME=VALUE, e.g. adhesive_coefficient=0.35");
+  const std::string name = assignment.substr(0, equals);
+  const KnownInput* known = find_known_input(name);
+  if (known == nullptr) throw Error("--fix '" + assignment + "': '" + name + "' is not a model input");
+  if (std::find(data.condition_names.begin(), data.condition_names.end(), name) != data.condition_names.end()) {
+    throw Error("--fix '" + assignment + "': the measurements already give " + name);
+  }
+  const double value = parse_quantity(assignment.substr(equals + 1), known->kind, "--fix " + name);
+  data.condition_names.push_back(name);
+  data.conditions.conservativeResize(Eigen::NoChange, data.conditions.cols() + 1);
+  data.conditions.col(data.conditions.cols() - 1).setConstant(value);
 }
 
 // Every input of the model that the measurements do not give.
@@ -86,7 +102,8 @@ void write_posterior(const std::string& path, const CalibrationProblem& problem,
 
 void calibrate_command(const CalibrateOptions& o) {
   const auto emulator = load_emulator(o.model);
-  const Measurements data = read_measurements(o.data);
+  Measurements data = read_measurements(o.data);
+  for (const std::string& assignment : o.fixed) fix_input(data, assignment);
   CalibrationPriors priors;
   if (!o.priors.empty()) {
     const std::optional<std::string> text = read_whole_file(o.priors);
@@ -140,6 +157,9 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--calibrate", o->parameters,
                   "The model inputs to calibrate (default: every input the measurements do not give)")
       ->delimiter(',');
+  cmd->add_option("--fix", o->fixed,
+                  "Hold a model input at one value instead of calibrating it, e.g. --fix adhesive_coefficient=0.35\n"
+                  "(repeatable; for coefficients the data cannot tell apart, which calibrate refuses to sample)");
   cmd->add_option("--priors", o->priors,
                   "Priors (JSON): {\"parameters\": {\"shear_factor\": {\"uniform\": [0.2, 0.9]}},\n"
                   "\"discrepancy\": {\"enabled\": true, \"amplitude\": {\"half_normal\": [0.05]}, \"length_scale\":\n"

@@ -55,7 +55,11 @@ Prior parse_prior(const nlohmann::json& node, const std::string& where) {
   if (!node.is_object() || node.size() != 1) {
     throw Error(where + ": a prior is an object with one key, e.g. {\"uniform\": [0.2, 0.9]}");
   }
-  const auto& [word, arguments] = *node.items().begin();
+  // The one key and its value, taken from an iterator of `node` itself (a binding to *items().begin()
+  // refers into the temporary proxy: a stack use after scope, which ASan found).
+  const auto only = node.begin();
+  const std::string word = only.key();
+  const nlohmann::json& arguments = only.value();
   Prior prior;
   size_t expected = 2;
   if (word == "uniform") {

@@ -401,9 +401,10 @@ TEST(CalibrationPriors, AFilesErrorsNameTheKey) {
       {R"({"discrepancy": {"scale": 1}})", "discrepancy.scale: unknown key"},
       {R"({"prior": {}})", "p.json: prior: unknown key"},
       {R"({"parameters": )", "p.json: not JSON"}};
-  for (const auto& [text, expected] : cases) {
+  for (const auto& one : cases) {
+    const std::string& text = one.first;  // clang 14 does not capture a structured binding
     const std::string why = error_of([&] { parse_calibration_priors(text, "p.json"); });
-    EXPECT_NE(why.find(expected), std::string::npos) << text << " → " << why;
+    EXPECT_NE(why.find(one.second), std::string::npos) << text << " → " << why;
   }
   const auto emulator = synthetic_emulator();
   CalibrationPriors stray;

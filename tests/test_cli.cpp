@@ -951,6 +951,12 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   r = run("calibrate --model " + path("campaign.h5") + " --data " + path("outside.csv"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("outside.csv line 3: contact_pressure 1500MPa lies outside the model's box 300MPa – 1300MPa"), std::string::npos) << r.output;
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --fix shear_factor=0.5");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("no input is calibrated"), std::string::npos) << r.output;  // held, nothing left to calibrate
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --fix sliding_velocity=3m/s");
+  EXPECT_NE(r.output.find("--fix 'sliding_velocity=3m/s': the measurements already give sliding_velocity"), std::string::npos)
+      << r.output;
   std::ofstream(path("priors.json")) << R"({"parameters": {"shear_factor": {"uniform": [0.9, 0.2]}}})";
   r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --priors " + path("priors.json"));
   EXPECT_EQ(r.exit_code, 2);
