@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # mufric's test command (the README's, and what .ci/run calls) on a fresh Debian 12 machine.
 #
-#   bash deploy/test.sh          the whole suite, ~25 min on 2 cores:
+#   bash deploy/test.sh          the whole suite, ~29 min on 2 cores:
 #       dependencies; a Release build (unity) and every test but the long ones (unit, micro-solver,
 #       service, CLI, client, examples, container image around this build's executable); a
 #       ThreadSanitizer build of the shared-handle client tests; one clang build with ASan + UBSan +
