@@ -531,6 +531,9 @@ void add_describe(CLI::App& app) {
     const auto model = load_model_isolated(model_path_from_uri(*model_uri));
     std::printf("%s: kind %s\ninputs (training box):\n", model_uri->c_str(), std::string(model->kind()).c_str());
     print_inputs(model->inputs());
+    if (const std::string why = servable_inputs_violation(input_names(model->inputs())); !why.empty()) {
+      std::printf("not served: %s\n", why.c_str());
+    }
     std::printf("outside the box: %s (a request may choose raw, clamp or refuse); mu kept in [%g, %g]\n",
                 std::string(to_string(model->default_extrapolation())).c_str(), model->mu_min(), model->mu_max());
     std::printf("%s\n", model->summary().c_str());

@@ -917,6 +917,9 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   r = run("predict --model " + path("campaign.h5") + " --p 800MPa --v 100m/min");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("'shear_factor' is a coefficient of the interface law"), std::string::npos) << r.output;
+  r = run("describe " + path("campaign.h5"));  // describe shows it, and says why it is not served
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("not served: its input 'shear_factor' is a coefficient"), std::string::npos) << r.output;
 
   const std::string calibrate = "calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") +
                                 " --walkers 12 --burn-in 300 --steps 1200 --seed 5 --out ";
