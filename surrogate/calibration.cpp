@@ -336,17 +336,24 @@ double CalibrationProblem::log_posterior(const Eigen::VectorXd& coordinates) con
   }
   if (!std::isfinite(log_density)) return kMinusInfinity;
 
-  const Eigen::MatrixXd points = emulator_points(data_.conditions, theta);
-  Eigen::MatrixXd covariance = emulator_->latent_covariance(points);
-  covariance.diagonal().array() += data_.mu_sd.array().square() + kCovarianceJitter;
-  if (priors_.discrepancy) covariance += discrepancy_covariance(unit_data_conditions_, unit_data_conditions_, amplitude, length_scale);
-  const Eigen::LLT<Eigen::MatrixXd> factor(covariance);
-  if (factor.info() != Eigen::Success) return kMinusInfinity;
-  const Eigen::VectorXd residual = data_.mu - emulator_->latent_mean(points);
-  const Eigen::VectorXd whitened = factor.matrixL().solve(residual);
-  const double log_determinant_half = factor.matrixLLT().diagonal().array().log().sum();
+  const Likelihood likelihood = likelihood_at(theta, amplitude, length_scale);
+  if (likelihood.factor.info() != Eigen::Success) return kMinusInfinity;
+  const Eigen::VectorXd whitened = likelihood.factor.matrixL().solve(likelihood.residual);
+  const double log_determinant_half = likelihood.factor.matrixLLT().diagonal().array().log().sum();
   const double value = log_density - 0.5 * whitened.squaredNorm() - log_determinant_half;
   return std::isfinite(value) ? value : kMinusInfinity;
+}
+
+CalibrationProblem::Likelihood CalibrationProblem::likelihood_at(const Eigen::VectorXd& theta, double amplitude,
+                                                                 double length_scale) const {
+  Likelihood out;
+  out.points = emulator_points(data_.conditions, theta);
+  Eigen::MatrixXd covariance = emulator_->latent_covariance(out.points);
+  covariance.diagonal().array() += data_.mu_sd.array().square() + kCovarianceJitter;
+  if (amplitude > 0.0) covariance += discrepancy_covariance(unit_data_conditions_, unit_data_conditions_, amplitude, length_scale);
+  out.factor.compute(covariance);
+  out.residual = data_.mu - emulator_->latent_mean(out.points);
+  return out;
 }
 
 Eigen::MatrixXd CalibrationProblem::draw_start(int walkers, std::uint64_t seed) const {
@@ -410,7 +417,7 @@ CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const
   const Eigen::Index k = problem.parameter_count();
   const Measurements& data = problem.data();
   const Eigen::MatrixXd unit_new = problem.unit_conditions(conditions);
-  const Eigen::MatrixXd unit_data = problem.unit_conditions(data.conditions);
+  const Eigen::MatrixXd& unit_data = problem.unit_data_conditions();
   Eigen::MatrixXd means(q, used), variances(q, used), discrepancy_means(q, used), discrepancy_variances(q, used);
   for (Eigen::Index s = 0; s < used; ++s) {
     // Evenly spaced through the pooled samples (walker by walker), so every walker contributes.
@@ -418,19 +425,14 @@ CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const
     const Eigen::VectorXd theta = result.samples.row(row).head(k).transpose();
     const double amplitude = problem.discrepancy() ? result.samples(row, k) : 0.0;
     const double length_scale = problem.discrepancy() ? result.samples(row, k + 1) : 1.0;
-    const Eigen::MatrixXd data_points = problem.emulator_points(data.conditions, theta);
-    const Eigen::MatrixXd new_points = problem.emulator_points(conditions, theta);
-    Eigen::MatrixXd covariance = problem.emulator().latent_covariance(data_points);
-    covariance.diagonal().array() += data.mu_sd.array().square() + kCovarianceJitter;
-    Eigen::MatrixXd discrepancy_cross = Eigen::MatrixXd::Zero(q, data.mu.size());
-    if (problem.discrepancy()) {
-      covariance += CalibrationProblem::discrepancy_covariance(unit_data, unit_data, amplitude, length_scale);
-      discrepancy_cross = CalibrationProblem::discrepancy_covariance(unit_new, unit_data, amplitude, length_scale);
-    }
-    const Eigen::LLT<Eigen::MatrixXd> factor(covariance);
+    const CalibrationProblem::Likelihood likelihood = problem.likelihood_at(theta, amplitude, length_scale);
+    const Eigen::LLT<Eigen::MatrixXd>& factor = likelihood.factor;
     if (factor.info() != Eigen::Success) throw Error("calibrated prediction: the likelihood's covariance at a posterior sample is not positive definite");
-    const Eigen::VectorXd residual = data.mu - problem.emulator().latent_mean(data_points);
-    const Eigen::VectorXd weights = factor.solve(residual);
+    const Eigen::MatrixXd& data_points = likelihood.points;
+    const Eigen::MatrixXd new_points = problem.emulator_points(conditions, theta);
+    Eigen::MatrixXd discrepancy_cross = Eigen::MatrixXd::Zero(q, data.mu.size());
+    if (problem.discrepancy()) discrepancy_cross = CalibrationProblem::discrepancy_covariance(unit_new, unit_data, amplitude, length_scale);
+    const Eigen::VectorXd weights = factor.solve(likelihood.residual);
     // ζ(x) = η(x, θ) + δ(x) given y: cov(ζ(x), y) = C_η(x, X) + K_δ(x, X).
     const Eigen::MatrixXd cross = problem.emulator().latent_covariance(new_points, data_points) + discrepancy_cross;
     means.col(s) = problem.emulator().latent_mean(new_points) + cross * weights;

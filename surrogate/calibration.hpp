@@ -101,6 +101,16 @@ class CalibrationProblem {
   Eigen::MatrixXd emulator_points(const Eigen::MatrixXd& conditions, const Eigen::VectorXd& theta) const;
   // Unit-box coordinates of conditions in the emulator's box (δ's inputs).
   Eigen::MatrixXd unit_conditions(const Eigen::MatrixXd& conditions) const;
+  // The likelihood at θ and δ's (σ_δ, ℓ_δ): the emulator's rows at the measured conditions, the
+  // Cholesky factor of C_η + K_δ + diag(s²) and the residual y − m (σ_δ = 0: no δ). The factor's
+  // info() says whether the covariance was positive definite.
+  struct Likelihood {
+    Eigen::MatrixXd points;
+    Eigen::LLT<Eigen::MatrixXd> factor;
+    Eigen::VectorXd residual;
+  };
+  Likelihood likelihood_at(const Eigen::VectorXd& theta, double amplitude, double length_scale) const;
+  const Eigen::MatrixXd& unit_data_conditions() const { return unit_data_conditions_; }
   // σ_δ² exp(−½ |u − u'|²/ℓ_δ²) between two sets of unit-box conditions.
   static Eigen::MatrixXd discrepancy_covariance(const Eigen::MatrixXd& ua, const Eigen::MatrixXd& ub,
                                                 double amplitude, double length_scale);

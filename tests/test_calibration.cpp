@@ -15,6 +15,7 @@
 #include "surrogate/ensemble_sampler.hpp"
 #include "surrogate/gp_training.hpp"
 #include "tests/gp_test_data.hpp"
+#include "tests/error_text.hpp"
 
 namespace mufric {
 namespace {
@@ -356,14 +357,7 @@ TEST(Calibration, TheSameSeedGivesTheSamePosteriorBitForBit) {
   EXPECT_TRUE((a.samples.array() == b.samples.array()).all());
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 TEST(Calibration, AMeasurementOutsideTheBoxIsRefusedNamingItsRow) {
   const auto emulator = synthetic_emulator();

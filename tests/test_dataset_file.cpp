@@ -9,6 +9,7 @@
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "temp_path.hpp"
+#include "error_text.hpp"
 
 namespace mufric {
 namespace {
@@ -22,14 +23,7 @@ Eigen::VectorXd values(std::initializer_list<double> list) {
   return v;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 TEST(DatasetFile, RoundTripKeepsFailuresAndTrainingSetSkipsThem) {
   Dataset d;
