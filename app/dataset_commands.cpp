@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -277,7 +278,7 @@ void status_command(const std::string& path) {
   print_box(d.inputs);
   for (const auto& change : d.box_history) std::printf("  box %s\n", change.c_str());
   if (converged > 0) {
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = std::numeric_limits<double>::infinity(), hi = -std::numeric_limits<double>::infinity();
     for (Eigen::Index i = 0; i < d.size(); ++i) {
       if (!d.converged(i)) continue;
       lo = std::min(lo, d.mu(i));
