@@ -13,14 +13,21 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/units.hpp"
+#include "surrogate/calibrated_model.hpp"
 #include "surrogate/calibration.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/model_file.hpp"
 
 namespace mufric::app {
 namespace {
 
 struct CalibrateOptions {
-  std::string model, data, priors, out;
+  std::string model, data, priors, out, model_out;
+  // The tolerances a request asks by default (EvaluationRequest), so that the grid answers it.
+  double fast_mu_tolerance = EvaluationRequest{}.mu_tolerance, fast_std_tolerance = EvaluationRequest{}.std_relative_tolerance;
+  // The grid's work budget in multiply-adds of the exact model: about 5 minutes on one core (1e10 per second).
+  double fast_max_work = 3e12;
+  bool no_fast_evaluator = false;
   std::vector<std::string> parameters, fixed;
   bool discrepancy = false;
   EnsembleOptions sampler;
@@ -100,6 +107,70 @@ void write_posterior(const std::string& path, const CalibrationProblem& problem,
   write_file_atomically(path, text.str());
 }
 
+// The measurement file's name and its '#' provenance lines, for the calibrated model's record.
+std::string measurement_source(const std::string& path) {
+  std::string source = path;
+  std::istringstream lines(read_whole_file(path).value_or(""));
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind('#', 0) == 0) source += "; " + line.substr(line.find_first_not_of("# ") == std::string::npos ? line.size() : line.find_first_not_of("# "));
+  }
+  return source;
+}
+
+std::string priors_text(const CalibrationProblem& problem, const CalibrationPriors& priors) {
+  std::string text;
+  for (Eigen::Index k = 0; k < problem.parameter_count(); ++k) {
+    text += (k ? "; " : "") + problem.coordinate_names()[static_cast<size_t>(k)] + " " + problem.prior_of(k).describe();
+  }
+  if (priors.discrepancy) {
+    text += "; discrepancy_amplitude " + priors.discrepancy_amplitude.describe() + "; discrepancy_length_scale " +
+            priors.discrepancy_length_scale.describe();
+  }
+  return text;
+}
+
+// The calibrated model: served like any other, with a fast evaluator certified against it.
+void write_calibrated_model(const CalibrateOptions& o, const std::shared_ptr<const GaussianProcess>& emulator,
+                            const Measurements& data, const std::vector<std::string>& parameters,
+                            const CalibrationProblem& problem, const CalibrationPriors& priors, const CalibrationResult& result) {
+  CalibrationRecord record{.data_source = measurement_source(o.data),
+                           .priors = priors_text(problem, priors),
+                           .posterior = result.summary,
+                           .walkers = o.sampler.walkers,
+                           .steps = o.sampler.steps,
+                           .burn_in_steps = o.sampler.burn_in_steps,
+                           .seed = static_cast<unsigned long long>(o.sampler.seed),
+                           .acceptance = result.acceptance};
+  std::vector<std::string> held;
+  for (const std::string& assignment : o.fixed) held.push_back(assignment.substr(0, assignment.find('=')));
+  CalibratedModel model(emulator, data, parameters, held, priors.discrepancy, result.samples, std::move(record));
+  model.set_default_extrapolation(emulator->default_extrapolation());
+  model.set_mu_range(emulator->mu_min(), emulator->mu_max());
+  FastEvaluatorOptions fast;
+  fast.mu_tolerance = o.fast_mu_tolerance;
+  fast.std_relative_tolerance = o.fast_std_tolerance;
+  fast.max_work = o.fast_max_work;
+  fast.progress = [](const std::string& line) { std::fprintf(stderr, "calibrate: fast evaluator: %s\n", line.c_str()); };
+  try {
+    if (o.no_fast_evaluator) throw FastEvaluatorOverCap("--no-fast-evaluator");
+    model.attach_fast_evaluator(std::make_shared<const FastEvaluator>(
+        build_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, fast)));
+    if (!model.fast_evaluator()->stop_reason().empty()) {
+      std::printf("fast evaluator stopped before the tolerances (%s): requests asking for more use the exact model\n",
+                  model.fast_evaluator()->stop_reason().c_str());
+    }
+  } catch (const FastEvaluatorOverCap& e) {
+    std::printf("no fast evaluator (%s): the exact posterior predictive answers\n", e.what());
+  }
+  save_model(o.model_out, model);
+  const IntervalParts& c = model.centre_parts();
+  std::printf("wrote %s (calibrated model of", o.model_out.c_str());
+  for (const InputSpec& input : model.inputs()) std::printf(" %s", input.name.c_str());
+  std::printf(")\nat the box centre: mu %.4g, sd %.3g = sqrt(law coefficients %.3g^2 + given them %.3g^2); "
+              "alone: roughness mean %.3g, discrepancy %.3g\n",
+              c.mu, c.sd, c.parameter_sd, c.conditional_sd, c.emulator_sd, c.discrepancy_sd);
+}
+
 void calibrate_command(const CalibrateOptions& o) {
   const auto emulator = load_emulator(o.model);
   Measurements data = read_measurements(o.data);
@@ -137,6 +208,7 @@ void calibrate_command(const CalibrateOptions& o) {
     write_posterior(o.out, problem, result, o);
     std::printf("wrote %s (%lld samples)\n", o.out.c_str(), static_cast<long long>(result.samples.rows()));
   }
+  if (!o.model_out.empty()) write_calibrated_model(o, emulator, data, parameters, problem, priors, result);
 }
 
 }  // namespace
@@ -176,6 +248,20 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--seed", o->sampler.seed, "Seed: the same seed, data and model give the same posterior, bit for bit")
       ->capture_default_str();
   cmd->add_option("--out", o->out, "Write the posterior samples here (CSV, one column per parameter)");
+  cmd->add_option("--model-out", o->model_out,
+                  "Write the calibrated model here (HDF5): mu(conditions) as the posterior predictive, its interval the\n"
+                  "roughness mean, the coefficients' posterior and delta; served, described and evaluated like any model");
+  cmd->add_option("--fast-mu-tolerance", o->fast_mu_tolerance,
+                  "The calibrated model's fast evaluator: mu within this (absolute)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--fast-std-tolerance", o->fast_std_tolerance,
+                  "The calibrated model's fast evaluator: std within this (relative)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--no-fast-evaluator", o->no_fast_evaluator,
+                "Write the calibrated model without its grid: the exact posterior predictive answers every request\n"
+                "(slower per point; the grid takes seconds to minutes to certify)");
   cmd->footer(
       "y_i = mu(x_i, theta) + delta(x_i) + eps_i: the GP's interval of the mean, the measurement's SD and\n"
       "(with --discrepancy) delta in the likelihood. Prints each parameter's mean, SD, 95 % credible interval,\n"

@@ -8,7 +8,7 @@
 
 namespace mufric {
 
-void write_input_space(h5::Writer& out, const InputSpace& inputs) {
+void write_input_space(h5::Writer& out, const InputSpace& inputs, const std::string& group) {
   std::vector<std::string> names, units;
   std::vector<double> lo, hi;
   for (const auto& input : inputs) {
@@ -17,11 +17,11 @@ void write_input_space(h5::Writer& out, const InputSpace& inputs) {
     lo.push_back(input.lo);
     hi.push_back(input.hi);
   }
-  out.group("/inputs");
-  out.strings("/inputs/names", names);
-  out.strings("/inputs/units", units);
-  out.doubles("/inputs/box_lo", lo);
-  out.doubles("/inputs/box_hi", hi);
+  out.group(group);
+  out.strings(group + "/names", names);
+  out.strings(group + "/units", units);
+  out.doubles(group + "/box_lo", lo);
+  out.doubles(group + "/box_hi", hi);
 }
 
 namespace {
@@ -61,23 +61,23 @@ std::string input_space_difference(const InputSpace& a, std::string_view a_sourc
   return "";
 }
 
-InputSpace read_input_space(const h5::Reader& in) {
-  const auto names = in.strings("/inputs/names");
-  const auto units = in.strings("/inputs/units");
-  const auto lo = in.doubles("/inputs/box_lo");
-  const auto hi = in.doubles("/inputs/box_hi");
-  if (names.empty()) in.fail("/inputs/names", "no inputs declared");
+InputSpace read_input_space(const h5::Reader& in, const std::string& group) {
+  const auto names = in.strings(group + "/names");
+  const auto units = in.strings(group + "/units");
+  const auto lo = in.doubles(group + "/box_lo");
+  const auto hi = in.doubles(group + "/box_hi");
+  if (names.empty()) in.fail(group + "/names", "no inputs declared");
   if (units.size() != names.size() || lo.size() != names.size() || hi.size() != names.size()) {
-    in.fail("/inputs", "names, units, box_lo and box_hi differ in length");
+    in.fail(group, "names, units, box_lo and box_hi differ in length");
   }
   InputSpace space;
   for (size_t i = 0; i < names.size(); ++i) {
     if (!(lo[i] < hi[i]) || !std::isfinite(lo[i]) || !std::isfinite(hi[i])) {
-      in.fail("/inputs/box_lo", "input '" + names[i] + "' has an empty or non-finite box");
+      in.fail(group + "/box_lo", "input '" + names[i] + "' has an empty or non-finite box");
     }
     const QuantityKind kind = kind_of_input(names[i]);
     if (kind != QuantityKind::dimensionless && units[i] != si_unit(kind)) {
-      in.fail("/inputs/units", "input '" + names[i] + "' is stored in '" + units[i] + "', expected SI '" +
+      in.fail(group + "/units", "input '" + names[i] + "' is stored in '" + units[i] + "', expected SI '" +
                                    std::string(si_unit(kind)) + "'");
     }
     space.push_back({names[i], units[i], lo[i], hi[i]});

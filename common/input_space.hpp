@@ -68,8 +68,9 @@ class Reader;
 class Writer;
 }  // namespace h5
 
-// /inputs/{names, units, box_lo, box_hi} — shared by dataset and model files.
-void write_input_space(h5::Writer& out, const InputSpace& inputs);
+// <group>/{names, units, box_lo, box_hi} — shared by dataset and model files (a calibrated model also
+// keeps its campaign emulator's inputs in a group of its own).
+void write_input_space(h5::Writer& out, const InputSpace& inputs, const std::string& group = "/inputs");
 // Validates: equal lengths, at least one input, finite boxes with lo < hi, SI units for known names.
-InputSpace read_input_space(const h5::Reader& in);
+InputSpace read_input_space(const h5::Reader& in, const std::string& group = "/inputs");
 }  // namespace mufric

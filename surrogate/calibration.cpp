@@ -410,39 +410,70 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const EnsembleOpt
   return result;
 }
 
-CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const CalibrationResult& result,
-                                        const Eigen::MatrixXd& conditions, Eigen::Index thinned) {
-  const Eigen::Index total = result.samples.rows(), q = conditions.rows();
+CalibratedPosterior::CalibratedPosterior(std::shared_ptr<const CalibrationProblem> problem, const Eigen::MatrixXd& samples,
+                                         Eigen::Index thinned)
+    : problem_(std::move(problem)) {
+  const Eigen::Index total = samples.rows();
+  if (total < 1) throw Error("calibrated prediction: no posterior samples");
+  if (samples.cols() != problem_->dimension()) {
+    throw Error("calibrated prediction: posterior samples have " + std::to_string(samples.cols()) + " coordinates for " +
+                std::to_string(problem_->dimension()));
+  }
   const Eigen::Index used = std::max<Eigen::Index>(1, std::min(thinned, total));
-  const Eigen::Index k = problem.parameter_count();
-  const Measurements& data = problem.data();
-  const Eigen::MatrixXd unit_new = problem.unit_conditions(conditions);
-  const Eigen::MatrixXd& unit_data = problem.unit_data_conditions();
-  Eigen::MatrixXd means(q, used), variances(q, used), discrepancy_means(q, used), discrepancy_variances(q, used);
+  const Eigen::Index k = problem_->parameter_count();
+  kept_.resize(used, samples.cols());
   for (Eigen::Index s = 0; s < used; ++s) {
     // Evenly spaced through the pooled samples (walker by walker), so every walker contributes.
-    const Eigen::Index row = s * total / used;
-    const Eigen::VectorXd theta = result.samples.row(row).head(k).transpose();
-    const double amplitude = problem.discrepancy() ? result.samples(row, k) : 0.0;
-    const double length_scale = problem.discrepancy() ? result.samples(row, k + 1) : 1.0;
-    const CalibrationProblem::Likelihood likelihood = problem.likelihood_at(theta, amplitude, length_scale);
-    const Eigen::LLT<Eigen::MatrixXd>& factor = likelihood.factor;
-    if (factor.info() != Eigen::Success) throw Error("calibrated prediction: the likelihood's covariance at a posterior sample is not positive definite");
-    const Eigen::MatrixXd& data_points = likelihood.points;
-    const Eigen::MatrixXd new_points = problem.emulator_points(conditions, theta);
-    Eigen::MatrixXd discrepancy_cross = Eigen::MatrixXd::Zero(q, data.mu.size());
-    if (problem.discrepancy()) discrepancy_cross = CalibrationProblem::discrepancy_covariance(unit_new, unit_data, amplitude, length_scale);
-    const Eigen::VectorXd weights = factor.solve(likelihood.residual);
+    kept_.row(s) = samples.row(s * total / used);
+    Sample sample;
+    sample.theta = kept_.row(s).head(k).transpose();
+    if (problem_->discrepancy()) {
+      sample.amplitude = kept_(s, k);
+      sample.length_scale = kept_(s, k + 1);
+    }
+    sample.likelihood = problem_->likelihood_at(sample.theta, sample.amplitude, sample.length_scale);
+    if (sample.likelihood.factor.info() != Eigen::Success) {
+      throw Error("calibrated prediction: the likelihood's covariance at posterior sample " + std::to_string(s) +
+                  " is not positive definite");
+    }
+    sample.weights = sample.likelihood.factor.solve(sample.likelihood.residual);
+    samples_.push_back(std::move(sample));
+  }
+}
+
+CalibratedPrediction CalibratedPosterior::predict(const Eigen::MatrixXd& conditions) const {
+  const CalibrationProblem& problem = *problem_;
+  const GaussianProcess& emulator = problem.emulator();
+  const Eigen::Index q = conditions.rows(), used = static_cast<Eigen::Index>(samples_.size());
+  const Eigen::Index n = problem.data().mu.size();
+  const Eigen::MatrixXd unit_new = problem.unit_conditions(conditions);
+  const Eigen::MatrixXd& unit_data = problem.unit_data_conditions();
+  Eigen::MatrixXd means(q, used), variances(q, used), discrepancy_means(q, used), discrepancy_variances(q, used),
+      emulator_variances(q, used);
+  for (Eigen::Index s = 0; s < used; ++s) {
+    const Sample& sample = samples_[static_cast<size_t>(s)];
+    const Eigen::LLT<Eigen::MatrixXd>& factor = sample.likelihood.factor;
+    const Eigen::MatrixXd new_points = problem.emulator_points(conditions, sample.theta);
+    Eigen::MatrixXd discrepancy_cross = Eigen::MatrixXd::Zero(q, n);
+    if (problem.discrepancy()) {
+      discrepancy_cross =
+          CalibrationProblem::discrepancy_covariance(unit_new, unit_data, sample.amplitude, sample.length_scale);
+    }
     // ζ(x) = η(x, θ) + δ(x) given y: cov(ζ(x), y) = C_η(x, X) + K_δ(x, X).
-    const Eigen::MatrixXd cross = problem.emulator().latent_covariance(new_points, data_points) + discrepancy_cross;
-    means.col(s) = problem.emulator().latent_mean(new_points) + cross * weights;
-    const Eigen::MatrixXd solved = factor.solve(cross.transpose());  // n × q
-    variances.col(s) = problem.emulator().latent_variance(new_points).array() + amplitude * amplitude -
-                       (cross.array() * solved.transpose().array()).rowwise().sum();
-    discrepancy_means.col(s) = discrepancy_cross * weights;
-    const Eigen::MatrixXd discrepancy_solved = factor.solve(discrepancy_cross.transpose());
-    discrepancy_variances.col(s) = amplitude * amplitude -
-                                   (discrepancy_cross.array() * discrepancy_solved.transpose().array()).rowwise().sum();
+    const Eigen::MatrixXd emulator_cross = emulator.latent_covariance(new_points, sample.likelihood.points);
+    const Eigen::MatrixXd cross = emulator_cross + discrepancy_cross;
+    const Eigen::VectorXd prior_emulator_variance = emulator.latent_variance(new_points);
+    means.col(s) = emulator.latent_mean(new_points) + cross * sample.weights;
+    // diag(A C⁻¹ Bᵀ) for cross-covariances A, B with y.
+    auto explained = [&factor](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+      const Eigen::MatrixXd solved = factor.solve(b.transpose());  // n × q
+      return Eigen::VectorXd((a.array() * solved.transpose().array()).rowwise().sum().matrix());
+    };
+    const double discrepancy_variance = sample.amplitude * sample.amplitude;
+    variances.col(s) = prior_emulator_variance.array() + discrepancy_variance - explained(cross, cross).array();
+    emulator_variances.col(s) = prior_emulator_variance - explained(emulator_cross, emulator_cross);
+    discrepancy_means.col(s) = discrepancy_cross * sample.weights;
+    discrepancy_variances.col(s) = discrepancy_variance - explained(discrepancy_cross, discrepancy_cross).array();
   }
   // A mixture's moments: the mean of the means; the mean variance plus the variance of the means.
   auto spread = [used](const Eigen::MatrixXd& m) {
@@ -453,10 +484,20 @@ CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const
   out.mean = means.rowwise().mean();
   const Eigen::VectorXd between = spread(means);
   out.parameter_sd = between.cwiseSqrt();
-  out.sd = (variances.rowwise().mean().cwiseMax(0.0) + between).cwiseSqrt();
+  const Eigen::VectorXd within = variances.rowwise().mean().cwiseMax(0.0);
+  out.sd = (within + between).cwiseSqrt();
+  out.conditional_sd = within.cwiseSqrt();
+  out.emulator_sd = emulator_variances.rowwise().mean().cwiseMax(0.0).cwiseSqrt();
   out.discrepancy_mean = discrepancy_means.rowwise().mean();
   out.discrepancy_sd = (discrepancy_variances.rowwise().mean().cwiseMax(0.0) + spread(discrepancy_means)).cwiseSqrt();
   return out;
+}
+
+CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const CalibrationResult& result,
+                                        const Eigen::MatrixXd& conditions, Eigen::Index thinned) {
+  // Not owned: the posterior lives only for this call.
+  const std::shared_ptr<const CalibrationProblem> borrowed(&problem, [](const CalibrationProblem*) {});
+  return CalibratedPosterior(borrowed, result.samples, thinned).predict(conditions);
 }
 
 }  // namespace mufric

@@ -28,6 +28,7 @@ namespace mufric {
 
 class GaussianProcess;
 struct FastEvaluatorOptions;
+struct GridSource;
 
 struct FastEvaluatorBounds {
   double mu_absolute = std::numeric_limits<double>::infinity();   // max |μ_fast − μ|
@@ -62,7 +63,7 @@ class FastEvaluator {
 
  private:
   // The builder (surrogate/fast_evaluator_build.hpp) sets the certified bounds and the stop reason.
-  friend FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options);
+  friend FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& options);
 
   InputSpace box_;
   TensorCubicGrid grid_;

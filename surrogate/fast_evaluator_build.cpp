@@ -39,9 +39,9 @@ EvaluationRequest exact_with_std() {
   return what;
 }
 
-std::vector<int> cells_for(const GaussianProcess& gp, double resolution) {
+std::vector<int> cells_for(const GridSource& source, double resolution) {
   std::vector<int> cells;
-  const Eigen::VectorXd& l = gp.state().hyper.length_scales;
+  const Eigen::VectorXd& l = source.unit_length_scales;
   for (Eigen::Index k = 0; k < l.size(); ++k) {
     const double wanted = std::ceil(resolution / l(k));
     cells.push_back(static_cast<int>(
@@ -64,9 +64,9 @@ Eigen::MatrixXd to_si(const Eigen::MatrixXd& u, const InputSpace& box) {
 }
 
 // The exact μ and log σ at every node of a grid.
-TensorCubicGrid tabulate(const GaussianProcess& gp, const std::vector<int>& cells) {
-  const Eigen::MatrixXd x = to_si(TensorCubicGrid::nodes(cells), gp.inputs());
-  const Evaluation e = gp.evaluate(x, exact_with_std());
+TensorCubicGrid tabulate(const FrictionModel& model, const std::vector<int>& cells) {
+  const Eigen::MatrixXd x = to_si(TensorCubicGrid::nodes(cells), model.inputs());
+  const Evaluation e = model.evaluate(x, exact_with_std());
   Eigen::MatrixXd values(x.rows(), 2);
   values.col(0) = e.mu;
   values.col(1) = e.std.array().max(kSmallestTabulatedStd).log().matrix();
@@ -107,8 +107,8 @@ struct MeasuredErrors {
   std::vector<PointError> per_point;
   PointError worst;
 };
-MeasuredErrors point_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
-  const Evaluation exact = gp.evaluate(x, exact_with_std());
+MeasuredErrors point_errors(const FastEvaluator& fast, const FrictionModel& model, const Eigen::MatrixXd& x) {
+  const Evaluation exact = model.evaluate(x, exact_with_std());
   MeasuredErrors m;
   m.per_point.resize(static_cast<size_t>(x.rows()));
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
@@ -123,7 +123,7 @@ MeasuredErrors point_errors(const FastEvaluator& fast, const GaussianProcess& gp
 
 struct SearchContext {
   const FastEvaluator* fast;
-  const GaussianProcess* gp;
+  const FrictionModel* model;
   const FastEvaluatorOptions* options;
   PointError worst;
 };
@@ -135,7 +135,7 @@ double search_objective(unsigned d, const double* u, double*, void* data) {
     const auto& in = c->fast->box()[k];
     x(k) = in.lo + std::clamp(u[k], 0.0, 1.0) * (in.hi - in.lo);
   }
-  const Evaluation e = c->gp->evaluate(x, exact_with_std());
+  const Evaluation e = c->model->evaluate(x, exact_with_std());
   const PointError p = error_at(*c->fast, e.mu(0), e.std(0), x.data());
   c->worst.mu_absolute = std::max(c->worst.mu_absolute, p.mu_absolute);
   c->worst.std_relative = std::max(c->worst.std_relative, p.std_relative);
@@ -143,9 +143,9 @@ double search_objective(unsigned d, const double* u, double*, void* data) {
 }
 
 // Measured on a fresh random set, then (final grid only) local searches from its worst points.
-FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianProcess& gp,
+FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const FrictionModel& model,
                                     const FastEvaluatorOptions& o, unsigned seed, bool search) {
-  const auto d = static_cast<Eigen::Index>(gp.inputs().size());
+  const auto d = static_cast<Eigen::Index>(model.inputs().size());
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const long long checks = search ? o.check_points : std::min(o.check_points, kRefinementCheckPoints);
@@ -153,7 +153,7 @@ FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianPro
   for (Eigen::Index i = 0; i < u.rows(); ++i) {
     for (Eigen::Index k = 0; k < d; ++k) u(i, k) = uniform(rng);
   }
-  const MeasuredErrors measured = point_errors(fast, gp, to_si(u, gp.inputs()));
+  const MeasuredErrors measured = point_errors(fast, model, to_si(u, model.inputs()));
   const std::vector<PointError>& errors = measured.per_point;
   PointError worst = measured.worst;
   if (search && o.local_searches > 0) {
@@ -162,7 +162,7 @@ FastEvaluatorBounds measured_bounds(const FastEvaluator& fast, const GaussianPro
     const size_t starts = std::min(order.size(), static_cast<size_t>(o.local_searches));
     std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(starts), order.end(),
                       [&](size_t a, size_t b) { return errors[a].score(o) > errors[b].score(o); });
-    SearchContext context{&fast, &gp, &o, worst};
+    SearchContext context{&fast, &model, &o, worst};
     for (size_t s = 0; s < starts; ++s) {
       nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, static_cast<unsigned>(d));
       const std::vector<double> lower(static_cast<size_t>(d), 0.0), upper(static_cast<size_t>(d), 1.0);
@@ -197,12 +197,17 @@ std::string shape_text(const std::vector<int>& cells) {
 
 }  // namespace
 
-FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x) {
-  const PointError worst = point_errors(fast, gp, x).worst;
+FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const FrictionModel& model, const Eigen::MatrixXd& x) {
+  const PointError worst = point_errors(fast, model, x).worst;
   return {worst.mu_absolute, worst.std_relative, fast.bounds().std_floor};
 }
 
-FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& o) {
+FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options) {
+  return build_fast_evaluator(GridSource{gp, gp.state().hyper.length_scales, exact_point_work(gp)}, options);
+}
+
+FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& o) {
+  const FrictionModel& model = source.model;
   if (!(o.mu_tolerance > 0.0) || !(o.std_relative_tolerance > 0.0)) {
     throw Error("fast evaluator: tolerances must be > 0");
   }
@@ -214,8 +219,12 @@ FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluato
   const Clock::time_point start = Clock::now();
   const FastEvaluatorBounds unmeasured{.std_floor = std_floor_for(o.mu_tolerance, o.std_relative_tolerance)};
   double resolution = kFirstResolution;
-  std::vector<int> cells = cells_for(gp, resolution);
-  const double per_point = exact_point_work(gp);
+  if (source.unit_length_scales.size() != static_cast<Eigen::Index>(model.inputs().size()) ||
+      !(source.unit_length_scales.array() > 0.0).all()) {
+    throw Error("fast evaluator: one positive length scale per input is needed");
+  }
+  std::vector<int> cells = cells_for(source, resolution);
+  const double per_point = source.point_work;
   double work_done = 0.0;
   if (grid_megabytes(cells) > o.max_megabytes) {
     throw FastEvaluatorOverCap("the coarsest grid needs " + std::to_string(grid_megabytes(cells)) +
@@ -223,8 +232,8 @@ FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluato
   }
   char line[320];
   for (unsigned round = 0;; ++round) {
-    FastEvaluator fast(gp.inputs(), tabulate(gp, cells), unmeasured);
-    const FastEvaluatorBounds sampled = measured_bounds(fast, gp, o, o.seed + round, false);
+    FastEvaluator fast(model.inputs(), tabulate(model, cells), unmeasured);
+    const FastEvaluatorBounds sampled = measured_bounds(fast, model, o, o.seed + round, false);
     work_done += per_point * static_cast<double>(TensorCubicGrid::node_count(cells) +
                                                  std::min(o.check_points, kRefinementCheckPoints));
     const double score = std::max(sampled.mu_absolute / o.mu_tolerance, sampled.std_relative / o.std_relative_tolerance);
@@ -234,7 +243,7 @@ FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluato
                   unmeasured.std_floor, seconds_since(start));
     say(line);
     const double growth = std::clamp(std::pow(score, 0.25) * kGrowthMargin, kLeastGrowth, kMostGrowth);
-    const std::vector<int> finer = cells_for(gp, resolution * growth);
+    const std::vector<int> finer = cells_for(source, resolution * growth);
     const double certification_work =
         per_point * (static_cast<double>(o.check_points) + o.local_searches * kLocalSearchEvaluations * kSearchEvaluationCost);
     const double next_round_work =
@@ -253,7 +262,7 @@ FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluato
     }
     if (score <= 1.0 || !limit.empty()) {
       // Certify this grid: the full check set and local searches from its worst points.
-      fast.bounds_ = measured_bounds(fast, gp, o, o.seed + 1000 + round, true);
+      fast.bounds_ = measured_bounds(fast, model, o, o.seed + 1000 + round, true);
       const bool meets = fast.meets(o.mu_tolerance, o.std_relative_tolerance);
       std::snprintf(line, sizeof line, "certified: mu within %.2e, std within %.2e of max(std, %.0e) (%s); %.1f s",
                     fast.bounds_.mu_absolute, fast.bounds_.std_relative, unmeasured.std_floor,

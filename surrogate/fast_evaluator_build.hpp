@@ -1,6 +1,7 @@
 #pragma once
-// Building and certifying a FastEvaluator (surrogate/fast_evaluator.hpp) from a Gaussian process:
-// the tolerances and budgets, the refinement loop and the error measurement against the exact GP.
+// Building and certifying a FastEvaluator (surrogate/fast_evaluator.hpp) from a Gaussian process or
+// another smooth model (a calibrated one): the tolerances and budgets, the refinement loop and the
+// error measurement against the exact model.
 // Apart from the evaluator itself so that the GP, which evaluates through a grid, does not depend
 // on the code that builds one from it.
 #include <functional>
@@ -42,12 +43,23 @@ struct FastEvaluatorOptions {
 // 1e10 per second on one core of a 2-core AMD EPYC with AVX2 (bench/RESULTS.md).
 double exact_point_work(const GaussianProcess& gp);
 
+// What a grid is built from: a model evaluated exactly (EvaluationRequest with zero tolerances), the
+// length scale along each input in widths of its box (the grid's cells per input ∝ 1/ℓ), and the
+// multiply-adds of one exact evaluation of μ and σ (the unit of the work budget).
+struct GridSource {
+  const FrictionModel& model;
+  Eigen::VectorXd unit_length_scales;
+  double point_work = 0.0;
+};
+
 // Refines until the bounds are within the options' tolerances, or the next grid would exceed the
 // memory cap or the work budget (then the finest grid built, whose bounds say what it reached).
+FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& options);
+// The GP's own: its length scales and exact_point_work.
 FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options);
 
-// The largest errors of `fast` against the exact `gp` at the points x (SI, one row each): what the
-// bound is measured from, and what a test checks it with.
-FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const GaussianProcess& gp, const Eigen::MatrixXd& x);
+// The largest errors of `fast` against the exact `model` at the points x (SI, one row each): what
+// the bound is measured from, and what a test checks it with.
+FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const FrictionModel& model, const Eigen::MatrixXd& x);
 
 }  // namespace mufric

@@ -81,7 +81,7 @@ struct Evaluation {
 struct TrainingDescription {
   long long training_points = 0;
   double loo_mean_relative_error = 0.0, loo_max_relative_error = 0.0, loo_coverage_95 = 0.0;
-  std::string interval;          // what the interval means, by name: new-run, shared-scatter, mean-over-draws
+  std::string interval;          // what the interval means, by name: new-run, shared-scatter, mean-over-draws, calibrated
   std::string interval_meaning;  // the same in words
   double micro_std_error = 0.0;  // the shared scatter added to every interval (0: none)
 };

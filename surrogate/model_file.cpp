@@ -14,6 +14,7 @@
 #include "common/error.hpp"
 #include "common/isolation.hpp"
 #include "common/version.hpp"
+#include "surrogate/calibrated_model.hpp"
 #include "surrogate/cholesky.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/fast_evaluator.hpp"
@@ -147,6 +148,7 @@ std::unique_ptr<FrictionModel> read_kind(const h5::Reader& in, const std::string
   if (kind == "gp") return std::make_unique<GaussianProcess>(GaussianProcess::read(in, std::move(inputs)));
   if (kind == "mlr") return std::make_unique<MlrLaw>(MlrLaw::read(in, std::move(inputs)));
   if (kind == "coulomb") return std::make_unique<CoulombLaw>(CoulombLaw::read(in, std::move(inputs)));
+  if (kind == "calibrated") return std::make_unique<CalibratedModel>(CalibratedModel::read(in, std::move(inputs)));
   return nullptr;
 }
 
@@ -167,7 +169,7 @@ std::unique_ptr<FrictionModel> read_model(const std::string& path) {
     if (message.rfind("model '", 0) == 0) throw;
     in.fail("/" + kind, message);
   }
-  in.fail("/", "unknown model kind '" + kind + "' (known: gp, mlr, coulomb)");
+  in.fail("/", "unknown model kind '" + kind + "' (known: gp, mlr, coulomb, calibrated)");
 }
 }  // namespace
 
@@ -334,7 +336,22 @@ MlrLaw MlrLaw::read(const h5::Reader& in, InputSpace inputs) {
 namespace {
 
 // A stored fast evaluator, refused unless its checksum matches and sampled nodes are the exact model's.
-std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, const GaussianProcess& gp,
+void write_fast_evaluator(h5::Writer& out, const FastEvaluator& fast, const std::string& group) {
+  const std::vector<long long> cells(fast.grid().cells().begin(), fast.grid().cells().end());
+  const FastEvaluatorBounds& b = fast.bounds();
+  out.group(group);
+  out.string_attribute(group, "interpolation",
+                       "piecewise-cubic tensor Lagrange on a uniform grid over the unit box; node values (mu, log std), "
+                       "node-major, last input fastest; bounds measured against the exact model");
+  out.ints(group + "/cells", cells);
+  out.doubles(group + "/values", fast.grid().values());
+  out.double_attribute(group, "bound_mu_absolute", b.mu_absolute);
+  out.double_attribute(group, "bound_std_relative", b.std_relative);
+  out.double_attribute(group, "std_floor", b.std_floor);
+  out.string_attribute(group, "sha256", fast_evaluator_digest(cells, fast.grid().values(), b));
+}
+
+std::shared_ptr<const FastEvaluator> read_fast_evaluator(const h5::Reader& in, const FrictionModel& gp,
                                                          const std::string& group) {
   const std::vector<long long> cells = in.ints(group + "/cells");
   const std::vector<double> values = in.doubles(group + "/values");
@@ -436,20 +453,7 @@ void GaussianProcess::write_group(h5::Writer& out, const std::string& group) con
   for (const auto& [name, field] : kSummaryTexts) out.string_attribute(summary_group, name, s.summary.*field);
   out.string_attribute(summary_group, kSummaryDatasetDescription, s.summary.dataset_description);
   out.double_attribute(summary_group, kSummaryStandardisedRms, s.summary.loo_standardised_rms);
-  if (fast_) {
-    const std::vector<long long> cells(fast_->grid().cells().begin(), fast_->grid().cells().end());
-    const FastEvaluatorBounds& b = fast_->bounds();
-    out.group(fast_group);
-    out.string_attribute(fast_group, "interpolation",
-                         "piecewise-cubic tensor Lagrange on a uniform grid over the unit box; node values (mu, log std), "
-                         "node-major, last input fastest; bounds measured against the exact GP");
-    out.ints(fast_group + "/cells", cells);
-    out.doubles(fast_group + "/values", fast_->grid().values());
-    out.double_attribute(fast_group, "bound_mu_absolute", b.mu_absolute);
-    out.double_attribute(fast_group, "bound_std_relative", b.std_relative);
-    out.double_attribute(fast_group, "std_floor", b.std_floor);
-    out.string_attribute(fast_group, "sha256", fast_evaluator_digest(cells, fast_->grid().values(), b));
-  }
+  if (fast_) write_fast_evaluator(out, *fast_, fast_group);
   if (patch_scatter_) patch_scatter_->write_group(out, group + "/patch_scatter");
 }
 
@@ -575,12 +579,127 @@ GaussianProcess GaussianProcess::read_group(const h5::Reader& in, InputSpace inp
   GaussianProcess gp(std::move(s));
   if (group.ends_with("/patch_scatter")) gp.set_unbounded_output();  // before its grid's load check
   if (in.has(fast_group)) gp.attach_fast_evaluator(read_fast_evaluator(in, gp, fast_group));
-  // Only the model's own GP has a patch scatter (a scatter of the scatter is not a thing, and a file
-  // nesting them deeply would recurse here).
-  if (group == "/gp" && in.has(group + "/patch_scatter")) {
+  // Only a model's own GP has a patch scatter (a scatter of the scatter is not a thing, and a file
+  // nesting them deeply would recurse here); a calibrated model's emulator is one.
+  if (!group.ends_with("/patch_scatter") && in.has(group + "/patch_scatter")) {
     gp.attach_patch_scatter(std::make_shared<const GaussianProcess>(read_group(in, inputs_of_model, group + "/patch_scatter")));
   }
   return gp;
+}
+
+namespace {
+constexpr const char* kCalibratedGroup = "/calibrated";
+const std::vector<std::string> kPosteriorColumns = {"mean", "sd", "lo95", "median", "hi95", "split_rhat", "effective_sample_size"};
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ",") + name;
+  return text;
+}
+
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> names;
+  std::string name;
+  for (const char c : text + ",") {
+    if (c != ',') {
+      name += c;
+    } else if (!name.empty()) {
+      names.push_back(name);
+      name.clear();
+    }
+  }
+  return names;
+}
+}  // namespace
+
+void CalibratedModel::write(h5::Writer& out) const {
+  const std::string g = kCalibratedGroup;
+  const CalibrationProblem& p = problem();
+  out.group(g);
+  out.string_attribute(g, "meaning",
+                       "mu(x) = mean over posterior samples s of E[eta(x, theta_s) + delta(x) | measurements]; std the "
+                       "mixture's (Kennedy & O'Hagan 2001, eq. 6); the emulator is the campaign's GP over the conditions "
+                       "and the law's coefficients");
+  write_input_space(out, emulator_->inputs(), g + "/emulator_inputs");
+  emulator_->write_group(out, g + "/emulator");
+  const Measurements& data = p.data();
+  out.group(g + "/measurements");
+  out.strings(g + "/measurements/condition_names", data.condition_names);
+  out.matrix(g + "/measurements/conditions", data.conditions);
+  out.doubles(g + "/measurements/mu", data.mu);
+  out.doubles(g + "/measurements/mu_sd", data.mu_sd);
+  out.strings(g + "/measurements/row_names", data.row_names);
+  const std::vector<std::string> parameters(p.coordinate_names().begin(), p.coordinate_names().begin() + p.parameter_count());
+  out.string_attribute(g, "parameters", joined(parameters));
+  out.string_attribute(g, "held", joined(held_));
+  out.int_attribute(g, "discrepancy", p.discrepancy() ? 1 : 0);
+  out.matrix(g + "/samples", samples());
+  out.string_attribute(g, "data_source", record_.data_source);
+  out.string_attribute(g, "priors", record_.priors);
+  out.int_attribute(g, "walkers", record_.walkers);
+  out.int_attribute(g, "steps", record_.steps);
+  out.int_attribute(g, "burn_in_steps", record_.burn_in_steps);
+  out.int_attribute(g, "seed", static_cast<long long>(record_.seed));
+  out.double_attribute(g, "acceptance", record_.acceptance);
+  std::vector<std::string> names;
+  Eigen::MatrixXd table(static_cast<Eigen::Index>(record_.posterior.size()), static_cast<Eigen::Index>(kPosteriorColumns.size()));
+  for (size_t j = 0; j < record_.posterior.size(); ++j) {
+    const ParameterSummary& q = record_.posterior[j];
+    names.push_back(q.name);
+    table.row(static_cast<Eigen::Index>(j)) << q.mean, q.sd, q.lo95, q.median, q.hi95, q.split_rhat, q.effective_sample_size;
+  }
+  out.group(g + "/posterior");
+  out.string_attribute(g + "/posterior", "columns", joined(kPosteriorColumns));
+  out.strings(g + "/posterior/names", names);
+  out.matrix(g + "/posterior/summary", table);
+  if (fast_) write_fast_evaluator(out, *fast_, g + "/fast_evaluator");
+}
+
+CalibratedModel CalibratedModel::read(const h5::Reader& in, InputSpace inputs) {
+  const std::string g = kCalibratedGroup;
+  InputSpace emulator_inputs = read_input_space(in, g + "/emulator_inputs");
+  auto emulator = std::make_shared<const GaussianProcess>(GaussianProcess::read_group(in, emulator_inputs, g + "/emulator"));
+  Measurements data;
+  data.condition_names = in.strings(g + "/measurements/condition_names");
+  data.conditions = in.matrix(g + "/measurements/conditions");
+  const auto rows = data.conditions.rows();
+  if (data.conditions.cols() != static_cast<Eigen::Index>(data.condition_names.size())) {
+    in.fail(g + "/measurements/conditions", "has " + std::to_string(data.conditions.cols()) + " columns for " +
+                                               std::to_string(data.condition_names.size()) + " condition names");
+  }
+  data.mu = in.vector(g + "/measurements/mu", rows);
+  data.mu_sd = in.vector(g + "/measurements/mu_sd", rows);
+  data.row_names = in.strings(g + "/measurements/row_names");
+  if (static_cast<Eigen::Index>(data.row_names.size()) != rows) in.fail(g + "/measurements/row_names", "not one per measurement");
+  const bool discrepancy = in.int_attribute(g, "discrepancy") != 0;
+  const std::vector<std::string> parameters = split_names(in.string_attribute(g, "parameters"));
+  const Eigen::MatrixXd samples = in.matrix(g + "/samples");
+  const auto dimension = static_cast<Eigen::Index>(parameters.size()) + (discrepancy ? 2 : 0);
+  if (samples.cols() != dimension || samples.rows() < 1 || !samples.allFinite()) {
+    in.fail(g + "/samples", "must hold one finite row per posterior sample, " + std::to_string(dimension) + " columns");
+  }
+  CalibrationRecord record;
+  record.data_source = in.string_attribute(g, "data_source");
+  record.priors = in.string_attribute(g, "priors");
+  record.walkers = static_cast<int>(in.int_attribute(g, "walkers"));
+  record.steps = static_cast<int>(in.int_attribute(g, "steps"));
+  record.burn_in_steps = static_cast<int>(in.int_attribute(g, "burn_in_steps"));
+  record.seed = static_cast<unsigned long long>(in.int_attribute(g, "seed"));
+  record.acceptance = in.double_attribute(g, "acceptance");
+  const std::vector<std::string> names = in.strings(g + "/posterior/names");
+  const Eigen::MatrixXd table = in.matrix(g + "/posterior/summary");
+  if (table.rows() != static_cast<Eigen::Index>(names.size()) || table.cols() != static_cast<Eigen::Index>(kPosteriorColumns.size())) {
+    in.fail(g + "/posterior/summary", "must have one row per name and " + std::to_string(kPosteriorColumns.size()) + " columns");
+  }
+  for (size_t j = 0; j < names.size(); ++j) {
+    const auto r = table.row(static_cast<Eigen::Index>(j));
+    record.posterior.push_back({names[j], r(0), r(1), r(2), r(4), r(3), r(5), r(6)});
+  }
+  CalibratedModel model(std::move(emulator), std::move(data), parameters, split_names(in.string_attribute(g, "held")), discrepancy,
+                        samples, std::move(record));
+  if (!same_input_space(model.inputs(), inputs)) in.fail("/inputs", "are not the calibrated model's served inputs");
+  if (in.has(g + "/fast_evaluator")) model.attach_fast_evaluator(read_fast_evaluator(in, model, g + "/fast_evaluator"));
+  return model;
 }
 
 }  // namespace mufric

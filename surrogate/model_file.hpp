@@ -1,6 +1,6 @@
 #pragma once
 // Model files (ARCHITECTURE.md "Model"): one HDF5 file per model, self-describing and versioned.
-//   /  attributes format = "mufric-model", schema_version, kind (gp | mlr | coulomb),
+//   /  attributes format = "mufric-model", schema_version, kind (gp | mlr | coulomb | calibrated),
 //      code_version, created_utc;   /inputs (names, SI units, box);   /<kind> the model's own data.
 // Loading validates everything and refuses a corrupt or incompatible file naming the field.
 #include <memory>
@@ -19,7 +19,10 @@ namespace mufric {
 // Version 4 added a GP's interval attribute (new-run, shared-scatter or mean-over-draws) and its
 // optional /gp/patch_scatter (a GP of the same layout for the log per-draw variance of μ, issue 33);
 // older files load with the interval their micro_std_error implies and no patch scatter.
-inline constexpr long long kModelSchemaVersion = 4;
+// Version 5 added kind "calibrated" (/calibrated: the campaign's GP, the measurements, the posterior
+// samples and their summary, an optional fast evaluator; surrogate/calibrated_model.hpp); files of
+// the other kinds are unchanged.
+inline constexpr long long kModelSchemaVersion = 5;
 inline constexpr long long kOldestReadableModelSchema = 1;
 inline constexpr const char* kModelFormat = "mufric-model";
 

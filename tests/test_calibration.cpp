@@ -5,15 +5,21 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <random>
 #include <string>
 
+#include <unistd.h>
+
 #include "common/error.hpp"
 #include "common/sanitizers.hpp"
+#include "surrogate/calibrated_model.hpp"
 #include "surrogate/calibration.hpp"
 #include "surrogate/ensemble_sampler.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
+#include "surrogate/model_file.hpp"
 #include "tests/gp_test_data.hpp"
 #include "tests/error_text.hpp"
 
@@ -406,6 +412,142 @@ TEST(CalibrationPriors, AFilesErrorsNameTheKey) {
   EXPECT_NE(error_of([&] {
               CalibrationProblem(emulator, synthetic_measurements(3, 0.4, 0.01, 1), {"shear_factor"}, stray);
             }).find("adhesive_coefficient"),
+            std::string::npos);
+}
+
+// --- the calibrated model ------------------------------------------------------------------------
+
+// A calibration with δ on and three posterior samples kept, so that the mixture can be computed
+// independently below.
+struct SmallCalibration {
+  std::shared_ptr<const GaussianProcess> emulator = synthetic_emulator();
+  Measurements data = synthetic_measurements(10, 0.6, 0.005, 17, smooth_discrepancy);
+  Eigen::MatrixXd samples;
+  SmallCalibration() {
+    CalibrationPriors priors;
+    priors.discrepancy = true;
+    priors.parameters.emplace_back("shear_factor", Prior{PriorKind::normal, 0.6, 0.05});
+    EnsembleOptions options = quick_sampler(51);
+    options.steps = 300;
+    const CalibrationResult result = calibrate(CalibrationProblem(emulator, data, {"shear_factor"}, priors), options);
+    samples.resize(3, result.samples.cols());
+    samples << result.samples.row(0), result.samples.row(result.samples.rows() / 2), result.samples.row(result.samples.rows() - 1);
+  }
+  CalibratedModel model() const { return CalibratedModel(emulator, data, {"shear_factor"}, {}, true, samples, {}); }
+};
+
+// The KOH predictive of ζ = η + δ given y at one sample, from the dense latent covariance above and
+// the GP's own evaluated mean: an independent path to each mixture component.
+void dense_component(const SmallCalibration& c, const Eigen::RowVectorXd& theta_row, const Eigen::RowVectorXd& x, double& mean,
+                     double& variance) {
+  const GaussianProcess& gp = *c.emulator;
+  const double m = theta_row(0), amplitude = theta_row(1), length = theta_row(2);
+  const Eigen::Index n = c.data.mu.size();
+  Eigen::MatrixXd data_points(n, 3), query(1, 3);
+  data_points << c.data.conditions, Eigen::VectorXd::Constant(n, m);
+  query << x, m;
+  const InputSpace box = synthetic_box();
+  auto unit = [&box](const Eigen::RowVectorXd& row) {
+    return Eigen::RowVector2d((row(0) - box[0].lo) / (box[0].hi - box[0].lo), (row(1) - box[1].lo) / (box[1].hi - box[1].lo));
+  };
+  auto delta = [&](const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) {
+    return amplitude * amplitude * std::exp(-0.5 * (unit(a) - unit(b)).squaredNorm() / (length * length));
+  };
+  Eigen::MatrixXd covariance = dense_latent_covariance(gp, data_points, data_points);
+  Eigen::RowVectorXd cross = dense_latent_covariance(gp, query, data_points);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    covariance(i, i) += c.data.mu_sd(i) * c.data.mu_sd(i);
+    cross(i) += delta(x, c.data.conditions.row(i));
+    for (Eigen::Index j = 0; j < n; ++j) covariance(i, j) += delta(c.data.conditions.row(i), c.data.conditions.row(j));
+  }
+  EvaluationRequest exact;
+  exact.mu_tolerance = 0.0;
+  const Eigen::VectorXd residual = c.data.mu - gp.evaluate(data_points, exact).mu;
+  const Eigen::LDLT<Eigen::MatrixXd> solver(covariance);
+  mean = gp.evaluate(query, exact).mu(0) + cross.dot(solver.solve(residual));
+  variance = dense_latent_covariance(gp, query, query)(0, 0) + amplitude * amplitude - cross.dot(solver.solve(cross.transpose()));
+}
+
+TEST(CalibratedModel, ServesTheMixtureOfTheKennedyOHaganPredictivesOverItsPosteriorSamples) {
+  const SmallCalibration c;
+  const CalibratedModel model = c.model();
+  ASSERT_EQ(model.inputs().size(), 2u);  // p and v: the shear factor is calibrated, not served
+  EXPECT_EQ(model.inputs()[0].name, "contact_pressure");
+  Eigen::MatrixXd x(4, 2);
+  x << 400e6, 0.5, 800e6, 1.5, 1200e6, 3.0, 650e6, 2.2;
+  EvaluationRequest exact{.std = true};
+  exact.mu_tolerance = 0.0;
+  const Evaluation e = model.evaluate(x, exact);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    double mean_sum = 0.0, second_moment = 0.0;
+    for (Eigen::Index s = 0; s < 3; ++s) {
+      double mean = 0.0, variance = 0.0;
+      dense_component(c, c.samples.row(s), x.row(i), mean, variance);
+      mean_sum += mean;
+      second_moment += variance + mean * mean;
+    }
+    const double mean = mean_sum / 3.0, sd = std::sqrt(second_moment / 3.0 - mean * mean);
+    EXPECT_NEAR(e.mu(i), mean, 1e-9) << i;
+    EXPECT_NEAR(e.std(i), sd, 1e-7 * sd + 1e-9) << i;
+  }
+  // The parts: sd² = parameter_sd² + conditional_sd².
+  const IntervalParts& centre = model.centre_parts();
+  EXPECT_NEAR(centre.sd * centre.sd, centre.parameter_sd * centre.parameter_sd + centre.conditional_sd * centre.conditional_sd,
+              1e-12);
+  EXPECT_GT(centre.discrepancy_sd, 0.0);
+  EXPECT_GT(centre.emulator_sd, 0.0);
+  EXPECT_EQ(model.training_description()->interval, "calibrated");
+  // The exact gradient: a central difference over a much wider step agrees to the curvature's size.
+  EvaluationRequest with_gradient = exact;
+  with_gradient.gradient = true;
+  const Evaluation g = model.evaluate(x.topRows(1), with_gradient);
+  Eigen::MatrixXd up = x.topRows(1), down = x.topRows(1);
+  up(0, 0) += 1e6;
+  down(0, 0) -= 1e6;
+  EXPECT_NEAR(g.gradient(0, 0), (model.evaluate(up, exact).mu(0) - model.evaluate(down, exact).mu(0)) / 2e6, 1e-12);
+}
+
+TEST(CalibratedModel, ItsFileAndFastEvaluatorGiveBackWhatItServes) {
+  const SmallCalibration c;
+  CalibratedModel model = c.model();
+  FastEvaluatorOptions options;
+  options.mu_tolerance = 1e-4;
+  options.std_relative_tolerance = 1e-2;
+  options.check_points = 500;
+  options.local_searches = 2;
+  model.attach_fast_evaluator(std::make_shared<const FastEvaluator>(
+      build_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, options)));
+  const std::string path = (std::filesystem::temp_directory_path() / ("mufric-calibrated-" + std::to_string(::getpid()) + ".h5")).string();
+  save_model(path, model);
+  const std::unique_ptr<FrictionModel> loaded = load_model(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(loaded->kind(), "calibrated");
+  EXPECT_TRUE(same_input_space(loaded->inputs(), model.inputs()));
+  std::mt19937_64 random(61);
+  Eigen::MatrixXd x(50, 2);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    for (Eigen::Index k = 0; k < 2; ++k) x(i, k) = model.inputs()[static_cast<size_t>(k)].lo + uniform01(random()) *
+                                                   (model.inputs()[static_cast<size_t>(k)].hi - model.inputs()[static_cast<size_t>(k)].lo);
+  }
+  EvaluationRequest exact{.std = true}, loose{.std = true};
+  exact.mu_tolerance = 0.0;
+  loose.mu_tolerance = 1e-4;
+  loose.std_relative_tolerance = 1e-2;
+  for (const EvaluationRequest& what : {exact, loose}) {
+    const Evaluation a = model.evaluate(x, what), b = loaded->evaluate(x, what);
+    EXPECT_TRUE((a.mu.array() == b.mu.array()).all()) << "the file gives back the same mu, bit for bit";
+    EXPECT_TRUE((a.std.array() == b.std.array()).all());
+  }
+  const Evaluation fast = loaded->evaluate(x, loose), slow = loaded->evaluate(x, exact);
+  EXPECT_EQ(fast.fast_points, x.rows());
+  EXPECT_EQ(slow.fast_points, 0);
+  const FastEvaluatorBounds& bound = model.fast_evaluator()->bounds();
+  EXPECT_LE((fast.mu - slow.mu).cwiseAbs().maxCoeff(), bound.mu_absolute);
+  EXPECT_LE(((fast.std - slow.std).array().abs() / slow.std.array().max(bound.std_floor)).maxCoeff(), bound.std_relative);
+  EXPECT_NE(loaded->summary().find("interval at the box centre"), std::string::npos) << loaded->summary();
+  // A held input must be one of the measurements' conditions; a served input must be on the wire.
+  EXPECT_NE(error_of([&] { CalibratedModel(c.emulator, c.data, {"shear_factor"}, {"temperature"}, true, c.samples, {}); })
+                .find("temperature"),
             std::string::npos);
 }
 

@@ -944,6 +944,28 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   ASSERT_EQ(run(calibrate + path("again.csv")).exit_code, 0);
   EXPECT_EQ(read_text(path("again.csv")), posterior) << "the same seed, the same posterior";
 
+  // The calibrated model: read from its file and served, the same μ both ways; describe shows its parts.
+  std::filesystem::create_directories(path("served"));
+  r = run(calibrate + path("posterior.csv") + " --model-out " + path("served/calibrated.h5") + " --no-fast-evaluator");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("calibrated model of contact_pressure sliding_velocity"), std::string::npos) << r.output;
+  r = run("describe " + path("served/calibrated.h5"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("kind calibrated"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("interval at the box centre: mu "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("measurements: " + path("measured.csv") + "; synthetic"), std::string::npos) << r.output;
+  const CommandResult from_file = run("predict --model " + path("served/calibrated.h5") + " --p 700MPa --v 100m/min");
+  ASSERT_EQ(from_file.exit_code, 0) << from_file.output;
+  {
+    ServeProcess server(path("served"), path("serve-calibrated.log"), path("address-calibrated"));
+    ASSERT_FALSE(server.address().empty()) << "server did not start: " << read_text(path("serve-calibrated.log"));
+    const CommandResult served = run("predict --model grpc://" + server.address() + "/calibrated --p 700MPa --v 100m/min");
+    ASSERT_EQ(served.exit_code, 0) << served.output;
+    const auto mu_of = [](const std::string& text) { return text.substr(text.find("mu = "), text.find("  std")  - text.find("mu = ")); };
+    EXPECT_EQ(mu_of(served.output), mu_of(from_file.output)) << served.output << from_file.output;
+    EXPECT_EQ(server.stop(), 0);
+  }
+
   r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --steps 8 --burn-in 0 --out " +
           path("short.csv"));
   EXPECT_EQ(r.exit_code, 2);

@@ -1,0 +1,235 @@
+#include "surrogate/calibrated_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "common/units.hpp"
+
+namespace mufric {
+namespace {
+
+// The exact gradient is a central difference of the exact mean over this fraction of each input's
+// box width (one-sided within it of a face): the posterior mean is a sum of RBF terms, smooth on the
+// scale of the emulator's length scales (≥ 0.05 box widths), so the truncation error is ~1e-8 relative.
+constexpr double kGradientStep = 1e-4;
+
+std::vector<Eigen::Index> served_columns(const Measurements& data, const std::vector<std::string>& held) {
+  std::vector<Eigen::Index> columns;
+  for (size_t c = 0; c < data.condition_names.size(); ++c) {
+    if (std::find(held.begin(), held.end(), data.condition_names[c]) == held.end()) {
+      columns.push_back(static_cast<Eigen::Index>(c));
+    }
+  }
+  return columns;
+}
+
+InputSpace served_inputs(const GaussianProcess& emulator, const Measurements& data, const std::vector<std::string>& held) {
+  for (const std::string& name : held) {
+    if (std::find(data.condition_names.begin(), data.condition_names.end(), name) == data.condition_names.end()) {
+      throw Error("calibrated model: held input '" + name + "' is not among the measurements' conditions");
+    }
+  }
+  InputSpace served;
+  std::vector<std::string> names;
+  for (const Eigen::Index c : served_columns(data, held)) {
+    const std::string& name = data.condition_names[static_cast<size_t>(c)];
+    const auto input = std::find_if(emulator.inputs().begin(), emulator.inputs().end(),
+                                    [&name](const InputSpec& s) { return s.name == name; });
+    if (input == emulator.inputs().end()) throw Error("calibrated model: condition '" + name + "' is not an input of the emulator");
+    served.push_back(*input);
+    names.push_back(name);
+  }
+  if (served.empty()) throw Error("calibrated model: every condition is held; nothing is left to serve");
+  const std::string violation = servable_inputs_violation(names);
+  if (!violation.empty()) throw Error("calibrated model: " + violation);
+  return served;
+}
+
+}  // namespace
+
+CalibratedModel::CalibratedModel(std::shared_ptr<const GaussianProcess> emulator, Measurements data,
+                                 std::vector<std::string> parameters, std::vector<std::string> held, bool discrepancy,
+                                 const Eigen::MatrixXd& samples, CalibrationRecord record)
+    : FrictionModel(served_inputs(*emulator, data, held)),
+      emulator_(std::move(emulator)),
+      held_(std::move(held)),
+      served_column_(served_columns(data, held_)),
+      record_(std::move(record)) {
+  held_values_ = Eigen::RowVectorXd::Zero(data.conditions.cols());
+  for (Eigen::Index c = 0; c < data.conditions.cols(); ++c) {
+    const bool served = std::find(served_column_.begin(), served_column_.end(), c) != served_column_.end();
+    if (served || data.conditions.rows() == 0) continue;
+    held_values_(c) = data.conditions(0, c);
+    if (!(data.conditions.col(c).array() == held_values_(c)).all()) {
+      throw Error("calibrated model: held input '" + data.condition_names[static_cast<size_t>(c)] +
+                  "' differs between measurements");
+    }
+  }
+  CalibrationPriors priors;  // the priors shaped the samples; a prediction needs only the samples
+  priors.discrepancy = discrepancy;
+  auto problem = std::make_shared<const CalibrationProblem>(emulator_, std::move(data), std::move(parameters), priors);
+  posterior_ = std::make_shared<const CalibratedPosterior>(std::move(problem), samples);
+  Eigen::RowVectorXd centre(inputs().size());
+  for (size_t j = 0; j < inputs().size(); ++j) centre(static_cast<Eigen::Index>(j)) = 0.5 * (inputs()[j].lo + inputs()[j].hi);
+  centre_parts_ = parts_at(centre);
+}
+
+Eigen::MatrixXd CalibratedModel::conditions_of(const QueryBatch& x) const {
+  Eigen::MatrixXd conditions = held_values_.replicate(x.rows(), 1);
+  for (size_t j = 0; j < served_column_.size(); ++j) conditions.col(served_column_[j]) = x.col(static_cast<Eigen::Index>(j));
+  return conditions;
+}
+
+CalibratedPrediction CalibratedModel::predict(const QueryBatch& x) const { return posterior_->predict(conditions_of(x)); }
+
+IntervalParts CalibratedModel::parts_at(const Eigen::RowVectorXd& x) const {
+  const CalibratedPrediction p = predict(x);
+  return {p.mean(0), p.sd(0), p.parameter_sd(0), p.conditional_sd(0), p.emulator_sd(0), p.discrepancy_sd(0)};
+}
+
+void CalibratedModel::attach_fast_evaluator(std::shared_ptr<const FastEvaluator> fast) {
+  if (fast && !same_input_space(fast->box(), inputs())) throw Error("calibrated model: the fast evaluator's box is not the model's");
+  fast_ = std::move(fast);
+}
+
+Eigen::VectorXd CalibratedModel::unit_length_scales() const {
+  Eigen::VectorXd l(static_cast<Eigen::Index>(inputs().size()));
+  double discrepancy_length = std::numeric_limits<double>::infinity();
+  if (problem().discrepancy()) {
+    const Eigen::Index column = problem().parameter_count() + 1;
+    std::vector<double> values(samples().col(column).data(), samples().col(column).data() + samples().rows());
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+    discrepancy_length = values[values.size() / 2];
+  }
+  for (size_t j = 0; j < inputs().size(); ++j) {
+    const auto at = std::find_if(emulator_->inputs().begin(), emulator_->inputs().end(),
+                                 [&](const InputSpec& s) { return s.name == inputs()[j].name; });
+    const auto column = static_cast<Eigen::Index>(at - emulator_->inputs().begin());
+    l(static_cast<Eigen::Index>(j)) = std::min(emulator_->state().hyper.length_scales(column), discrepancy_length);
+  }
+  return l;
+}
+
+double CalibratedModel::exact_point_work() const {
+  // Per kept sample: the cross-covariance with the measurements and the latent variance, each a
+  // triangular solve with the emulator's factor (n²), and the solves with the likelihood's (m²).
+  const auto n = static_cast<double>(emulator_->state().x_train.rows());
+  const auto m = static_cast<double>(problem().data().mu.size());
+  return static_cast<double>(samples().rows()) * (2.0 * n * n + 2.0 * m * m + n * m);
+}
+
+void CalibratedModel::evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const {
+  const CalibratedPrediction p = predict(x);
+  out.mu = p.mean;
+  if (what.std || what.ci_level > 0.0) out.std = p.sd;
+}
+
+void CalibratedModel::evaluate_valid(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const {
+  const Eigen::Index m = x.rows(), d = x.cols();
+  const bool fast = fast_ && !what.exact_only() && fast_->meets(what.mu_tolerance, what.std_relative_tolerance);
+  std::vector<Eigen::Index> inside, outside;
+  for (Eigen::Index i = 0; i < m && fast; ++i) {
+    const Eigen::RowVectorXd row = x.row(i);
+    (fast_->inside(row.data()) ? inside : outside).push_back(i);
+  }
+  if (!fast || inside.empty()) {
+    evaluate_exact(x, what, out);
+  } else {
+    out.mu.resize(m);
+    out.std.resize(m);
+    for (const Eigen::Index i : inside) {
+      const Eigen::RowVectorXd row = x.row(i);
+      fast_->evaluate(row.data(), out.mu(i), out.std(i));
+    }
+    out.fast_points += static_cast<long long>(inside.size());
+    if (!outside.empty()) {
+      QueryBatch rest(static_cast<Eigen::Index>(outside.size()), d);
+      for (size_t r = 0; r < outside.size(); ++r) rest.row(static_cast<Eigen::Index>(r)) = x.row(outside[r]);
+      const CalibratedPrediction p = predict(rest);
+      for (size_t r = 0; r < outside.size(); ++r) {
+        out.mu(outside[r]) = p.mean(static_cast<Eigen::Index>(r));
+        out.std(outside[r]) = p.sd(static_cast<Eigen::Index>(r));
+      }
+    }
+    if (!(what.std || what.ci_level > 0.0)) out.std.resize(0);
+  }
+  if (what.gradient) {
+    // Central differences of the exact mean (one-sided near a face), whatever answered μ.
+    out.gradient.resize(m, d);
+    for (Eigen::Index k = 0; k < d; ++k) {
+      const InputSpec& input = inputs()[static_cast<size_t>(k)];
+      const double h = kGradientStep * (input.hi - input.lo);
+      QueryBatch plus = x, minus = x;
+      Eigen::VectorXd span(m);
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const bool room_above = x(i, k) + h <= input.hi || x(i, k) > input.hi;
+        const bool room_below = x(i, k) - h >= input.lo || x(i, k) < input.lo;
+        plus(i, k) = room_above ? x(i, k) + h : x(i, k);
+        minus(i, k) = room_below ? x(i, k) - h : x(i, k);
+        span(i) = plus(i, k) - minus(i, k);
+      }
+      out.gradient.col(k) = ((predict(plus).mean - predict(minus).mean).array() / span.array()).matrix();
+    }
+  }
+}
+
+Eigen::VectorXd CalibratedModel::patch_std_valid(const QueryBatch& x, const EvaluationRequest& what) const {
+  // The campaign's patch scatter at the posterior median of θ: how one patch's μ scatters about the
+  // mean, a property of the roughness, not of what is known about θ.
+  const CalibrationProblem& p = problem();
+  Eigen::VectorXd median(p.parameter_count());
+  for (Eigen::Index j = 0; j < p.parameter_count(); ++j) median(j) = record_.posterior.empty() ? samples().col(j).mean()
+                                                                                                : record_.posterior[static_cast<size_t>(j)].median;
+  return emulator_->patch_std(p.emulator_points(conditions_of(x), median), what.exact_only() ? 0.0 : what.std_relative_tolerance);
+}
+
+std::optional<TrainingDescription> CalibratedModel::training_description() const {
+  std::optional<TrainingDescription> t = emulator_->training_description();
+  t->interval = "calibrated";
+  t->interval_meaning =
+      "posterior predictive of measured friction's mean: the campaign's interval of the mean (roughness draws), "
+      "the law coefficients' posterior and the model discrepancy delta given " +
+      std::to_string(problem().data().mu.size()) + " measurements";
+  t->micro_std_error = 0.0;
+  return t;
+}
+
+std::string CalibratedModel::summary() const {
+  std::ostringstream s;
+  s.precision(4);
+  const CalibrationProblem& p = problem();
+  s << "calibrated: the posterior predictive of a campaign's GP (" << emulator_->state().x_train.rows() << " samples over";
+  for (const InputSpec& input : emulator_->inputs()) s << " " << input.name;
+  s << ") given " << p.data().mu.size() << " measurements, " << samples().rows() << " posterior samples, discrepancy "
+    << (p.discrepancy() ? "on" : "off") << "\n";
+  s << "  measurements: " << record_.data_source << "\n";
+  if (!record_.priors.empty()) s << "  priors: " << record_.priors << "\n";
+  for (size_t j = 0; j < held_.size(); ++j) {
+    const auto c = static_cast<Eigen::Index>(std::find(p.data().condition_names.begin(), p.data().condition_names.end(), held_[j]) -
+                                             p.data().condition_names.begin());
+    s << "  held: " << held_[j] << " = " << held_values_(c) << "\n";
+  }
+  for (const ParameterSummary& q : record_.posterior) {
+    s << "  posterior " << q.name << ": mean " << q.mean << ", sd " << q.sd << ", 95 % " << q.lo95 << " .. " << q.hi95
+      << " (split-R^ " << q.split_rhat << ", ESS " << q.effective_sample_size << ")\n";
+  }
+  s << "  sampler: " << record_.walkers << " walkers x " << record_.steps << " steps after " << record_.burn_in_steps
+    << " burn-in, seed " << record_.seed << ", acceptance " << record_.acceptance << "\n";
+  const IntervalParts& c = centre_parts_;
+  s << "  interval at the box centre: mu " << c.mu << ", sd " << c.sd << " = sqrt(law coefficients' posterior " << c.parameter_sd
+    << "^2 + given the coefficients " << c.conditional_sd << "^2); given the data, the roughness mean alone " << c.emulator_sd
+    << ", the discrepancy alone " << c.discrepancy_sd << "\n";
+  if (fast_) {
+    s << "  fast evaluator: grid";
+    for (const int cells : fast_->grid().cells()) s << " " << cells;
+    s << " cells, mu within " << fast_->bounds().mu_absolute << ", std within " << fast_->bounds().std_relative << " relative\n";
+  } else {
+    s << "  no fast evaluator (the exact posterior predictive answers)\n";
+  }
+  return s.str();
+}
+
+}  // namespace mufric
