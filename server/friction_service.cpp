@@ -114,6 +114,28 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
     out.set_interval(training->interval);
     out.set_micro_std_error(training->micro_std_error);
   }
+  if (const auto calibration = model.calibration_description()) {
+    auto* c = out.mutable_calibration();
+    c->set_data_source(calibration->data_source);
+    c->set_measurements(static_cast<uint64_t>(calibration->measurements));
+    c->set_discrepancy(calibration->discrepancy);
+    c->set_posterior_samples(static_cast<uint64_t>(calibration->posterior_samples));
+    for (const auto& p : calibration->parameters) {
+      auto* q = c->add_parameters();
+      q->set_name(p.name);
+      q->set_mean(p.mean);
+      q->set_sd(p.sd);
+      q->set_lo95(p.lo95);
+      q->set_hi95(p.hi95);
+    }
+    auto* parts = c->mutable_at_box_centre();
+    parts->set_mu(calibration->mu);
+    parts->set_sd(calibration->sd);
+    parts->set_parameter_sd(calibration->parameter_sd);
+    parts->set_conditional_sd(calibration->conditional_sd);
+    parts->set_emulator_sd(calibration->emulator_sd);
+    parts->set_discrepancy_sd(calibration->discrepancy_sd);
+  }
   out.set_has_patch_scatter(model.has_patch_scatter());
   out.set_summary(model.summary());
 }

@@ -197,6 +197,23 @@ std::optional<TrainingDescription> CalibratedModel::training_description() const
   return t;
 }
 
+std::optional<CalibrationDescription> CalibratedModel::calibration_description() const {
+  CalibrationDescription d;
+  d.data_source = record_.data_source;
+  d.measurements = problem().data().mu.size();
+  d.posterior_samples = samples().rows();
+  d.discrepancy = problem().discrepancy();
+  for (const ParameterSummary& q : record_.posterior) d.parameters.push_back({q.name, q.mean, q.sd, q.lo95, q.hi95});
+  const IntervalParts& c = centre_parts_;
+  d.mu = c.mu;
+  d.sd = c.sd;
+  d.parameter_sd = c.parameter_sd;
+  d.conditional_sd = c.conditional_sd;
+  d.emulator_sd = c.emulator_sd;
+  d.discrepancy_sd = c.discrepancy_sd;
+  return d;
+}
+
 std::string CalibratedModel::summary() const {
   std::ostringstream s;
   s.precision(4);

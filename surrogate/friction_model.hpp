@@ -86,6 +86,20 @@ struct TrainingDescription {
   double micro_std_error = 0.0;  // the shared scatter added to every interval (0: none)
 };
 
+// What a calibrated model was calibrated on and its interval's parts at the box centre (μ units), for
+// `describe` and DescribeModel; see surrogate/calibrated_model.hpp.
+struct CalibrationDescription {
+  struct Parameter {
+    std::string name;
+    double mean = 0.0, sd = 0.0, lo95 = 0.0, hi95 = 0.0;
+  };
+  std::string data_source;
+  long long measurements = 0, posterior_samples = 0;
+  bool discrepancy = false;
+  std::vector<Parameter> parameters;
+  double mu = 0.0, sd = 0.0, parameter_sd = 0.0, conditional_sd = 0.0, emulator_sd = 0.0, discrepancy_sd = 0.0;
+};
+
 class FrictionModel {
  public:
   virtual ~FrictionModel() = default;
@@ -118,6 +132,8 @@ class FrictionModel {
   virtual std::string summary() const = 0;
   // Its training, for a model that was trained; nothing for a law.
   virtual std::optional<TrainingDescription> training_description() const { return std::nullopt; }
+  // What it was calibrated on, for a calibrated model; nothing otherwise.
+  virtual std::optional<CalibrationDescription> calibration_description() const { return std::nullopt; }
 
  protected:
   explicit FrictionModel(InputSpace inputs) : inputs_(std::move(inputs)) {}

@@ -34,6 +34,7 @@
 #include "server/friction_service.hpp"
 #include "server/memory_budget.hpp"
 #include "server/server.hpp"
+#include "surrogate/calibrated_model.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
@@ -1045,6 +1046,107 @@ TEST_F(Service, ExtrapolationPolicyIsChosenPerRequest) {
 // over one stream (the server counts the streams opened), and a misspelt key is refused by name.
 // (A deadline cannot be shown to bite on loopback without a slow model: a 1 µs call sometimes
 // completes; parse_options is checked above and the C++ client's deadlines in their own tests.)
+// A calibrated model (issue 51) answers every interface with the same bits — in-process from its
+// file, unary gRPC, the stream and the C ABI — and DescribeModel carries what it was calibrated on
+// and its interval's parts (a campaign over p, v, T and a shear factor m; measurements at m = 0.5).
+TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration) {
+  auto simulator = [](const Eigen::RowVectorXd& x) {
+    const double ps = (x(0) - 300e6) / 1000e6, vs = (x(1) - 0.375) / 2.958, ts = (x(2) - 298.15) / 875.0;
+    return 0.1 + 0.5 * x(3) * (1.0 - 0.3 * ps) - 0.05 * vs - 0.03 * ts;
+  };
+  TrainingSet campaign;
+  campaign.inputs = default_friction_box();
+  campaign.inputs.push_back({"shear_factor", "1", 0.2, 0.9});
+  const Eigen::Index n = 60;
+  campaign.x.resize(n, 4);
+  campaign.mu.resize(n);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index k = 0; k < 4; ++k) {
+      const InputSpec& in = campaign.inputs[static_cast<size_t>(k)];
+      campaign.x(i, k) = in.lo + (in.hi - in.lo) * unit(rng);
+    }
+    campaign.mu(i) = simulator(campaign.x.row(i));
+  }
+  GpTrainingOptions options;
+  options.restarts = 1;
+  options.threads = 1;
+  const auto emulator = std::make_shared<const GaussianProcess>(train_gaussian_process(campaign, options));
+  Measurements data;
+  data.condition_names = {"contact_pressure", "sliding_velocity", "temperature"};
+  data.conditions.resize(6, 3);
+  data.mu.resize(6);
+  data.mu_sd = Eigen::VectorXd::Constant(6, 0.01);
+  for (Eigen::Index i = 0; i < 6; ++i) {
+    Eigen::RowVectorXd x(4);
+    x << 400e6 + 150e6 * static_cast<double>(i), 0.5 + 0.4 * static_cast<double>(i), 400.0 + 100.0 * static_cast<double>(i), 0.5;
+    data.conditions.row(i) = x.head(3);
+    data.mu(i) = simulator(x);
+    data.row_names.push_back("row " + std::to_string(i + 1));
+  }
+  const CalibrationProblem problem(emulator, data, {"shear_factor"}, {});
+  EnsembleOptions sampler;
+  sampler.walkers = 12;
+  sampler.burn_in_steps = 200;
+  sampler.steps = 400;
+  const CalibrationResult result = calibrate(problem, sampler);
+  CalibrationRecord record;
+  record.data_source = "six synthetic rows";
+  record.posterior = result.summary;
+  save_model((dir_ / "calibrated.h5").string(), CalibratedModel(emulator, data, {"shear_factor"}, {}, false, result.samples, record));
+
+  LoopbackServer server(dir_);
+  const Points pts = random_points(200);
+  EvaluationRequest what{.std = true, .ci_level = 0.95};
+  const client::Answer local = client::connect("file://" + (dir_ / "calibrated.h5").string())->evaluate(pts.block(), what);
+  ASSERT_EQ(local.mu.size(), 200u);
+  for (const bool stream : {false, true}) {
+    client::Options o;
+    o.streaming = stream;
+    o.chunk_points = 128;
+    const client::Answer a = client::connect("grpc://" + server.address() + "/calibrated", o)->evaluate(pts.block(), what);
+    EXPECT_EQ(a.mu, local.mu) << "stream " << stream;
+    EXPECT_EQ(a.std, local.std);
+    EXPECT_EQ(a.hi, local.hi);
+  }
+  mufric_client* c = nullptr;
+  ASSERT_EQ(mufric_open(("grpc://" + server.address() + "/calibrated").c_str(), &c), MUFRIC_OK) << mufric_last_error();
+  std::vector<double> mu(200);
+  ASSERT_EQ(mufric_evaluate(c, 200, pts.p.data(), pts.v.data(), pts.t.data(), nullptr, 0.95, mu.data(), nullptr, nullptr, nullptr,
+                            nullptr),
+            MUFRIC_OK)
+      << mufric_last_error();
+  EXPECT_EQ(mu, local.mu);
+  mufric_close(c);
+
+  auto stub = mufric::v1::FrictionService::NewStub(grpc::CreateChannel(server.address(), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  mufric::v1::DescribeModelRequest request;
+  request.set_model("calibrated");
+  mufric::v1::ModelDescription d;
+  ASSERT_TRUE(stub->DescribeModel(&context, request, &d).ok());
+  EXPECT_EQ(d.kind(), "calibrated");
+  EXPECT_EQ(d.interval(), "calibrated");
+  EXPECT_EQ(d.inputs_size(), 3);
+  ASSERT_TRUE(d.has_calibration());
+  EXPECT_EQ(d.calibration().data_source(), "six synthetic rows");
+  EXPECT_EQ(d.calibration().measurements(), 6u);
+  ASSERT_EQ(d.calibration().parameters_size(), 1);
+  EXPECT_EQ(d.calibration().parameters(0).name(), "shear_factor");
+  EXPECT_LE(d.calibration().parameters(0).lo95(), 0.5);
+  EXPECT_GE(d.calibration().parameters(0).hi95(), 0.5);
+  const auto& parts = d.calibration().at_box_centre();
+  EXPECT_NEAR(parts.sd() * parts.sd(), parts.parameter_sd() * parts.parameter_sd() + parts.conditional_sd() * parts.conditional_sd(),
+              1e-12);
+  EXPECT_GT(parts.parameter_sd(), 0.0);
+  // A GP's description carries none.
+  grpc::ClientContext gp_context;
+  request.set_model("gp");
+  ASSERT_TRUE(stub->DescribeModel(&gp_context, request, &d).ok());
+  EXPECT_FALSE(d.has_calibration());
+}
+
 // The patch scatter (issue 33) of a model trained by stochastic kriging reaches every interface with
 // the same bits: in-process, unary gRPC, the stream and the C ABI; DescribeModel says the model has
 // one and what its interval is; a model without one refuses the C call and sends none.
