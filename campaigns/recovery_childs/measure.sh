@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# The recovery study's "measurements" (issue 51): the micro-model itself at a shear factor m* = 0.55
+# that the campaign (run.sh) never ran, at 8 conditions of seed 000's box that it never ran either
+# (a Sobol' plan with another shift), on surfaces of their own. Each measurement is a sample's mean
+# over its four draws, its standard error the measurement's SD: what a tribometer paper reports as a
+# mean and its scatter. bench/recovery_calibration.sh calibrates m back from them. Resumable; never
+# part of CI.
+#   nohup bash campaigns/recovery_childs/measure.sh > measure.log 2>&1 &      # one core
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+mufric=${MUFRIC:-$here/../../build/app/mufric}
+plan=$here/measure-plan.h5
+db=$here/measure-db.h5
+if [[ ! -f $plan ]]; then
+  "$mufric" dataset plan --out "$plan" --samples 8 --design sobol --seed 7 \
+    --p 300MPa:1300MPa --v 22.5m/min:200m/min --T 25C:900C \
+    --set contact.law=childs --set contact.adhesive_coefficient=0.5 --set contact.shear_factor=0.55 \
+    --set contact.childs_exponent=1
+fi
+OMP_NUM_THREADS=1 exec "$mufric" dataset run --plan "$plan" --db "$db" --jobs 1 --threads 1 --sample-timeout 1800
