@@ -50,6 +50,10 @@ std::vector<int> cells_for(const GridSource& source, double resolution) {
   return cells;
 }
 
+bool every_input_at_finest(const std::vector<int>& cells) {
+  return std::all_of(cells.begin(), cells.end(), [](int c) { return c >= kMaximumCellsPerInput; });
+}
+
 double grid_megabytes(const std::vector<int>& cells) {
   return static_cast<double>(TensorCubicGrid::node_count(cells)) * 2.0 * sizeof(double) / 1e6;
 }
@@ -243,7 +247,11 @@ FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluator
                   unmeasured.std_floor, seconds_since(start));
     say(line);
     const double growth = std::clamp(std::pow(score, 0.25) * kGrowthMargin, kLeastGrowth, kMostGrowth);
-    const std::vector<int> finer = cells_for(source, resolution * growth);
+    double finer_resolution = resolution * growth;
+    std::vector<int> finer = cells_for(source, finer_resolution);
+    // Length scales of many box widths keep every input at the coarsest grid for several growths
+    // (a model flat in its inputs): grow on until some input gets more cells or all have the most.
+    while (finer == cells && !every_input_at_finest(cells)) finer = cells_for(source, finer_resolution *= growth);
     const double certification_work =
         per_point * (static_cast<double>(o.check_points) + o.local_searches * kLocalSearchEvaluations * kSearchEvaluationCost);
     const double next_round_work =
@@ -274,7 +282,7 @@ FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluator
         return fast;
       }
     }
-    resolution *= growth;
+    resolution = finer_resolution;
     cells = finer;
   }
 }

@@ -185,6 +185,21 @@ TEST(FastEvaluator, ANoiseFreeModelMeetsTheTolerancesOnASmallGrid) {
   EXPECT_EQ(fast.bounds().std_floor, o.mu_tolerance / o.std_relative_tolerance);
 }
 
+// Length scales of several box widths put every input at the coarsest grid for more than one growth
+// of the resolution; the build grows on until the grid changes rather than stop there as if at the
+// finest (it did: a calibrated model flat in p, v and T stopped at 3×3×3 with σ 6 % off).
+TEST(FastEvaluator, AModelFlatInEveryInputIsRefinedPastTheCoarsestGrid) {
+  const GaussianProcess gp = test::fixed_hyper_gp(60, 29, 1.0, {8.0, 10.0, 12.0}, 1e-4);
+  FastEvaluatorOptions o;
+  o.mu_tolerance = 1e-9;
+  o.std_relative_tolerance = 1e-5;
+  o.check_points = 500;
+  o.local_searches = 0;
+  const FastEvaluator fast = build_fast_evaluator(gp, o);
+  EXPECT_TRUE(fast.meets(o.mu_tolerance, o.std_relative_tolerance)) << fast.stop_reason();
+  EXPECT_GT(fast.grid().cells()[0], TensorCubicGrid::kMinimumCells);
+}
+
 // σ's error is |σ_fast − σ| / max(σ, floor): checked against that formula computed here, point by point.
 TEST(FastEvaluator, StdErrorIsMeasuredAgainstMaxOfStdAndTheFloor) {
   const GaussianProcess gp = noise_floor_gp();
