@@ -25,8 +25,9 @@ struct CalibrateOptions {
   std::string model, data, priors, out, model_out;
   // The tolerances a request asks by default (EvaluationRequest), so that the grid answers it.
   double fast_mu_tolerance = EvaluationRequest{}.mu_tolerance, fast_std_tolerance = EvaluationRequest{}.std_relative_tolerance;
-  // The grid's work budget in multiply-adds of the exact model: about 5 minutes on one core (1e10 per second).
-  double fast_max_work = 3e12;
+  // The grid's work budget in the GP's multiply-adds (CalibratedModel::exact_point_work): about 5
+  // minutes of one core (1e10 per second).
+  double fast_max_gigawork = 3000.0;
   bool no_fast_evaluator = false;
   std::vector<std::string> parameters, fixed;
   bool discrepancy = false;
@@ -44,8 +45,8 @@ std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
   return std::shared_ptr<const GaussianProcess>(gp);
 }
 
-// --fix NAME=VALUE: the input held at one value, as a condition every measurement shares.
-void fix_input(Measurements& data, const std::string& assignment) {
+// --fix NAME=VALUE: the input held at one value, as a condition every measurement shares; its name.
+std::string fix_input(Measurements& data, const std::string& assignment) {
   const auto equals = assignment.find('=');
   if (equals == std::string::npos) throw Error("--fix '" + assignment + "': give NAME=VALUE, e.g. adhesive_coefficient=0.35");
   const std::string name = assignment.substr(0, equals);
@@ -58,6 +59,7 @@ void fix_input(Measurements& data, const std::string& assignment) {
   data.condition_names.push_back(name);
   data.conditions.conservativeResize(Eigen::NoChange, data.conditions.cols() + 1);
   data.conditions.col(data.conditions.cols() - 1).setConstant(value);
+  return name;
 }
 
 // Every input of the model that the measurements do not give.
@@ -132,6 +134,7 @@ std::string priors_text(const CalibrationProblem& problem, const CalibrationPrio
 // The calibrated model: served like any other, with a fast evaluator certified against it.
 void write_calibrated_model(const CalibrateOptions& o, const std::shared_ptr<const GaussianProcess>& emulator,
                             const Measurements& data, const std::vector<std::string>& parameters,
+                            const std::vector<std::string>& held,
                             const CalibrationProblem& problem, const CalibrationPriors& priors, const CalibrationResult& result) {
   CalibrationRecord record{.data_source = measurement_source(o.data),
                            .priors = priors_text(problem, priors),
@@ -141,18 +144,18 @@ void write_calibrated_model(const CalibrateOptions& o, const std::shared_ptr<con
                            .burn_in_steps = o.sampler.burn_in_steps,
                            .seed = static_cast<unsigned long long>(o.sampler.seed),
                            .acceptance = result.acceptance};
-  std::vector<std::string> held;
-  for (const std::string& assignment : o.fixed) held.push_back(assignment.substr(0, assignment.find('=')));
   CalibratedModel model(emulator, data, parameters, held, priors.discrepancy, result.samples, std::move(record));
   model.set_default_extrapolation(emulator->default_extrapolation());
   model.set_mu_range(emulator->mu_min(), emulator->mu_max());
   FastEvaluatorOptions fast;
   fast.mu_tolerance = o.fast_mu_tolerance;
   fast.std_relative_tolerance = o.fast_std_tolerance;
-  fast.max_work = o.fast_max_work;
+  fast.max_work = o.fast_max_gigawork * 1e9;
   fast.progress = [](const std::string& line) { std::fprintf(stderr, "calibrate: fast evaluator: %s\n", line.c_str()); };
   try {
     if (o.no_fast_evaluator) throw FastEvaluatorOverCap("--no-fast-evaluator");
+    std::fprintf(stderr, "calibrate: fast evaluator: building within %.3g G multiply-adds (--fast-max-work; %.3g M a point)\n",
+                 o.fast_max_gigawork, model.exact_point_work() / 1e6);
     model.attach_fast_evaluator(std::make_shared<const FastEvaluator>(
         build_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, fast)));
     if (!model.fast_evaluator()->stop_reason().empty()) {
@@ -174,7 +177,8 @@ void write_calibrated_model(const CalibrateOptions& o, const std::shared_ptr<con
 void calibrate_command(const CalibrateOptions& o) {
   const auto emulator = load_emulator(o.model);
   Measurements data = read_measurements(o.data);
-  for (const std::string& assignment : o.fixed) fix_input(data, assignment);
+  std::vector<std::string> held;
+  for (const std::string& assignment : o.fixed) held.push_back(fix_input(data, assignment));
   CalibrationPriors priors;
   if (!o.priors.empty()) {
     const std::optional<std::string> text = read_whole_file(o.priors);
@@ -208,7 +212,7 @@ void calibrate_command(const CalibrateOptions& o) {
     write_posterior(o.out, problem, result, o);
     std::printf("wrote %s (%lld samples)\n", o.out.c_str(), static_cast<long long>(result.samples.rows()));
   }
-  if (!o.model_out.empty()) write_calibrated_model(o, emulator, data, parameters, problem, priors, result);
+  if (!o.model_out.empty()) write_calibrated_model(o, emulator, data, parameters, held, problem, priors, result);
 }
 
 }  // namespace
@@ -257,6 +261,12 @@ void add_calibrate_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--fast-std-tolerance", o->fast_std_tolerance,
                   "The calibrated model's fast evaluator: std within this (relative)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--fast-max-work", o->fast_max_gigawork,
+                  "The grid's work budget, G multiply-adds of the exact GP (about 10 per second on one core); a grid\n"
+                  "that does not meet the tolerances within it is kept with its certified bound, and requests asking\n"
+                  "for more use the exact predictive")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-fast-evaluator", o->no_fast_evaluator,

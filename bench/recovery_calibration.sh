@@ -48,7 +48,7 @@ for variant in "" "--discrepancy"; do
   echo "== calibrate ${variant:-(no discrepancy)}"
   # A refused posterior (exit 2: the chains fail the limits) is a result too: say so and go on.
   if ! "$mufric" calibrate --model "$out/campaign-gp.h5" --data "$out/measured.csv" --seed 1 $variant \
-      --out "$out/posterior${variant}.csv" --model-out "$out/calibrated${variant}.h5" --no-fast-evaluator \
+      --out "$out/posterior${variant}.csv" --model-out "$out/calibrated${variant}.h5" \
       > "$out/calibrate${variant}.txt" 2>&1; then
     grep -v "% of the steps" "$out/calibrate${variant}.txt"
     echo "calibrate refused the posterior: no credible interval to judge m* by"

@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "common/units.hpp"
+#include "surrogate/fast_evaluator_build.hpp"
 
 namespace mufric {
 namespace {
@@ -15,6 +16,12 @@ namespace {
 // box width (one-sided within it of a face): the posterior mean is a sum of RBF terms, smooth on the
 // scale of the emulator's length scales (≥ 0.05 box widths), so the truncation error is ~1e-8 relative.
 constexpr double kGradientStep = 1e-4;
+
+// The fixed cost of one posterior sample at one point, in the GP's multiply-adds (the unit of a
+// fast evaluator's work budget): measured 0.9 µs per sample and point whatever n against the GP's
+// 1.0e10 multiply-adds per second on the same core (bench/RESULTS.md, "The calibrated model's exact
+// predictive in blocks"), so that a budget means the same time for both.
+constexpr double kSamplePointOverheadWork = 1e4;
 
 std::vector<Eigen::Index> served_columns(const Measurements& data, const std::vector<std::string>& held) {
   std::vector<Eigen::Index> columns;
@@ -48,6 +55,16 @@ InputSpace served_inputs(const GaussianProcess& emulator, const Measurements& da
   return served;
 }
 
+Eigen::VectorXd column_medians(const Eigen::MatrixXd& rows) {
+  Eigen::VectorXd medians(rows.cols());
+  for (Eigen::Index j = 0; j < rows.cols(); ++j) {
+    std::vector<double> values(rows.col(j).data(), rows.col(j).data() + rows.rows());
+    std::sort(values.begin(), values.end());
+    medians(j) = quantile_of_sorted(values, 0.5);
+  }
+  return medians;
+}
+
 }  // namespace
 
 CalibratedModel::CalibratedModel(std::shared_ptr<const GaussianProcess> emulator, Measurements data,
@@ -72,6 +89,7 @@ CalibratedModel::CalibratedModel(std::shared_ptr<const GaussianProcess> emulator
   priors.discrepancy = discrepancy;
   auto problem = std::make_shared<const CalibrationProblem>(emulator_, std::move(data), std::move(parameters), priors);
   posterior_ = std::make_shared<const CalibratedPosterior>(std::move(problem), samples);
+  sample_medians_ = column_medians(posterior_->samples());
   Eigen::RowVectorXd centre(inputs().size());
   for (size_t j = 0; j < inputs().size(); ++j) centre(static_cast<Eigen::Index>(j)) = 0.5 * (inputs()[j].lo + inputs()[j].hi);
   centre_parts_ = parts_at(centre);
@@ -83,10 +101,14 @@ Eigen::MatrixXd CalibratedModel::conditions_of(const QueryBatch& x) const {
   return conditions;
 }
 
-CalibratedPrediction CalibratedModel::predict(const QueryBatch& x) const { return posterior_->predict(conditions_of(x)); }
+CalibratedPrediction CalibratedModel::predict(const QueryBatch& x, int max_threads) const {
+  return posterior_->predict(conditions_of(x), max_threads);
+}
 
 IntervalParts CalibratedModel::parts_at(const Eigen::RowVectorXd& x) const {
-  const CalibratedPrediction p = predict(x);
+  // On the calling thread: the constructor calls this, and a model is also read in a forked child
+  // (load_model_isolated), where an OpenMP team inherited from a threaded parent never starts.
+  const CalibratedPrediction p = predict(x, 1);
   return {p.mean(0), p.sd(0), p.parameter_sd(0), p.conditional_sd(0), p.emulator_sd(0), p.discrepancy_sd(0)};
 }
 
@@ -97,13 +119,8 @@ void CalibratedModel::attach_fast_evaluator(std::shared_ptr<const FastEvaluator>
 
 Eigen::VectorXd CalibratedModel::unit_length_scales() const {
   Eigen::VectorXd l(static_cast<Eigen::Index>(inputs().size()));
-  double discrepancy_length = std::numeric_limits<double>::infinity();
-  if (problem().discrepancy()) {
-    const Eigen::Index column = problem().parameter_count() + 1;
-    std::vector<double> values(samples().col(column).data(), samples().col(column).data() + samples().rows());
-    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
-    discrepancy_length = values[values.size() / 2];
-  }
+  const double discrepancy_length = problem().discrepancy() ? sample_medians_(problem().parameter_count() + 1)
+                                                            : std::numeric_limits<double>::infinity();
   for (size_t j = 0; j < inputs().size(); ++j) {
     const auto at = std::find_if(emulator_->inputs().begin(), emulator_->inputs().end(),
                                  [&](const InputSpec& s) { return s.name == inputs()[j].name; });
@@ -114,15 +131,18 @@ Eigen::VectorXd CalibratedModel::unit_length_scales() const {
 }
 
 double CalibratedModel::exact_point_work() const {
-  // Per kept sample: the cross-covariance with the measurements and the latent variance, each a
-  // triangular solve with the emulator's factor (n²), and the solves with the likelihood's (m²).
+  // Per kept sample, what the GP's own point costs (its correlations with the campaign and their
+  // whitening, GaussianProcess::latent_points), the cross-covariance with the m measurements (n m),
+  // its triangular solves with the likelihood's factor (m² each for η and δ), and a fixed cost of
+  // small products and exps that dominates at the n of a campaign.
+  const double gp_point = mufric::exact_point_work(*emulator_);
   const auto n = static_cast<double>(emulator_->state().x_train.rows());
   const auto m = static_cast<double>(problem().data().mu.size());
-  return static_cast<double>(samples().rows()) * (2.0 * n * n + 2.0 * m * m + n * m);
+  return static_cast<double>(samples().rows()) * (gp_point + n * m + 2.0 * m * m + kSamplePointOverheadWork);
 }
 
 void CalibratedModel::evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const {
-  const CalibratedPrediction p = predict(x);
+  const CalibratedPrediction p = predict(x, what.max_threads);
   out.mu = p.mean;
   if (what.std || what.ci_level > 0.0) out.std = p.sd;
 }
@@ -148,7 +168,7 @@ void CalibratedModel::evaluate_valid(const QueryBatch& x, const EvaluationReques
     if (!outside.empty()) {
       QueryBatch rest(static_cast<Eigen::Index>(outside.size()), d);
       for (size_t r = 0; r < outside.size(); ++r) rest.row(static_cast<Eigen::Index>(r)) = x.row(outside[r]);
-      const CalibratedPrediction p = predict(rest);
+      const CalibratedPrediction p = predict(rest, what.max_threads);
       for (size_t r = 0; r < outside.size(); ++r) {
         out.mu(outside[r]) = p.mean(static_cast<Eigen::Index>(r));
         out.std(outside[r]) = p.sd(static_cast<Eigen::Index>(r));
@@ -171,7 +191,8 @@ void CalibratedModel::evaluate_valid(const QueryBatch& x, const EvaluationReques
         minus(i, k) = room_below ? x(i, k) - h : x(i, k);
         span(i) = plus(i, k) - minus(i, k);
       }
-      out.gradient.col(k) = ((predict(plus).mean - predict(minus).mean).array() / span.array()).matrix();
+      out.gradient.col(k) =
+          ((predict(plus, what.max_threads).mean - predict(minus, what.max_threads).mean).array() / span.array()).matrix();
     }
   }
 }
@@ -180,10 +201,9 @@ Eigen::VectorXd CalibratedModel::patch_std_valid(const QueryBatch& x, const Eval
   // The campaign's patch scatter at the posterior median of θ: how one patch's μ scatters about the
   // mean, a property of the roughness, not of what is known about θ.
   const CalibrationProblem& p = problem();
-  Eigen::VectorXd median(p.parameter_count());
-  for (Eigen::Index j = 0; j < p.parameter_count(); ++j) median(j) = record_.posterior.empty() ? samples().col(j).mean()
-                                                                                                : record_.posterior[static_cast<size_t>(j)].median;
-  return emulator_->patch_std(p.emulator_points(conditions_of(x), median), what.exact_only() ? 0.0 : what.std_relative_tolerance);
+  const Eigen::VectorXd median_theta = sample_medians_.head(p.parameter_count());
+  return emulator_->patch_std(p.emulator_points(conditions_of(x), median_theta),
+                              what.exact_only() ? 0.0 : what.std_relative_tolerance);
 }
 
 std::optional<TrainingDescription> CalibratedModel::training_description() const {

@@ -60,7 +60,7 @@ class CalibratedModel final : public FrictionModel {
   static CalibratedModel read(const h5::Reader& in, InputSpace inputs);
 
   // The posterior predictive and its parts at served points (SI rows), exactly.
-  CalibratedPrediction predict(const QueryBatch& x) const;
+  CalibratedPrediction predict(const QueryBatch& x, int max_threads = 0) const;
   IntervalParts parts_at(const Eigen::RowVectorXd& x) const;
   // At the centre of the served box (what describe reports).
   const IntervalParts& centre_parts() const { return centre_parts_; }
@@ -95,6 +95,9 @@ class CalibratedModel final : public FrictionModel {
   Eigen::RowVectorXd held_values_;           // per condition column (served ones unused)
   CalibrationRecord record_;
   IntervalParts centre_parts_;
+  // Per coordinate (θ, then σ_δ and ℓ_δ with δ on), the median of the kept posterior samples: the
+  // θ at which the patch scatter is read, and δ's length scale for the grid.
+  Eigen::VectorXd sample_medians_;
   std::shared_ptr<const FastEvaluator> fast_;
 };
 

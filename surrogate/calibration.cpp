@@ -42,15 +42,6 @@ double draw_from(const Prior& prior, std::mt19937_64& random) {
   return prior.a;
 }
 
-// One quantile of sorted values, by linear interpolation between order statistics (Hyndman & Fan
-// 1996, definition 7, R's default).
-double quantile_of_sorted(const std::vector<double>& sorted, double probability) {
-  const double position = probability * static_cast<double>(sorted.size() - 1);
-  const auto below = static_cast<size_t>(std::floor(position));
-  const size_t above = std::min(below + 1, sorted.size() - 1);
-  return sorted[below] + (position - static_cast<double>(below)) * (sorted[above] - sorted[below]);
-}
-
 Prior parse_prior(const nlohmann::json& node, const std::string& where) {
   if (!node.is_object() || node.size() != 1) {
     throw Error(where + ": a prior is an object with one key, e.g. {\"uniform\": [0.2, 0.9]}");
@@ -88,6 +79,13 @@ Prior parse_prior(const nlohmann::json& node, const std::string& where) {
 }
 
 }  // namespace
+
+double quantile_of_sorted(const std::vector<double>& sorted, double probability) {
+  const double position = probability * static_cast<double>(sorted.size() - 1);
+  const auto below = static_cast<size_t>(std::floor(position));
+  const size_t above = std::min(below + 1, sorted.size() - 1);
+  return sorted[below] + (position - static_cast<double>(below)) * (sorted[above] - sorted[below]);
+}
 
 std::string_view to_string(PriorKind kind) {
   switch (kind) {
@@ -308,13 +306,7 @@ Eigen::MatrixXd CalibrationProblem::unit_conditions(const Eigen::MatrixXd& condi
 
 Eigen::MatrixXd CalibrationProblem::discrepancy_covariance(const Eigen::MatrixXd& ua, const Eigen::MatrixXd& ub,
                                                            double amplitude, double length_scale) {
-  Eigen::MatrixXd k(ua.rows(), ub.rows());
-  for (Eigen::Index j = 0; j < ub.rows(); ++j) {
-    for (Eigen::Index i = 0; i < ua.rows(); ++i) {
-      k(i, j) = amplitude * amplitude * std::exp(-0.5 * (ua.row(i) - ub.row(j)).squaredNorm() / (length_scale * length_scale));
-    }
-  }
-  return k;
+  return amplitude * amplitude * rbf_correlations(ua / length_scale, ub / length_scale);
 }
 
 double CalibrationProblem::log_posterior(const Eigen::VectorXd& coordinates) const {
@@ -347,12 +339,12 @@ double CalibrationProblem::log_posterior(const Eigen::VectorXd& coordinates) con
 CalibrationProblem::Likelihood CalibrationProblem::likelihood_at(const Eigen::VectorXd& theta, double amplitude,
                                                                  double length_scale) const {
   Likelihood out;
-  out.points = emulator_points(data_.conditions, theta);
-  Eigen::MatrixXd covariance = emulator_->latent_covariance(out.points);
+  out.measured = emulator_->latent_points(emulator_points(data_.conditions, theta));
+  Eigen::MatrixXd covariance = emulator_->latent_covariance(out.measured, out.measured);
   covariance.diagonal().array() += data_.mu_sd.array().square() + kCovarianceJitter;
   if (amplitude > 0.0) covariance += discrepancy_covariance(unit_data_conditions_, unit_data_conditions_, amplitude, length_scale);
   out.factor.compute(covariance);
-  out.residual = data_.mu - emulator_->latent_mean(out.points);
+  out.residual = data_.mu - out.measured.mean;
   return out;
 }
 
@@ -441,56 +433,77 @@ CalibratedPosterior::CalibratedPosterior(std::shared_ptr<const CalibrationProble
   }
 }
 
-CalibratedPrediction CalibratedPosterior::predict(const Eigen::MatrixXd& conditions) const {
+CalibratedPrediction CalibratedPosterior::predict(const Eigen::MatrixXd& conditions, int max_threads) const {
+  const Eigen::Index q = conditions.rows();
+  CalibratedPrediction out;
+  for (Eigen::VectorXd* v : {&out.mean, &out.sd, &out.discrepancy_mean, &out.discrepancy_sd, &out.parameter_sd,
+                             &out.emulator_sd, &out.conditional_sd}) {
+    v->resize(q);
+  }
+  for (Eigen::Index first = 0; first < q; first += kPredictionBlockRows) {
+    const Eigen::Index count = std::min(kPredictionBlockRows, q - first);
+    predict_block(conditions.middleRows(first, count), first, max_threads, out);
+  }
+  return out;
+}
+
+void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen::Index first, int max_threads,
+                                        CalibratedPrediction& out) const {
   const CalibrationProblem& problem = *problem_;
   const GaussianProcess& emulator = problem.emulator();
   const Eigen::Index q = conditions.rows(), used = static_cast<Eigen::Index>(samples_.size());
-  const Eigen::Index n = problem.data().mu.size();
   const Eigen::MatrixXd unit_new = problem.unit_conditions(conditions);
   const Eigen::MatrixXd& unit_data = problem.unit_data_conditions();
   Eigen::MatrixXd means(q, used), variances(q, used), discrepancy_means(q, used), discrepancy_variances(q, used),
       emulator_variances(q, used);
-  for (Eigen::Index s = 0; s < used; ++s) {
+  auto predict_sample = [&](Eigen::Index s) {
     const Sample& sample = samples_[static_cast<size_t>(s)];
-    const Eigen::LLT<Eigen::MatrixXd>& factor = sample.likelihood.factor;
-    const Eigen::MatrixXd new_points = problem.emulator_points(conditions, sample.theta);
-    Eigen::MatrixXd discrepancy_cross = Eigen::MatrixXd::Zero(q, n);
-    if (problem.discrepancy()) {
-      discrepancy_cross =
-          CalibrationProblem::discrepancy_covariance(unit_new, unit_data, sample.amplitude, sample.length_scale);
-    }
-    // ζ(x) = η(x, θ) + δ(x) given y: cov(ζ(x), y) = C_η(x, X) + K_δ(x, X).
-    const Eigen::MatrixXd emulator_cross = emulator.latent_covariance(new_points, sample.likelihood.points);
-    const Eigen::MatrixXd cross = emulator_cross + discrepancy_cross;
-    const Eigen::VectorXd prior_emulator_variance = emulator.latent_variance(new_points);
-    means.col(s) = emulator.latent_mean(new_points) + cross * sample.weights;
-    // diag(A C⁻¹ Bᵀ) for cross-covariances A, B with y.
-    auto explained = [&factor](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-      const Eigen::MatrixXd solved = factor.solve(b.transpose());  // n × q
-      return Eigen::VectorXd((a.array() * solved.transpose().array()).rowwise().sum().matrix());
-    };
+    const auto lower = sample.likelihood.factor.matrixL();
+    const GaussianProcess::LatentPoints at = emulator.latent_points(problem.emulator_points(conditions, sample.theta));
+    // ζ(x) = η(x, θ) + δ(x) given y (KOH eq. 6): cov(η(x), y) = C_η(x, X), cov(δ(x), y) = K_δ(x, X).
+    // diag(A C⁻¹ Aᵀ) = |L⁻¹Aᵀ|² per column, with C = LLᵀ the likelihood's factor.
+    const Eigen::MatrixXd emulator_cross = emulator.latent_covariance(at, sample.likelihood.measured);
+    const Eigen::MatrixXd emulator_explained = lower.solve(emulator_cross.transpose());
     const double discrepancy_variance = sample.amplitude * sample.amplitude;
-    variances.col(s) = prior_emulator_variance.array() + discrepancy_variance - explained(cross, cross).array();
-    emulator_variances.col(s) = prior_emulator_variance - explained(emulator_cross, emulator_cross);
-    discrepancy_means.col(s) = discrepancy_cross * sample.weights;
-    discrepancy_variances.col(s) = discrepancy_variance - explained(discrepancy_cross, discrepancy_cross).array();
-  }
+    const Eigen::VectorXd prior_emulator_variance = emulator.latent_variance(at);
+    emulator_variances.col(s) = prior_emulator_variance - emulator_explained.colwise().squaredNorm().transpose();
+    if (problem.discrepancy()) {
+      const Eigen::MatrixXd discrepancy_cross =
+          CalibrationProblem::discrepancy_covariance(unit_new, unit_data, sample.amplitude, sample.length_scale);
+      const Eigen::MatrixXd discrepancy_explained = lower.solve(discrepancy_cross.transpose());
+      discrepancy_means.col(s) = discrepancy_cross * sample.weights;
+      discrepancy_variances.col(s) =
+          (discrepancy_variance - discrepancy_explained.colwise().squaredNorm().array()).transpose().matrix();
+      means.col(s) = at.mean + emulator_cross * sample.weights + discrepancy_means.col(s);
+      variances.col(s) = prior_emulator_variance.array() + discrepancy_variance -
+                         (emulator_explained + discrepancy_explained).colwise().squaredNorm().transpose().array();
+    } else {
+      discrepancy_means.col(s).setZero();
+      discrepancy_variances.col(s).setZero();
+      means.col(s) = at.mean + emulator_cross * sample.weights;
+      variances.col(s) = emulator_variances.col(s);
+    }
+  };
+  // Each sample writes its own columns: the threads share nothing but what they read.
+  const int team = evaluation_team_size(max_threads);
+#pragma omp parallel for num_threads(team) schedule(static) if (team > 1)
+  for (Eigen::Index s = 0; s < used; ++s) predict_sample(s);
+
   // A mixture's moments: the mean of the means; the mean variance plus the variance of the means.
   auto spread = [used](const Eigen::MatrixXd& m) {
     const Eigen::VectorXd centre = m.rowwise().mean();
     return Eigen::VectorXd(((m.colwise() - centre).array().square().rowwise().sum() / static_cast<double>(used)).matrix());
   };
-  CalibratedPrediction out;
-  out.mean = means.rowwise().mean();
   const Eigen::VectorXd between = spread(means);
-  out.parameter_sd = between.cwiseSqrt();
   const Eigen::VectorXd within = variances.rowwise().mean().cwiseMax(0.0);
-  out.sd = (within + between).cwiseSqrt();
-  out.conditional_sd = within.cwiseSqrt();
-  out.emulator_sd = emulator_variances.rowwise().mean().cwiseMax(0.0).cwiseSqrt();
-  out.discrepancy_mean = discrepancy_means.rowwise().mean();
-  out.discrepancy_sd = (discrepancy_variances.rowwise().mean().cwiseMax(0.0) + spread(discrepancy_means)).cwiseSqrt();
-  return out;
+  out.mean.segment(first, q) = means.rowwise().mean();
+  out.parameter_sd.segment(first, q) = between.cwiseSqrt();
+  out.sd.segment(first, q) = (within + between).cwiseSqrt();
+  out.conditional_sd.segment(first, q) = within.cwiseSqrt();
+  out.emulator_sd.segment(first, q) = emulator_variances.rowwise().mean().cwiseMax(0.0).cwiseSqrt();
+  out.discrepancy_mean.segment(first, q) = discrepancy_means.rowwise().mean();
+  out.discrepancy_sd.segment(first, q) =
+      (discrepancy_variances.rowwise().mean().cwiseMax(0.0) + spread(discrepancy_means)).cwiseSqrt();
 }
 
 CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const CalibrationResult& result,

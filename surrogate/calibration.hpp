@@ -101,11 +101,12 @@ class CalibrationProblem {
   Eigen::MatrixXd emulator_points(const Eigen::MatrixXd& conditions, const Eigen::VectorXd& theta) const;
   // Unit-box coordinates of conditions in the emulator's box (δ's inputs).
   Eigen::MatrixXd unit_conditions(const Eigen::MatrixXd& conditions) const;
-  // The likelihood at θ and δ's (σ_δ, ℓ_δ): the emulator's rows at the measured conditions, the
-  // Cholesky factor of C_η + K_δ + diag(s²) and the residual y − m (σ_δ = 0: no δ). The factor's
-  // info() says whether the covariance was positive definite.
+  // The likelihood at θ and δ's (σ_δ, ℓ_δ): the emulator's latent posterior at the measured
+  // conditions (its rows' correlations with the campaign, kept for predictions), the Cholesky factor
+  // of C_η + K_δ + diag(s²) and the residual y − m (σ_δ = 0: no δ). The factor's info() says whether
+  // the covariance was positive definite.
   struct Likelihood {
-    Eigen::MatrixXd points;
+    GaussianProcess::LatentPoints measured;
     Eigen::LLT<Eigen::MatrixXd> factor;
     Eigen::VectorXd residual;
   };
@@ -142,6 +143,10 @@ struct CalibrationResult {
   EnsembleOptions options;
 };
 
+// One quantile of sorted values, by linear interpolation between order statistics (Hyndman & Fan
+// 1996, definition 7, R's default).
+double quantile_of_sorted(const std::vector<double>& sorted, double probability);
+
 CalibrationResult calibrate(const CalibrationProblem& problem, const EnsembleOptions& options,
                             const SamplerProgress& progress = {});
 
@@ -170,7 +175,10 @@ class CalibratedPosterior {
                       Eigen::Index thinned = kDefaultThinnedSamples);
   static constexpr Eigen::Index kDefaultThinnedSamples = 200;
 
-  CalibratedPrediction predict(const Eigen::MatrixXd& conditions) const;
+  // In blocks of kPredictionBlockRows conditions (memory bounded whatever the batch), the samples
+  // of a block shared among max_threads threads (0: as many as OpenMP allows; evaluation_team_size).
+  CalibratedPrediction predict(const Eigen::MatrixXd& conditions, int max_threads = 0) const;
+  static constexpr Eigen::Index kPredictionBlockRows = 256;
   const CalibrationProblem& problem() const { return *problem_; }
   // The kept samples, one row each (natural units).
   const Eigen::MatrixXd& samples() const { return kept_; }
@@ -182,6 +190,9 @@ class CalibratedPosterior {
     CalibrationProblem::Likelihood likelihood;
     Eigen::VectorXd weights;  // (C_η + K_δ + diag s²)⁻¹ (y − m)
   };
+  // Rows [first, first + conditions.rows()) of out, from every kept sample.
+  void predict_block(const Eigen::MatrixXd& conditions, Eigen::Index first, int max_threads, CalibratedPrediction& out) const;
+
   std::shared_ptr<const CalibrationProblem> problem_;
   Eigen::MatrixXd kept_;
   std::vector<Sample> samples_;

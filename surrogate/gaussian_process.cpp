@@ -73,6 +73,13 @@ void rbf_correlation_in_place(Eigen::Ref<Eigen::ArrayXd> values) {
   exp_in_place(values.data(), values.size());
 }
 
+Eigen::MatrixXd rbf_correlations(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  Eigen::MatrixXd k(a.rows(), b.rows());
+  for (Eigen::Index j = 0; j < b.rows(); ++j) k.col(j) = (a.rowwise() - b.row(j)).rowwise().squaredNorm();
+  rbf_correlation_in_place(Eigen::Map<Eigen::ArrayXd>(k.data(), k.size()));
+  return k;
+}
+
 void rbf_signal_covariance(const Eigen::MatrixXd& x_unit, const GpHyperParameters& hyper, Eigen::MatrixXd& kf) {
   const Eigen::Index n = x_unit.rows();
   const Eigen::MatrixXd scaled = x_unit * hyper.length_scales.cwiseInverse().asDiagonal();
@@ -258,15 +265,21 @@ Eigen::VectorXd GaussianProcess::latent_mean(const Eigen::MatrixXd& x) const {
   return mean;
 }
 
-Eigen::MatrixXd GaussianProcess::whitened_correlations(const Eigen::MatrixXd& scaled) const {
+GaussianProcess::LatentPoints GaussianProcess::latent_points(const Eigen::MatrixXd& x) const {
+  require_query_columns(x);
+  LatentPoints out;
+  out.scaled = scaled_queries(x);
   const Eigen::Index n = scaled_train_.rows();
-  Eigen::MatrixXd correlations(n, scaled.rows());
+  Eigen::MatrixXd correlations(n, x.rows());
   Eigen::ArrayXd correlation(n);
-  for (Eigen::Index j = 0; j < scaled.rows(); ++j) {
-    correlations_with_training(scaled.row(j), correlation);
+  out.mean.resize(x.rows());
+  for (Eigen::Index j = 0; j < x.rows(); ++j) {
+    correlations_with_training(out.scaled.row(j), correlation);
+    out.mean(j) = mean_from_correlations(correlation.data());
     correlations.col(j) = correlation.matrix();
   }
-  return inverse_factor_.triangularView<Eigen::Lower>() * correlations;
+  out.whitened.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * correlations;
+  return out;
 }
 
 Eigen::RowVectorXd GaussianProcess::unexplained_trend(const Eigen::MatrixXd& whitened) const {
@@ -275,33 +288,26 @@ Eigen::RowVectorXd GaussianProcess::unexplained_trend(const Eigen::MatrixXd& whi
 }
 
 Eigen::MatrixXd GaussianProcess::latent_covariance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) const {
-  require_query_columns(a);
-  require_query_columns(b);
-  const bool same = &a == &b;
-  const Eigen::MatrixXd qa = scaled_queries(a);
-  const Eigen::MatrixXd qb = same ? qa : scaled_queries(b);
-  const Eigen::MatrixXd va = whitened_correlations(qa);
-  const Eigen::MatrixXd vb = same ? va : whitened_correlations(qb);
+  const LatentPoints pa = latent_points(a);
+  return &a == &b ? latent_covariance(pa, pa) : latent_covariance(pa, latent_points(b));
+}
+
+Eigen::MatrixXd GaussianProcess::latent_covariance(const LatentPoints& a, const LatentPoints& b) const {
   const double s2 = state_.hyper.signal_variance;
-  Eigen::MatrixXd covariance(a.rows(), b.rows());
-  for (Eigen::Index j = 0; j < b.rows(); ++j) {
-    for (Eigen::Index i = 0; i < a.rows(); ++i) {
-      const double r2 = (qa.row(i) - qb.row(j)).squaredNorm();
-      covariance(i, j) = s2 * std::exp(std::max(-0.5 * r2, kMinimumExponent));
-    }
-  }
-  covariance.noalias() -= (s2 * s2) * va.transpose() * vb;
+  Eigen::MatrixXd covariance = s2 * rbf_correlations(a.scaled, b.scaled);
+  covariance.noalias() -= (s2 * s2) * a.whitened.transpose() * b.whitened;
   if (state_.mean_estimated) {
-    covariance.noalias() += unexplained_trend(va).transpose() * unexplained_trend(vb) / trend_precision_;
+    covariance.noalias() += unexplained_trend(a.whitened).transpose() * unexplained_trend(b.whitened) / trend_precision_;
   }
   return state_.y_scale * state_.y_scale * covariance;
 }
 
 Eigen::MatrixXd GaussianProcess::latent_covariance(const Eigen::MatrixXd& x) const { return latent_covariance(x, x); }
 
-Eigen::VectorXd GaussianProcess::latent_variance(const Eigen::MatrixXd& x) const {
-  require_query_columns(x);
-  const Eigen::MatrixXd v = whitened_correlations(scaled_queries(x));
+Eigen::VectorXd GaussianProcess::latent_variance(const Eigen::MatrixXd& x) const { return latent_variance(latent_points(x)); }
+
+Eigen::VectorXd GaussianProcess::latent_variance(const LatentPoints& x) const {
+  const Eigen::MatrixXd& v = x.whitened;
   const double s2 = state_.hyper.signal_variance;
   Eigen::ArrayXd variance = s2 - s2 * s2 * v.colwise().squaredNorm().transpose().array();
   if (state_.mean_estimated) variance += unexplained_trend(v).transpose().array().square() / trend_precision_;

@@ -164,6 +164,16 @@ class GaussianProcess final : public FrictionModel {
   Eigen::MatrixXd latent_covariance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) const;
   Eigen::MatrixXd latent_covariance(const Eigen::MatrixXd& x) const;  // of x with itself
   Eigen::VectorXd latent_variance(const Eigen::MatrixXd& x) const;    // its diagonal alone
+  // The same from a set of points' correlations with the training set, formed once (n²/2
+  // multiply-adds a point): a calibration's posterior keeps its measurements' for every prediction.
+  struct LatentPoints {
+    Eigen::MatrixXd scaled;    // rows × d, in the training inputs' scaled space
+    Eigen::VectorXd mean;      // the latent mean, μ units (latent_mean's bits)
+    Eigen::MatrixXd whitened;  // L⁻¹ k̂, n × rows
+  };
+  LatentPoints latent_points(const Eigen::MatrixXd& x) const;
+  Eigen::MatrixXd latent_covariance(const LatentPoints& a, const LatentPoints& b) const;
+  Eigen::VectorXd latent_variance(const LatentPoints& x) const;
 
   // The model file's groups under `group` ("/gp"; the patch scatter's under "/gp/patch_scatter").
   void write_group(h5::Writer& out, const std::string& group) const;
@@ -185,8 +195,6 @@ class GaussianProcess final : public FrictionModel {
   // ((x − lo)/width)/l per row: the space the training inputs are scaled to.
   Eigen::MatrixXd scaled_queries(const Eigen::MatrixXd& x) const;
   void require_query_columns(const Eigen::MatrixXd& x) const;
-  // L⁻¹ k̂ for each row's correlations k̂ with the training inputs (n × rows), from scaled queries.
-  Eigen::MatrixXd whitened_correlations(const Eigen::MatrixXd& scaled) const;
   // 1 − σ² uᵀV per column of a whitened V (an estimated mean's share); empty without one.
   Eigen::RowVectorXd unexplained_trend(const Eigen::MatrixXd& whitened) const;
   // exp(−½ |s_i − q|²) for every scaled training input s_i and a scaled query q.
@@ -225,6 +233,10 @@ Eigen::MatrixXd to_unit_box(const Eigen::MatrixXd& x, const InputSpace& inputs);
 
 // Overwrites scaled squared distances r² with exp(−½ r²), floored at 1e-150 (never subnormal).
 void rbf_correlation_in_place(Eigen::Ref<Eigen::ArrayXd> values);
+
+// exp(−½ |a_i − b_j|²) between the rows of two sets of points already divided by their length
+// scales (rows(a) × rows(b)), vectorised as rbf_correlation_in_place.
+Eigen::MatrixXd rbf_correlations(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
 
 // Lower triangle (and diagonal) of the signal covariance σ² exp(−½ r²) for unit-box inputs.
 void rbf_signal_covariance(const Eigen::MatrixXd& x_unit, const GpHyperParameters& hyper, Eigen::MatrixXd& kf);

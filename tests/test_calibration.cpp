@@ -507,6 +507,35 @@ TEST(CalibratedModel, ServesTheMixtureOfTheKennedyOHaganPredictivesOverItsPoster
   EXPECT_NEAR(g.gradient(0, 0), (model.evaluate(up, exact).mu(0) - model.evaluate(down, exact).mu(0)) / 2e6, 1e-12);
 }
 
+// A batch is predicted in blocks of CalibratedPosterior::kPredictionBlockRows (bounded memory) with
+// the samples shared among threads: the same bits on any team, and a point's answer is the one it
+// gets alone, to rounding (Eigen's product of a single column sums in another order; the variance is
+// a difference of two terms ~100× its size, hence its looser relative bound).
+TEST(CalibratedModel, ABatchAcrossSeveralBlocksAndThreadsGivesEachPointItsOwnAnswer) {
+  const SmallCalibration c;
+  const CalibratedModel model = c.model();
+  const Eigen::Index count = 2 * CalibratedPosterior::kPredictionBlockRows + 37;
+  std::mt19937_64 random(83);
+  Eigen::MatrixXd x(count, 2);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    for (Eigen::Index k = 0; k < 2; ++k) {
+      const InputSpec& in = model.inputs()[static_cast<size_t>(k)];
+      x(i, k) = in.lo + uniform01(random()) * (in.hi - in.lo);
+    }
+  }
+  const CalibratedPrediction one_thread = model.predict(x, 1), two_threads = model.predict(x, 2);
+  EXPECT_TRUE((one_thread.mean.array() == two_threads.mean.array()).all()) << "the same bits on any team";
+  EXPECT_TRUE((one_thread.sd.array() == two_threads.sd.array()).all());
+  for (const Eigen::Index i : {Eigen::Index{0}, CalibratedPosterior::kPredictionBlockRows - 1,
+                               CalibratedPosterior::kPredictionBlockRows, count - 1}) {
+    const CalibratedPrediction alone = model.predict(x.row(i), 1);
+    EXPECT_NEAR(one_thread.mean(i), alone.mean(0), 1e-12) << i;
+    EXPECT_NEAR(one_thread.sd(i), alone.sd(0), 1e-9 * alone.sd(0)) << i;
+    EXPECT_NEAR(one_thread.discrepancy_sd(i), alone.discrepancy_sd(0), 1e-9 * alone.discrepancy_sd(0)) << i;
+    EXPECT_NEAR(one_thread.emulator_sd(i), alone.emulator_sd(0), 1e-9 * alone.emulator_sd(0)) << i;
+  }
+}
+
 TEST(CalibratedModel, ItsFileAndFastEvaluatorGiveBackWhatItServes) {
   const SmallCalibration c;
   CalibratedModel model = c.model();
