@@ -3,7 +3,8 @@
 # the micro-model made at m* = 0.55 (campaigns/recovery_childs/measure.sh), through the GP of the
 # campaign over (p, v, T, m) (campaigns/recovery_childs/run.sh; its samples so far). Prints m's
 # posterior with and without the discrepancy delta, whether m* lies inside its 95 % credible
-# interval, and writes the calibrated model; figures go to bench/RESULTS.md by hand.
+# interval, writes the calibrated models and draws recovery.png (bench/plot_recovery.py); figures go to
+# bench/RESULTS.md by hand.
 #   bash bench/recovery_calibration.sh [--mufric PATH] [--out DIR]
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -14,7 +15,7 @@ while [[ $# -gt 0 ]]; do
   case $1 in
     --mufric) mufric=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
-    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "recovery_calibration.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -59,3 +60,5 @@ for variant in "" "--discrepancy"; do
     printf "m* = %s %s the 95 %% credible interval %s .. %s\n", m, (lo <= m && m <= hi) ? "inside" : "OUTSIDE", lo, hi }' \
     "$out/calibrate${variant}.txt"
 done
+# The picture: m's posterior against m*, and what each calibrated model serves at the measured conditions.
+/usr/bin/python3 "$here/bench/plot_recovery.py" "$mufric" "$out" "$m_star" "$out/recovery.png"
