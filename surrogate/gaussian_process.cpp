@@ -173,25 +173,10 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
   const Eigen::Index d = scaled_train_.cols();
   const Eigen::MatrixXd q = scaled_queries(x.middleRows(first, count));
   const bool need_std = what.std || what.ci_level > 0.0;
-  if (!need_std && !what.gradient) {
-    // Mean only: correlations and dot product per query, in L1, no kernel block stored.
-    Eigen::ArrayXd correlation(n);
-    for (Eigen::Index b = 0; b < count; ++b) {
-      correlations_with_training(q.row(b), correlation);
-      out.mu(first + b) = mean_from_correlations(correlation.data());
-    }
-    return;
-  }
-  // Column b of k_block is the correlation vector of query b with every training point. It is
-  // computed in an aligned buffer like the mean-only path's, then copied: exp over a column that
-  // starts anywhere takes a scalar head in a portable build and would round differently.
-  k_block.resize(n, count);
-  Eigen::ArrayXd correlation(n);
-  for (Eigen::Index b = 0; b < count; ++b) {
-    correlations_with_training(q.row(b), correlation);
-    out.mu(first + b) = mean_from_correlations(correlation.data());
-    k_block.col(b) = correlation.matrix();
-  }
+  // Column b of k_block: query b's correlations with every training point; a mean-only request
+  // stores none (each query's correlations and dot product stay in L1).
+  means_and_correlations(q, out.mu.segment(first, count), need_std || what.gradient ? &k_block : nullptr);
+  if (!need_std && !what.gradient) return;
 
   if (what.gradient) {
     // ∂μ/∂x_k = −Σ_i w_i k_i (q_k − s_ik) / (l_k · width_k)  with s = scaled training inputs.
@@ -253,15 +238,24 @@ Eigen::MatrixXd GaussianProcess::scaled_queries(const Eigen::MatrixXd& x) const 
          state_.hyper.length_scales.cwiseInverse().asDiagonal();
 }
 
+void GaussianProcess::means_and_correlations(const Eigen::MatrixXd& scaled, Eigen::Ref<Eigen::VectorXd> mean,
+                                             Eigen::MatrixXd* correlations) const {
+  const Eigen::Index n = scaled_train_.rows();
+  if (correlations != nullptr) correlations->resize(n, scaled.rows());
+  // Each row's correlations are computed in an aligned buffer, then copied: exp over a column that
+  // starts anywhere takes a scalar head in a portable build and would round differently.
+  Eigen::ArrayXd correlation(n);
+  for (Eigen::Index b = 0; b < scaled.rows(); ++b) {
+    correlations_with_training(scaled.row(b), correlation);
+    mean(b) = mean_from_correlations(correlation.data());
+    if (correlations != nullptr) correlations->col(b) = correlation.matrix();
+  }
+}
+
 Eigen::VectorXd GaussianProcess::latent_mean(const Eigen::MatrixXd& x) const {
   require_query_columns(x);
-  const Eigen::MatrixXd q = scaled_queries(x);
-  Eigen::ArrayXd correlation(scaled_train_.rows());
   Eigen::VectorXd mean(x.rows());
-  for (Eigen::Index b = 0; b < x.rows(); ++b) {
-    correlations_with_training(q.row(b), correlation);
-    mean(b) = mean_from_correlations(correlation.data());
-  }
+  means_and_correlations(scaled_queries(x), mean, nullptr);
   return mean;
 }
 
@@ -269,15 +263,9 @@ GaussianProcess::LatentPoints GaussianProcess::latent_points(const Eigen::Matrix
   require_query_columns(x);
   LatentPoints out;
   out.scaled = scaled_queries(x);
-  const Eigen::Index n = scaled_train_.rows();
-  Eigen::MatrixXd correlations(n, x.rows());
-  Eigen::ArrayXd correlation(n);
   out.mean.resize(x.rows());
-  for (Eigen::Index j = 0; j < x.rows(); ++j) {
-    correlations_with_training(out.scaled.row(j), correlation);
-    out.mean(j) = mean_from_correlations(correlation.data());
-    correlations.col(j) = correlation.matrix();
-  }
+  Eigen::MatrixXd correlations;
+  means_and_correlations(out.scaled, out.mean, &correlations);
   out.whitened.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * correlations;
   return out;
 }

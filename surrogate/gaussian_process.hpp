@@ -203,6 +203,9 @@ class GaussianProcess final : public FrictionModel {
   // for the interval or the gradient must not change μ by a single bit (an explicit meso run and its
   // twin would part ways). Not inlined, so that every caller runs the same instructions.
   [[gnu::noinline]] double mean_from_correlations(const double* correlation) const;
+  // μ of each scaled row (mean_from_correlations) and, unless null, its correlations as column b.
+  void means_and_correlations(const Eigen::MatrixXd& scaled, Eigen::Ref<Eigen::VectorXd> mean,
+                              Eigen::MatrixXd* correlations) const;
   // For each column k_b of a few kernel vectors, reading each row of L⁻¹ once: |L⁻¹ k_b|² (row 0)
   // and, with an estimated mean, uᵀ L⁻¹ k_b = 1ᵀK⁻¹k_b (row 1; 0 otherwise).
   Eigen::Matrix<double, 2, Eigen::Dynamic> norms_row_by_row(const Eigen::MatrixXd& kernels, int max_threads) const;
