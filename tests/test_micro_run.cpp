@@ -102,6 +102,31 @@ TEST(Scene, ShippedScenesStateTheBuiltInDefaultsExceptTheirDeclaredChoices) {
   }
 }
 
+// The Ti6Al4V scene states its source's material table (Ducobu, Pantale & Lauwers, Article.tex at
+// pantale/CIRP-2022-paper 0d1f901, Table tab:prop: Seo et al. 2005's Johnson-Cook set and the
+// properties at 293 K), typed here from the table, and reads like any scene. Its interface law is
+// Childs' (the calibration campaign's, campaigns/ti6al4v_tin/run.sh).
+TEST(Scene, TheTi6Al4VSceneHoldsItsSourcesMaterialTable) {
+  const std::string file = std::string(MUFRIC_SOURCE_DIR) + "/micro/scene/ti6al4v_tin.json";
+  const Scene scene = parse_scene(read_scene_json(file), file);
+  const auto& jc = scene.material;
+  EXPECT_DOUBLE_EQ(jc.youngs_modulus, 113.8e9);
+  EXPECT_DOUBLE_EQ(jc.poisson_ratio, 0.34);
+  EXPECT_DOUBLE_EQ(jc.density, 4430.0);
+  EXPECT_DOUBLE_EQ(jc.a, 997.9e6);
+  EXPECT_DOUBLE_EQ(jc.b, 653.1e6);
+  EXPECT_DOUBLE_EQ(jc.c, 0.0198);
+  EXPECT_DOUBLE_EQ(jc.m, 0.7);
+  EXPECT_DOUBLE_EQ(jc.n, 0.45);
+  EXPECT_DOUBLE_EQ(jc.reference_strain_rate, 1.0);
+  EXPECT_DOUBLE_EQ(jc.transition_temperature, 293.0);
+  EXPECT_DOUBLE_EQ(jc.melting_temperature, 1873.0);
+  EXPECT_DOUBLE_EQ(jc.specific_heat, 531.0);
+  EXPECT_DOUBLE_EQ(scene.conductivity, 6.3);
+  EXPECT_EQ(scene.contact_interface.law->name(), "childs");
+  EXPECT_TRUE(scene.warnings.empty());
+}
+
 // Each known input with a scene key sets that key to its SI value to the last bit (the awkward
 // doubles too: %.17g reads back exactly), through the scene's own reader, so the key's checks apply
 // (a pressure above the physical range is refused naming the key); an input without a scene key is

@@ -11,13 +11,5 @@
 # widest. Then: bash campaigns/dry_default/train.sh (the shipped model, committed with db.h5).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-mufric=${MUFRIC:-$here/../../build/app/mufric}
-jobs=${JOBS:-1}
-plan=$here/plan.h5
-db=$here/db.h5
-if [[ ! -f $plan ]]; then
-  "$mufric" dataset plan --out "$plan" --samples 256 --design sobol --seed 1 \
-    --p 300MPa:3100MPa --v 1m/min:2000m/min --T 25C:900C
-fi
-# One thread per sample: the draws of a sample run one after the other, samples side by side.
-OMP_NUM_THREADS=1 exec "$mufric" dataset run --plan "$plan" --db "$db" --jobs "$jobs" --threads 1 --sample-timeout 900
+exec bash "$here/../run_plan.sh" "$here/plan.h5" "$here/db.h5" 900 -- \
+  --samples 256 --design sobol --seed 1 --p 300MPa:3100MPa --v 1m/min:2000m/min --T 25C:900C

@@ -8,13 +8,8 @@
 #   nohup bash campaigns/recovery_childs/measure.sh > measure.log 2>&1 &      # one core
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-mufric=${MUFRIC:-$here/../../build/app/mufric}
-plan=$here/measure-plan.h5
-db=$here/measure-db.h5
-if [[ ! -f $plan ]]; then
-  "$mufric" dataset plan --out "$plan" --samples 8 --design sobol --seed 7 \
-    --p 300MPa:1300MPa --v 22.5m/min:200m/min --T 25C:900C \
-    --set contact.law=childs --set contact.adhesive_coefficient=0.5 --set contact.shear_factor=0.55 \
-    --set contact.childs_exponent=1
-fi
-OMP_NUM_THREADS=1 exec "$mufric" dataset run --plan "$plan" --db "$db" --jobs 1 --threads 1 --sample-timeout 1800
+exec bash "$here/../run_plan.sh" "$here/measure-plan.h5" "$here/measure-db.h5" 1800 -- \
+  --samples 8 --design sobol --seed 7 \
+  --p 300MPa:1300MPa --v 22.5m/min:200m/min --T 25C:900C \
+  --set contact.law=childs --set contact.adhesive_coefficient=0.5 --set contact.shear_factor=0.55 \
+  --set contact.childs_exponent=1

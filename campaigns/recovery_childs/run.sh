@@ -8,15 +8,8 @@
 #   nohup bash campaigns/recovery_childs/run.sh > recovery.log 2>&1 &     # one core, one free for builds
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-mufric=${MUFRIC:-$here/../../build/app/mufric}
-jobs=${JOBS:-1}
-plan=$here/plan.h5
-db=$here/db.h5
-if [[ ! -f $plan ]]; then
-  "$mufric" dataset plan --out "$plan" --samples 64 --design sobol --seed 1 \
-    --p 300MPa:1300MPa --v 22.5m/min:200m/min --T 25C:900C --shear-factor 0.2:0.9 \
-    --set contact.law=childs --set contact.adhesive_coefficient=0.5 --set contact.shear_factor=0.5 \
-    --set contact.childs_exponent=1
-fi
-# One thread per sample: the draws of a sample run one after the other.
-OMP_NUM_THREADS=1 exec "$mufric" dataset run --plan "$plan" --db "$db" --jobs "$jobs" --threads 1 --sample-timeout 1800
+exec bash "$here/../run_plan.sh" "$here/plan.h5" "$here/db.h5" 1800 -- \
+  --samples 64 --design sobol --seed 1 \
+  --p 300MPa:1300MPa --v 22.5m/min:200m/min --T 25C:900C --shear-factor 0.2:0.9 \
+  --set contact.law=childs --set contact.adhesive_coefficient=0.5 --set contact.shear_factor=0.5 \
+  --set contact.childs_exponent=1
