@@ -150,14 +150,18 @@ bool computed_in_user_space(const ChildActivity& before, const ChildActivity& no
 
 // One child: fork, run the rewrite, read its message until it exits, is out of time or stalls.
 ChildOutcome run_child(const std::string& original, const std::string& copy_path, const Rewrite& rewrite,
-                       const IsolationLimits& limits, const std::function<Error(const std::string&)>& fail) {
+                       const IsolationLimits& limits, const std::function<std::string(const std::string&)>& fail) {
   int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) throw fail(std::string("cannot create a pipe to check it: ") + std::strerror(errno));
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
+    throw CheckerUnavailable(fail(std::string("cannot create a pipe to check it: ") + std::strerror(errno) +
+                                  " (not the file's fault: try again)"));
+  }
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]);
     ::close(fds[1]);
-    throw fail(std::string("cannot fork a process to check it: ") + std::strerror(errno));
+    throw CheckerUnavailable(fail(std::string("cannot fork a process to check it: ") + std::strerror(errno) +
+                                  " (not the file's fault: try again)"));
   }
   if (pid == 0) {
     ::close(fds[0]);
@@ -209,33 +213,34 @@ ChildOutcome run_child(const std::string& original, const std::string& copy_path
 
 IsolatedCopy rewrite_in_child(const std::string& original, const std::string& what, const Rewrite& rewrite,
                               const IsolationLimits& limits) {
-  const auto fail = [&](const std::string& reason) -> Error { return Error(what + " '" + original + "': " + reason); };
+  const auto fail = [&](const std::string& reason) { return what + " '" + original + "': " + reason; };
   IsolatedCopy copy(unique_copy_path());
   ChildOutcome outcome;
   for (int attempt = 1;; ++attempt) {
     outcome = run_child(original, copy.path(), rewrite, limits, fail);
     if (outcome.end != ChildEnd::stalled) break;
     if (attempt == kForkAttempts) {
-      throw fail("the checking process waited without progress in " + std::to_string(kForkAttempts) +
-                 " attempts (a lock held by another thread when it was forked); refused for now");
+      throw CheckerUnavailable(fail("the checking process waited without progress in " + std::to_string(kForkAttempts) +
+                                    " attempts: it was forked while another thread of this process held a lock it "
+                                    "needs (not the file's fault; not checked, try again)"));
     }
   }
   if (outcome.end == ChildEnd::timed_out) {
-    throw fail("parsing it did not finish within " + std::to_string(static_cast<int>(limits.seconds)) +
-               " s (a corrupt file can make the HDF5 library loop); refused");
+    throw Error(fail("parsing it did not finish within " + std::to_string(static_cast<int>(limits.seconds)) +
+               " s (a corrupt file can make the HDF5 library loop); refused"));
   }
   const int status = outcome.status;
   if (WIFSIGNALED(status)) {
     const int signal = WTERMSIG(status);
-    throw fail("parsing it crashed (signal " + std::to_string(signal) + ", " +
-               ::strsignal(signal) + "): the file is corrupt; refused");
+    throw Error(fail("parsing it crashed (signal " + std::to_string(signal) + ", " + ::strsignal(signal) +
+                     "): the file is corrupt; refused"));
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     std::string message = outcome.message;
     if (message.empty()) message = "parsing it failed (exit status " + std::to_string(WEXITSTATUS(status)) + ")";
     throw Error(message);  // the child's own message already names the file
   }
-  if (!std::filesystem::exists(copy.path())) throw fail("the checking process wrote no copy");
+  if (!std::filesystem::exists(copy.path())) throw Error(fail("the checking process wrote no copy"));
   return copy;
 }
 

@@ -8,7 +8,16 @@
 #include <functional>
 #include <string>
 
+#include "common/error.hpp"
+
 namespace mufric {
+
+// The check could not be made (no process could be forked, or the child stalled on a lock it
+// inherited): nothing is known about the file, so a caller that refuses it should try again later.
+class CheckerUnavailable : public Error {
+ public:
+  using Error::Error;
+};
 
 struct IsolationLimits {
   double seconds = 60.0;                           // wall time before the child is killed
@@ -36,7 +45,7 @@ using Rewrite = std::function<void(const std::string& original, const std::strin
 // accepted to `copy`. Throws Error "<what> '<original>': <reason>" when the child throws (its message
 // is passed on as it is), crashes (the signal is named), runs out of time or memory, or writes
 // nothing. A child that sleeps without progress (a lock inherited locked at fork) is forked again,
-// a few times at most. Only for processes that may fork (the CLI, the server), not inside a meso code.
+// a few times at most; then, as when no child can be forked, CheckerUnavailable says so. Only for processes that may fork (the CLI, the server), not inside a meso code.
 IsolatedCopy rewrite_in_child(const std::string& original, const std::string& what, const Rewrite& rewrite,
                               const IsolationLimits& limits = {});
 

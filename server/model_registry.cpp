@@ -7,6 +7,7 @@
 
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
+#include "common/isolation.hpp"
 #include "surrogate/model_file.hpp"
 
 namespace mufric::server {
@@ -68,6 +69,14 @@ int ModelRegistry::refresh(Rescan rescan) {
       if (const std::string why = servable_inputs_violation(input_names(served->model->inputs())); !why.empty()) {
         throw Error("not served: " + why);
       }
+    } catch (const CheckerUnavailable& e) {
+      // Nothing is known of the file: forget it was seen, so that the next scan (the poller's, or a
+      // SIGHUP's) checks it again.
+      log_("warning", "could not check model file " + entry.path().string() + ": " + e.what() +
+                          " (retried at the next scan; the previous version, if any, keeps serving)");
+      std::lock_guard lock(mutex_);
+      seen_.erase(name);
+      continue;
     } catch (const std::exception& e) {
       log_("warning", "refused model file " + entry.path().string() + ": " + e.what() +
                           " (the previous version, if any, keeps serving)");

@@ -106,9 +106,7 @@ CalibratedPrediction CalibratedModel::predict(const QueryBatch& x, int max_threa
 }
 
 IntervalParts CalibratedModel::parts_at(const Eigen::RowVectorXd& x) const {
-  // On the calling thread: the constructor calls this, and a model is also read in a forked child
-  // (load_model_isolated), where an OpenMP team inherited from a threaded parent never starts.
-  const CalibratedPrediction p = predict(x, 1);
+  const CalibratedPrediction p = predict(x);
   return {p.mean(0), p.sd(0), p.parameter_sd(0), p.conditional_sd(0), p.emulator_sd(0), p.discrepancy_sd(0)};
 }
 

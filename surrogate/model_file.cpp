@@ -10,6 +10,8 @@
 #include <limits>
 #include <memory>
 
+#include <omp.h>
+
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "common/isolation.hpp"
@@ -183,6 +185,10 @@ std::unique_ptr<FrictionModel> load_model(const std::string& path) {
 
 std::unique_ptr<FrictionModel> load_model_isolated(const std::string& path, const IsolationLimits& limits) {
   const IsolatedCopy copy = rewrite_in_child(path, "model", [](const std::string& original, const std::string& rewritten) {
+    // The child of a threaded parent runs on one thread: an OpenMP team there would wait for the
+    // parent's pool threads, which fork() does not copy (libgomp is not fork-safe), so a model kind
+    // that evaluates while it loads (a calibrated model's likelihood factors) would stall.
+    omp_set_num_threads(1);
     save_model(rewritten, *load_model(original));
   }, limits);
   return load_model(copy.path());

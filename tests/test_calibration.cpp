@@ -4,6 +4,7 @@
 // the refusals that name what is wrong.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -578,6 +579,31 @@ TEST(CalibratedModel, ItsFileAndFastEvaluatorGiveBackWhatItServes) {
   EXPECT_NE(error_of([&] { CalibratedModel(c.emulator, c.data, {"shear_factor"}, {"temperature"}, true, c.samples, {}); })
                 .find("temperature"),
             std::string::npos);
+}
+
+// A server loads a first calibrated model in its own process (an OpenMP team of two starts there),
+// then forks to check a second: the child must not wait for the parent's team threads, which the fork
+// did not copy (issue 63: "waited without progress in 3 attempts", both files refused at every start).
+TEST(CalibratedModel, LoadsInAnIsolatedChildAfterTheParentRanAnOpenMPTeam) {
+  const SmallCalibration c;
+  const std::string path = (std::filesystem::temp_directory_path() / ("mufric-calibrated-fork-" + std::to_string(::getpid()) + ".h5")).string();
+  save_model(path, c.model());
+  std::atomic<int> members{0};
+#pragma omp parallel num_threads(2)
+  members.fetch_add(1);
+  ASSERT_EQ(members.load(), 2);
+  // The team is alive (its threads idle in the pool) when the next fork comes.
+  const std::unique_ptr<FrictionModel> first = load_model(path);
+  IsolationLimits limits;
+  limits.seconds = 60;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    std::unique_ptr<FrictionModel> second;
+    EXPECT_NO_THROW(second = load_model_isolated(path, limits)) << "attempt " << attempt;
+    if (second) {
+      EXPECT_EQ(second->kind(), "calibrated");
+    }
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -1095,6 +1095,9 @@ TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration)
   record.data_source = "six synthetic rows";
   record.posterior = result.summary;
   save_model((dir_ / "calibrated.h5").string(), CalibratedModel(emulator, data, {"shear_factor"}, {}, false, result.samples, record));
+  // A second calibrated model in the folder at start: it is checked in a child forked after the first
+  // was loaded (and its OpenMP team started) in the server's process (issue 63).
+  std::filesystem::copy_file(dir_ / "calibrated.h5", dir_ / "calibrated_copy.h5");
 
   LoopbackServer server(dir_);
   const Points pts = random_points(200);
@@ -1110,6 +1113,7 @@ TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration)
     EXPECT_EQ(a.std, local.std);
     EXPECT_EQ(a.hi, local.hi);
   }
+  EXPECT_EQ(client::connect("grpc://" + server.address() + "/calibrated_copy")->evaluate(pts.block(), what).mu, local.mu);
   mufric_client* c = nullptr;
   ASSERT_EQ(mufric_open(("grpc://" + server.address() + "/calibrated").c_str(), &c), MUFRIC_OK) << mufric_last_error();
   std::vector<double> mu(200);
