@@ -15,6 +15,7 @@
 #include "common/units.hpp"
 #include "surrogate/calibrated_model.hpp"
 #include "surrogate/calibration.hpp"
+#include "surrogate/calibration_workflow.hpp"
 #include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/model_file.hpp"
 
@@ -22,16 +23,20 @@ namespace mufric::app {
 namespace {
 
 struct CalibrateOptions {
-  std::string model, data, priors, out, model_out;
+  std::string model, out, model_out;
+  CalibrationRequest request;
   // The tolerances a request asks by default (EvaluationRequest), so that the grid answers it.
   double fast_mu_tolerance = EvaluationRequest{}.mu_tolerance, fast_std_tolerance = EvaluationRequest{}.std_relative_tolerance;
   // The grid's work budget in the GP's multiply-adds (CalibratedModel::exact_point_work): about 5
   // minutes of one core (1e10 per second).
   double fast_max_gigawork = 3000.0;
   bool no_fast_evaluator = false;
-  std::vector<std::string> parameters, fixed;
-  bool discrepancy = false;
-  EnsembleOptions sampler;
+  EnsembleOptions sampler = [] {
+    EnsembleOptions o;
+    o.max_steps = 40000;
+    return o;
+  }();
+  bool automatic_walkers = true;  // --walkers not given: at least four per coordinate
 };
 
 std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
@@ -45,56 +50,66 @@ std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
   return std::shared_ptr<const GaussianProcess>(gp);
 }
 
-// --fix NAME=VALUE: the input held at one value, as a condition every measurement shares; its name.
-std::string fix_input(Measurements& data, const std::string& assignment) {
-  const auto equals = assignment.find('=');
-  if (equals == std::string::npos) throw Error("--fix '" + assignment + "': give NAME=VALUE, e.g. adhesive_coefficient=0.35");
-  const std::string name = assignment.substr(0, equals);
-  const KnownInput* known = find_known_input(name);
-  if (known == nullptr) throw Error("--fix '" + assignment + "': '" + name + "' is not a model input");
-  if (std::find(data.condition_names.begin(), data.condition_names.end(), name) != data.condition_names.end()) {
-    throw Error("--fix '" + assignment + "': the measurements already give " + name);
+// The kind of quantity of each posterior coordinate (for printing it in its human unit).
+QuantityKind coordinate_kind(const CalibrationProblem& problem, Eigen::Index j) {
+  if (j < problem.parameter_count()) return kind_of_input(problem.parameters()[static_cast<size_t>(j)]);
+  if (j >= problem.latent_offset()) {
+    const Eigen::Index condition = problem.latent_cells()[static_cast<size_t>(j - problem.latent_offset())].second;
+    return kind_of_input(problem.data().condition_names[static_cast<size_t>(condition)]);
   }
-  const double value = parse_quantity(assignment.substr(equals + 1), known->kind, "--fix " + name);
-  data.condition_names.push_back(name);
-  data.conditions.conservativeResize(Eigen::NoChange, data.conditions.cols() + 1);
-  data.conditions.col(data.conditions.cols() - 1).setConstant(value);
-  return name;
+  return QuantityKind::dimensionless;
 }
 
-// Every input of the model that the measurements do not give.
-std::vector<std::string> unmeasured_inputs(const GaussianProcess& model, const Measurements& data) {
-  std::vector<std::string> names;
-  for (const InputSpec& input : model.inputs()) {
-    if (std::find(data.condition_names.begin(), data.condition_names.end(), input.name) == data.condition_names.end()) {
-      names.push_back(input.name);
-    }
+std::string human(double value_si, QuantityKind kind) {
+  if (kind == QuantityKind::dimensionless) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value_si);
+    return text;
   }
-  return names;
+  return format_human(value_si, kind);
+}
+
+std::string human_difference(double value_si, QuantityKind kind) {
+  if (kind == QuantityKind::temperature) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g K", value_si);
+    return text;
+  }
+  return human(value_si, kind);
 }
 
 void print_summary(const CalibrationProblem& problem, const CalibrationResult& result, double seconds) {
-  std::printf("%-26s %10s %10s %23s %8s %8s\n", "parameter", "mean", "sd", "95 % credible interval", "split-R^", "ESS");
-  for (const ParameterSummary& s : result.summary) {
-    char interval[64];
-    std::snprintf(interval, sizeof interval, "%.4g .. %.4g", s.lo95, s.hi95);
-    std::printf("%-26s %10.4g %10.4g %23s %8.3f %8.0f\n", s.name.c_str(), s.mean, s.sd, interval, s.split_rhat,
-                s.effective_sample_size);
+  std::printf("%-40s %12s %12s %27s %9s %7s\n", "parameter", "mean", "sd", "95 % credible interval", "split-R^", "ESS");
+  for (size_t j = 0; j < result.summary.size(); ++j) {
+    const ParameterSummary& s = result.summary[j];
+    const QuantityKind kind = coordinate_kind(problem, static_cast<Eigen::Index>(j));
+    const std::string interval = human(s.lo95, kind) + " .. " + human(s.hi95, kind);
+    std::printf("%-40s %12s %12s %27s %9.4f %7.0f\n", s.name.c_str(), human(s.mean, kind).c_str(),
+                human_difference(s.sd, kind).c_str(), interval.c_str(), s.split_rhat, s.effective_sample_size);
   }
   std::printf("%d walkers x %d steps after %d burn-in, seed %llu; acceptance %.2f; %.1f s\n", result.options.walkers,
               result.options.steps, result.options.burn_in_steps, static_cast<unsigned long long>(result.options.seed),
               result.acceptance, seconds);
+  std::printf("how to read it: split-R^ compares each walker's two halves and the walkers with each other (1 when they agree; "
+              "used only at <= %.2f); ESS is the number of independent samples the chains are worth (used only at >= %.0f); "
+              "acceptance is the share of proposed moves taken (0.2-0.5 is usual for this sampler; near 0, the walkers are stuck)\n",
+              kMaximumSplitRhat, kMinimumEffectiveSamples);
   if (problem.discrepancy()) {
     std::printf("discrepancy_amplitude in mu units, discrepancy_length_scale in widths of the model's box\n");
+  }
+  if (problem.bias_count() > 0) std::printf("bias[set]: what that data set measures above the others, mu units\n");
+  if (problem.latent_count() > 0) {
+    std::printf("the rows' conditions given with an uncertainty: what the data imply of them (their prior: the stated SD or range)\n");
   }
 }
 
 void write_posterior(const std::string& path, const CalibrationProblem& problem, const CalibrationResult& result,
                      const CalibrateOptions& o) {
   std::ostringstream text;
-  text << "# posterior samples of mufric calibrate (every walker's kept states, natural units)\n";
-  text << "# model " << o.model << ", measurements " << o.data << (o.priors.empty() ? "" : ", priors " + o.priors)
-       << ", seed " << o.sampler.seed << "\n";
+  text << "# posterior samples of mufric calibrate (every walker's kept states, natural units: SI for inputs and conditions)\n";
+  text << "# model " << o.model << ", measurements";
+  for (const std::string& data : o.request.data_files) text << " " << data;
+  text << (o.request.priors_file.empty() ? "" : ", priors " + o.request.priors_file) << ", seed " << o.sampler.seed << "\n";
   const auto& names = problem.coordinate_names();
   for (size_t j = 0; j < names.size(); ++j) text << (j ? "," : "") << names[j];
   text << "\n";
@@ -109,94 +124,83 @@ void write_posterior(const std::string& path, const CalibrationProblem& problem,
   write_file_atomically(path, text.str());
 }
 
-// The measurement file's name and its '#' provenance lines, for the calibrated model's record.
-std::string measurement_source(const std::string& path) {
-  std::string source = path;
-  std::istringstream lines(read_whole_file(path).value_or(""));
-  for (std::string line; std::getline(lines, line);) {
-    if (line.rfind('#', 0) == 0) source += "; " + line.substr(line.find_first_not_of("# ") == std::string::npos ? line.size() : line.find_first_not_of("# "));
-  }
-  return source;
-}
-
-std::string priors_text(const CalibrationProblem& problem, const CalibrationPriors& priors) {
-  std::string text;
-  for (Eigen::Index k = 0; k < problem.parameter_count(); ++k) {
-    text += (k ? "; " : "") + problem.coordinate_names()[static_cast<size_t>(k)] + " " + problem.prior_of(k).describe();
-  }
-  if (priors.discrepancy) {
-    text += "; discrepancy_amplitude " + priors.discrepancy_amplitude.describe() + "; discrepancy_length_scale " +
-            priors.discrepancy_length_scale.describe();
-  }
-  return text;
-}
-
 // The calibrated model: served like any other, with a fast evaluator certified against it.
-void write_calibrated_model(const CalibrateOptions& o, const std::shared_ptr<const GaussianProcess>& emulator,
-                            const Measurements& data, const std::vector<std::string>& parameters,
-                            const std::vector<std::string>& held,
-                            const CalibrationProblem& problem, const CalibrationPriors& priors, const CalibrationResult& result) {
-  CalibrationRecord record{.data_source = measurement_source(o.data),
-                           .priors = priors_text(problem, priors),
-                           .posterior = result.summary,
-                           .walkers = o.sampler.walkers,
-                           .steps = o.sampler.steps,
-                           .burn_in_steps = o.sampler.burn_in_steps,
-                           .seed = static_cast<unsigned long long>(o.sampler.seed),
-                           .acceptance = result.acceptance};
-  CalibratedModel model(emulator, data, parameters, held, priors.discrepancy, result.samples, std::move(record));
-  model.set_default_extrapolation(emulator->default_extrapolation());
-  model.set_mu_range(emulator->mu_min(), emulator->mu_max());
+void write_calibrated_model(const CalibrateOptions& o, const CalibrationSetup& setup, const CalibrationResult& result) {
+  CalibratedModel model = calibrated_model(setup, result);
   FastEvaluatorOptions fast;
   fast.mu_tolerance = o.fast_mu_tolerance;
   fast.std_relative_tolerance = o.fast_std_tolerance;
   fast.max_work = o.fast_max_gigawork * 1e9;
   fast.progress = [](const std::string& line) { std::fprintf(stderr, "calibrate: fast evaluator: %s\n", line.c_str()); };
-  try {
-    if (o.no_fast_evaluator) throw FastEvaluatorOverCap("--no-fast-evaluator");
-    std::fprintf(stderr, "calibrate: fast evaluator: building within %.3g G multiply-adds (--fast-max-work; %.3g M a point)\n",
-                 o.fast_max_gigawork, model.exact_point_work() / 1e6);
-    model.attach_fast_evaluator(std::make_shared<const FastEvaluator>(
-        build_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, fast)));
-    if (!model.fast_evaluator()->stop_reason().empty()) {
-      std::printf("fast evaluator stopped before the tolerances (%s): requests asking for more use the exact model\n",
-                  model.fast_evaluator()->stop_reason().c_str());
+  if (o.no_fast_evaluator) {
+    std::printf("no fast evaluator (--no-fast-evaluator): the exact posterior predictive answers\n");
+  } else {
+    try {
+      std::fprintf(stderr, "calibrate: fast evaluator: building within %.3g G multiply-adds (--fast-max-work; %.3g M a point)\n",
+                   o.fast_max_gigawork, model.exact_point_work() / 1e6);
+      auto grid = std::make_shared<const FastEvaluator>(
+          build_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, fast));
+      if (const std::string refusal = short_grid_refusal(*grid, fast); !refusal.empty()) {
+        std::printf("fast evaluator not stored (%s; %s): the exact posterior predictive answers\n", grid->stop_reason().c_str(),
+                    refusal.c_str());
+      } else {
+        if (!grid->stop_reason().empty()) {
+          std::printf("fast evaluator stopped before the tolerances (%s) at mu within %.3g, std within %.3g relative: requests "
+                      "that ask no more use it, the others the exact model\n",
+                      grid->stop_reason().c_str(), grid->bounds().mu_absolute, grid->bounds().std_relative);
+        }
+        model.attach_fast_evaluator(std::move(grid));
+      }
+    } catch (const FastEvaluatorOverCap& e) {
+      std::printf("no fast evaluator (%s): the exact posterior predictive answers\n", e.what());
     }
-  } catch (const FastEvaluatorOverCap& e) {
-    std::printf("no fast evaluator (%s): the exact posterior predictive answers\n", e.what());
   }
   save_model(o.model_out, model);
   const IntervalParts& c = model.centre_parts();
   std::printf("wrote %s (calibrated model of", o.model_out.c_str());
   for (const InputSpec& input : model.inputs()) std::printf(" %s", input.name.c_str());
   std::printf(")\nat the box centre: mu %.4g, sd %.3g = sqrt(law coefficients %.3g^2 + given them %.3g^2); "
-              "alone: roughness mean %.3g, discrepancy %.3g\n",
+              "alone: roughness mean %.3g, discrepancy %.3g (parts alone need not add up: given the data, what one "
+              "explains the other need not)\n",
               c.mu, c.sd, c.parameter_sd, c.conditional_sd, c.emulator_sd, c.discrepancy_sd);
 }
 
 void calibrate_command(const CalibrateOptions& o) {
-  const auto emulator = load_emulator(o.model);
-  Measurements data = read_measurements(o.data);
-  std::vector<std::string> held;
-  for (const std::string& assignment : o.fixed) held.push_back(fix_input(data, assignment));
-  CalibrationPriors priors;
-  if (!o.priors.empty()) {
-    const std::optional<std::string> text = read_whole_file(o.priors);
-    if (!text) throw Error("--priors " + o.priors + ": cannot be read");
-    priors = parse_calibration_priors(*text, o.priors);
+  const CalibrationSetup setup = prepare_calibration(load_emulator(o.model), o.request);
+  const CalibrationProblem& problem = *setup.problem;
+  for (const std::string& warning : setup.warnings) std::printf("warning: %s\n", warning.c_str());
+  std::printf("calibrating %lld coefficient(s) against %lld measurements in %zu data set(s), discrepancy %s",
+              static_cast<long long>(problem.parameter_count()), static_cast<long long>(problem.data().rows()),
+              problem.data().data_sets.size(), problem.discrepancy() ? "on" : "off");
+  if (problem.latent_count() > 0) {
+    std::printf(", %lld conditions with their uncertainty", static_cast<long long>(problem.latent_count()));
   }
-  if (o.discrepancy) priors.discrepancy = true;
-  const std::vector<std::string> parameters = o.parameters.empty() ? unmeasured_inputs(*emulator, data) : o.parameters;
-  const CalibrationProblem problem(emulator, data, parameters, priors);
-  std::printf("calibrating %zu coefficient(s) against %lld measurements (%s), discrepancy %s\n", parameters.size(),
-              static_cast<long long>(data.mu.size()), o.data.c_str(), priors.discrepancy ? "on" : "off");
+  std::printf("\n");
   for (Eigen::Index k = 0; k < problem.parameter_count(); ++k) {
-    std::printf("  prior of %s: %s\n", parameters[static_cast<size_t>(k)].c_str(), problem.prior_of(k).describe().c_str());
+    const std::string& name = problem.parameters()[static_cast<size_t>(k)];
+    std::printf("  prior of %s: %s\n", name.c_str(), problem.prior_of(k).describe(kind_of_input(name)).c_str());
+  }
+  for (const auto& [name, value] : problem.held()) {
+    std::printf("  held: %s = %s\n", name.c_str(), human(value, kind_of_input(name)).c_str());
+  }
+  for (const auto& [set, prior] : problem.priors().biases) {
+    std::printf("  bias of data set %s: %s\n", set.c_str(), prior.describe().c_str());
   }
   std::fflush(stdout);
+  EnsembleOptions sampler = o.sampler;
+  // Walkers: four per coordinate (the stretch move needs more than two, and mixes better with more).
+  if (o.automatic_walkers) sampler.walkers = std::max(sampler.walkers, static_cast<int>(4 * problem.dimension()));
+  if (sampler.walkers < 2 * problem.dimension() + 2) {
+    throw Error("--walkers " + std::to_string(sampler.walkers) + ": the posterior has " + std::to_string(problem.dimension()) +
+                " coordinates; give at least " + std::to_string(2 * problem.dimension() + 2) + " walkers");
+  }
   const auto started = std::chrono::steady_clock::now();
-  int reported = 0;
-  const CalibrationResult result = calibrate(problem, o.sampler, [&reported](int done, int total) {
+  int reported = 0, run = 0;
+  const CalibrationResult result = calibrate(problem, sampler, [&](int done, int total) {
+    if (done == 1) {
+      reported = 0;
+      if (run++ > 0) std::fprintf(stderr, "calibrate: not yet within the limits: running on for %d steps\n", total);
+    }
     const int tenth = done * 10 / total;
     if (tenth > reported) {
       reported = tenth;
@@ -205,6 +209,7 @@ void calibrate_command(const CalibrateOptions& o) {
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   print_summary(problem, result, seconds);
+  std::fflush(stdout);
   if (!result.convergence_failure.empty()) {
     throw Error("the posterior is not usable, nothing written: " + result.convergence_failure);
   }
@@ -212,7 +217,7 @@ void calibrate_command(const CalibrateOptions& o) {
     write_posterior(o.out, problem, result, o);
     std::printf("wrote %s (%lld samples)\n", o.out.c_str(), static_cast<long long>(result.samples.rows()));
   }
-  if (!o.model_out.empty()) write_calibrated_model(o, emulator, data, parameters, held, problem, priors, result);
+  if (!o.model_out.empty()) write_calibrated_model(o, setup, result);
 }
 
 }  // namespace
@@ -225,30 +230,41 @@ void add_calibrate_command(CLI::App& app) {
                   "GP model of a campaign whose inputs are the measurements' conditions and the law's coefficients\n"
                   "(a plan with e.g. --shear-factor 0.2:0.9, run and trained)")
       ->required();
-  cmd->add_option("--data", o->data,
+  cmd->add_option("--data", o->request.data_files,
                   "Measurements: CSV with the conditions as columns with units, mu and mu_sd (the measurement's\n"
-                  "standard deviation), e.g. contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd")
+                  "standard deviation), e.g. contact_pressure[MPa],sliding_velocity[m/min],temperature[C],mu,mu_sd;\n"
+                  "a condition known only within an uncertainty adds temperature_sd[C] (normal) or temperature_min[C]\n"
+                  "and temperature_max[C] (a range). Repeatable: each file is a data set (named by its stem), which the\n"
+                  "priors file may give a bias of its own (\"data_sets\": {\"NAME\": {\"bias\": {\"normal\": [0, 0.1]}}})")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--calibrate", o->parameters,
-                  "The model inputs to calibrate (default: every input the measurements do not give)")
+  cmd->add_option("--calibrate", o->request.calibrated,
+                  "The law coefficients to calibrate (default: every coefficient of the model the measurements do not\n"
+                  "give and --fix does not hold; a condition the measurements lack is an error, not calibrated)")
       ->delimiter(',');
-  cmd->add_option("--fix", o->fixed,
+  cmd->add_option("--fix", o->request.fixed,
                   "Hold a model input at one value instead of calibrating it, e.g. --fix adhesive_coefficient=0.35\n"
                   "(repeatable; for coefficients the data cannot tell apart, which calibrate refuses to sample)");
-  cmd->add_option("--priors", o->priors,
+  cmd->add_option("--priors", o->request.priors_file,
                   "Priors (JSON): {\"parameters\": {\"shear_factor\": {\"uniform\": [0.2, 0.9]}},\n"
                   "\"discrepancy\": {\"enabled\": true, \"amplitude\": {\"half_normal\": [0.05]}, \"length_scale\":\n"
-                  "{\"log_normal\": [0.5, 0.7]}}}; priors: uniform [lo, hi], normal [mean, sd], log_normal [median,\n"
-                  "sd of log], half_normal [scale]. Default: uniform over the model's box, no discrepancy")
+                  "{\"log_normal\": [0.5, 0.7]}}, \"data_sets\": {\"tribometer\": {\"bias\": {\"normal\": [0, 0.1]}}}};\n"
+                  "priors: uniform [lo, hi], normal [mean, sd], log_normal [median, sd of log], half_normal [scale], in SI.\n"
+                  "Default: uniform over the model's box, no discrepancy, no bias")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("--discrepancy", o->discrepancy,
+  cmd->add_flag("--discrepancy", o->request.discrepancy,
                 "Add the model discrepancy delta(x), a zero-mean GP over the conditions (Kennedy & O'Hagan 2001)");
-  cmd->add_option("--walkers", o->sampler.walkers, "Ensemble walkers (Goodman & Weare 2010)")
-      ->capture_default_str()
-      ->check(CLI::Range(4, 100000));
+  cmd->add_option("--walkers", o->sampler.walkers,
+                  "Ensemble walkers (Goodman & Weare 2010); default: 32, or four per posterior coordinate when more")
+      ->check(CLI::Range(4, 100000))
+      ->each([o](const std::string&) { o->automatic_walkers = false; });
   cmd->add_option("--burn-in", o->sampler.burn_in_steps, "Steps discarded")->capture_default_str()->check(CLI::Range(0, 10000000));
   cmd->add_option("--steps", o->sampler.steps, "Steps kept")->capture_default_str()->check(CLI::Range(4, 10000000));
+  cmd->add_option("--max-steps", o->sampler.max_steps,
+                  "A run not yet within the limits goes on, its length doubling, up to this many steps in all, and is\n"
+                  "judged on its latest run (0: never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000000));
   cmd->add_option("--seed", o->sampler.seed, "Seed: the same seed, data and model give the same posterior, bit for bit")
       ->capture_default_str();
   cmd->add_option("--out", o->out, "Write the posterior samples here (CSV, one column per parameter)");
@@ -273,11 +289,14 @@ void add_calibrate_command(CLI::App& app) {
                 "Write the calibrated model without its grid: the exact posterior predictive answers every request\n"
                 "(slower per point; the grid takes seconds to minutes to certify)");
   cmd->footer(
-      "y_i = mu(x_i, theta) + delta(x_i) + eps_i: the GP's interval of the mean, the measurement's SD and\n"
-      "(with --discrepancy) delta in the likelihood. Prints each parameter's mean, SD, 95 % credible interval,\n"
-      "split-R^ and effective sample size; exit status 2, naming the parameter and the cause, when the chains\n"
-      "fail the limits (split-R^ <= 1.05, ESS >= 400, steps >= 20 autocorrelation times), or a measurement\n"
-      "lies outside the model's box (naming its line).");
+      "y_i = mu(x_i, theta) + delta(x_i) + b_set + eps_i: the GP's interval of the mean, the measurement's SD,\n"
+      "(with --discrepancy) delta and (for a data set given one) its bias in the likelihood; a condition given\n"
+      "with an SD or a range is sampled with the coefficients. Prints each parameter's mean, SD, 95 % credible\n"
+      "interval, split-R^ and effective sample size, with how to read them; exit status 2, naming the cause,\n"
+      "when the chains fail the limits (split-R^ <= 1.05, ESS >= 400, steps >= 20 autocorrelation times), a\n"
+      "measurement lies outside the model's box or cannot be friction (naming its line), the data lack a\n"
+      "condition of the model, or the model has no law coefficient. docs/usage.md walks through an example\n"
+      "(examples/calibration/).");
   cmd->callback([o] { calibrate_command(*o); });
 }
 

@@ -126,20 +126,8 @@ struct FastOptions {
   bool skip = false;
 };
 
-// The fast evaluator's default budget, counted in work (multiply-adds of the exact model,
-// exact_point_work), never in seconds: a model file must not depend on how busy the machine was
-// (issue 49: a 900-point model was written without its grid on a loaded machine, with it on an idle
-// one). A grid pays off in proportion to the exact model's cost per point, which grows with n as the
-// fit's does: the budget is about what a fit of n points costs, ~100 likelihood evaluations of
-// ~n³ each, and at least 1e11 (about 10 s of one core here at n = 900, where the grid that holds μ to
-// 1e-6 takes 3-5 s and then answers 100x faster than the exact model; bench/RESULTS.md, "train: fit
-// and fast evaluator against scikit-learn").
-constexpr double kLeastFastEvaluatorWork = 1e11;
-constexpr double kFitLikeEvaluations = 100.0;
 double fast_evaluator_budget(const FastOptions& o, const GaussianProcess& gp) {
-  if (o.max_gigawork > 0.0) return o.max_gigawork * 1e9;
-  const auto n = static_cast<double>(gp.state().x_train.rows());
-  return std::max(kLeastFastEvaluatorWork, kFitLikeEvaluations * n * n * n);
+  return o.max_gigawork > 0.0 ? o.max_gigawork * 1e9 : default_fast_evaluator_work(gp.state().x_train.rows());
 }
 
 void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
@@ -160,15 +148,14 @@ void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
                   "Fast evaluator: work budget in 10^9 multiply-adds of the exact model (about 0.1 s each on one\n"
                   "core with AVX2); a finer grid that would take the build past it is not built. Counted, not timed:\n"
                   "the same data and command give the same file on a busy machine and an idle one\n"
-                  "(default: 100 n^3 for a GP of n points, at least 100)")
+                  "(default: 100 n^3 for a GP of n points, at least 3000)")
       ->check(FiniteRange(kLeastBudget, 1e9));
   cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
 }
 
 // Builds and reports a fast evaluator of `gp` ("model" or "patch scatter" in the messages); null when
-// it cannot reach the tolerances within the budgets. Such a grid is not stored: no default request
-// could use it, and it would only weigh on the file (issue 30: 57.7 MB for a 2-point model). The
-// message says what stopped it and how to build it later.
+// it does not come within short_grid_refusal's factor of the tolerances (the one policy of train,
+// upgrade and calibrate). The message says what stopped it and how to build it later.
 std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess& gp, FastEvaluatorOptions build,
                                                           const std::string& label) {
   build.progress = [label](const std::string& line) {
@@ -188,12 +175,18 @@ std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess&
     return nullptr;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!fast->meets(build.mu_tolerance, build.std_relative_tolerance)) {
-    std::printf("fast evaluator (%s): not stored, built in %.1f s: %s before the tolerances were met; the exact model "
-                "answers every request (a larger --fast-max-work / --fast-max-mb, or looser --fast-*-tolerance, "
-                "with `mufric upgrade --rebuild`)\n",
-                label.c_str(), seconds, fast->stop_reason().c_str());
+  if (const std::string refusal = short_grid_refusal(*fast, build); !refusal.empty()) {
+    std::printf("fast evaluator (%s): not stored, built in %.1f s: %s, %s; the exact model answers every request "
+                "(a larger --fast-max-work / --fast-max-mb, or looser --fast-*-tolerance, with `mufric upgrade --rebuild`)\n",
+                label.c_str(), seconds, fast->stop_reason().c_str(), refusal.c_str());
     return nullptr;
+  }
+  if (!fast->meets(build.mu_tolerance, build.std_relative_tolerance)) {
+    std::printf("fast evaluator (%s): %.1f MB, built in %.1f s; stopped short (%s) at mu within %.3g, std within %.3g "
+                "relative: requests that ask no more use it, the others the exact model\n",
+                label.c_str(), static_cast<double>(fast->grid().bytes()) / 1e6, seconds, fast->stop_reason().c_str(),
+                fast->bounds().mu_absolute, fast->bounds().std_relative);
+    return fast;
   }
   std::printf("fast evaluator (%s): %.1f MB, built in %.1f s; meets the tolerances: it answers default requests inside "
               "the box\n",
@@ -319,8 +312,13 @@ void add_train(CLI::App& app) {
     apply_box_options(gp, o->box);  // before the grid: it tabulates μ as served (clipped to the range)
     attach_fast_evaluator(gp, o->fast);
     save_model(o->out, gp);
-    std::printf("wrote %s (gp, %lld training points) in %.2f s\n", o->out.c_str(),
-                static_cast<long long>(data.x.rows()), report.seconds);
+    const FastEvaluator* fast = gp.fast_evaluator();
+    std::printf("wrote %s (gp, %lld training points) in %.2f s; %s\n", o->out.c_str(),
+                static_cast<long long>(data.x.rows()), report.seconds,
+                fast == nullptr ? "no fast evaluator: the exact GP answers every request (see above why)"
+                : fast->meets(o->fast.build.mu_tolerance, o->fast.build.std_relative_tolerance)
+                    ? "its fast evaluator answers default requests"
+                    : "its fast evaluator stopped short of the tolerances: the exact GP answers requests that ask more");
   });
 }
 

@@ -146,8 +146,14 @@ class InProcessClient final : public FrictionClient {
   }
 
   ModelInfo describe() override {
-    return {path_, "", std::string(model_->kind()), model_->inputs(), model_->has_uncertainty(), model_->summary(),
-            model_->has_patch_scatter()};
+    return {path_,
+            "",
+            std::string(model_->kind()),
+            model_->inputs(),
+            model_->has_uncertainty(),
+            model_->summary(),
+            model_->has_patch_scatter(),
+            model_->calibration_description()};
   }
 
  private:
@@ -259,8 +265,25 @@ class GrpcClient final : public FrictionClient {
     request.set_model(model_);
     mufric::v1::ModelDescription d;
     call("DescribeModel", [&](grpc::ClientContext* context) { return stub_->DescribeModel(context, request, &d); });
-    ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary(), d.has_patch_scatter()};
+    ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary(), d.has_patch_scatter(), std::nullopt};
     for (const auto& input : d.inputs()) info.inputs.push_back({input.name(), input.unit(), input.lo(), input.hi()});
+    if (d.has_calibration()) {
+      const auto& c = d.calibration();
+      CalibrationDescription calibration;
+      calibration.data_source = c.data_source();
+      calibration.measurements = static_cast<long long>(c.measurements());
+      calibration.posterior_samples = static_cast<long long>(c.posterior_samples());
+      calibration.discrepancy = c.discrepancy();
+      for (const auto& p : c.parameters()) calibration.parameters.push_back({p.name(), p.mean(), p.sd(), p.lo95(), p.hi95()});
+      const auto& parts = c.at_box_centre();
+      calibration.mu = parts.mu();
+      calibration.sd = parts.sd();
+      calibration.parameter_sd = parts.parameter_sd();
+      calibration.conditional_sd = parts.conditional_sd();
+      calibration.emulator_sd = parts.emulator_sd();
+      calibration.discrepancy_sd = parts.discrepancy_sd();
+      info.calibration = std::move(calibration);
+    }
     return info;
   }
 

@@ -64,6 +64,9 @@ struct ModelInfo {
   bool has_uncertainty = false;
   std::string summary;
   bool has_patch_scatter = false;  // answers EvaluationRequest::patch_std
+  // A calibrated model's calibration (DescribeModel's `calibration`): what it was calibrated on, each
+  // posterior coordinate's mean, SD and 95 % interval (SI), the interval's parts at the box centre.
+  std::optional<CalibrationDescription> calibration;
 };
 
 struct Options {

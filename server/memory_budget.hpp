@@ -28,29 +28,38 @@ class MemoryBudget {
     std::size_t bytes_ = 0;
   };
 
-  // bytes 0: no limit. trim_after_bytes: once this many bytes were reserved since the last time
-  // nothing was in flight, the process returns freed memory to the system when the last call ends.
-  explicit MemoryBudget(std::size_t bytes, std::size_t trim_after_bytes = kTrimAfterBytes)
-      : limit_(bytes), trim_after_(trim_after_bytes) {}
+  // bytes 0: no limit.
+  explicit MemoryBudget(std::size_t bytes) : limit_(bytes) {}
 
   // A reservation of `bytes`, or an empty one when it does not fit beside the calls in flight. A
   // call alone is always admitted, whatever its size: refusing it could never succeed later.
   Reservation try_reserve(std::size_t bytes);
   std::size_t in_use() const;
   std::size_t limit() const { return limit_; }
-  long long trims() const { return trims_.load(); }
-
-  static constexpr std::size_t kTrimAfterBytes = std::size_t{64} << 20;
 
  private:
   void release(std::size_t bytes);
 
   const std::size_t limit_;
-  const std::size_t trim_after_;
   mutable std::mutex mutex_;
   std::size_t in_use_ = 0;
-  std::size_t since_idle_ = 0;  // bytes reserved since in_use_ was last 0
-  std::atomic<long long> trims_{0};
+};
+
+// Gives the memory freed by a busy spell back to the system once, on the transition from busy to
+// idle. glibc keeps freed memory in its arenas (one per thread that allocated: gRPC's threads each
+// have one), so a burst's peak stayed resident when idle; malloc_trim(0) returns the free pages of
+// every arena (malloc_trim(3)) in milliseconds. Once per spell: resident memory that a trim cannot
+// lower (a larger model loaded) must not be trimmed again and again.
+class IdleTrimmer {
+ public:
+  // `activity`: a count that grows with every call served (requests and streams opened); `idle`:
+  // nothing in flight. Trims when idle and there was activity since the last trim; says whether it did.
+  bool poll(long long activity, bool idle);
+  long long trims() const { return trims_; }
+
+ private:
+  long long trimmed_at_ = 0;
+  long long trims_ = 0;
 };
 
 }  // namespace mufric::server

@@ -54,13 +54,11 @@ double resident_mb() {
   return 0.0;
 }
 
-// Resident memory this far above the start, with nothing in flight, is freed memory glibc kept:
-// gRPC's transport buffers of a burst of streams, which the memory budget does not count.
-constexpr double kIdleGrowthBeforeTrim = 1.25;
-
-void give_back_idle_memory(const FrictionService& service, double start_mb) {
-  if (service.counters().in_flight.load() > 0 || service.memory().in_use() > 0) return;
-  if (resident_mb() > kIdleGrowthBeforeTrim * start_mb) malloc_trim(0);
+// The memory a busy spell freed (answers, gRPC's transport buffers of a burst of streams, which the
+// memory budget does not count) goes back once the service is idle again.
+void give_back_idle_memory(const FrictionService& service, IdleTrimmer& trimmer) {
+  const auto& c = service.counters();
+  trimmer.poll(c.requests.load() + c.streams.load(), c.in_flight.load() == 0 && service.memory().in_use() == 0);
 }
 
 void log_line(const std::string& level, const std::string& message) {
@@ -273,6 +271,7 @@ void run_server(const ServerOptions& options) {
   std::mutex mutex;
   std::condition_variable wake;
   bool stopping = false;
+  IdleTrimmer trimmer;
   std::thread poller([&] {
     std::unique_lock lock(mutex);
     while (!stopping) {
@@ -280,7 +279,7 @@ void run_server(const ServerOptions& options) {
       if (stopping) break;
       lock.unlock();
       registry.refresh();
-      give_back_idle_memory(service, start_mb);
+      give_back_idle_memory(service, trimmer);
       lock.lock();
     }
   });

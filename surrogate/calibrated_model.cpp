@@ -23,34 +23,17 @@ constexpr double kGradientStep = 1e-4;
 // predictive in blocks"), so that a budget means the same time for both.
 constexpr double kSamplePointOverheadWork = 1e4;
 
-std::vector<Eigen::Index> served_columns(const Measurements& data, const std::vector<std::string>& held) {
-  std::vector<Eigen::Index> columns;
-  for (size_t c = 0; c < data.condition_names.size(); ++c) {
-    if (std::find(held.begin(), held.end(), data.condition_names[c]) == held.end()) {
-      columns.push_back(static_cast<Eigen::Index>(c));
-    }
-  }
-  return columns;
-}
-
-InputSpace served_inputs(const GaussianProcess& emulator, const Measurements& data, const std::vector<std::string>& held) {
-  for (const std::string& name : held) {
-    if (std::find(data.condition_names.begin(), data.condition_names.end(), name) == data.condition_names.end()) {
-      throw Error("calibrated model: held input '" + name + "' is not among the measurements' conditions");
-    }
-  }
+InputSpace served_inputs(const CalibrationProblem& problem) {
+  const GaussianProcess& emulator = problem.emulator();
   InputSpace served;
-  std::vector<std::string> names;
-  for (const Eigen::Index c : served_columns(data, held)) {
-    const std::string& name = data.condition_names[static_cast<size_t>(c)];
+  for (const std::string& name : problem.data().condition_names) {
     const auto input = std::find_if(emulator.inputs().begin(), emulator.inputs().end(),
                                     [&name](const InputSpec& s) { return s.name == name; });
     if (input == emulator.inputs().end()) throw Error("calibrated model: condition '" + name + "' is not an input of the emulator");
     served.push_back(*input);
-    names.push_back(name);
   }
-  if (served.empty()) throw Error("calibrated model: every condition is held; nothing is left to serve");
-  const std::string violation = servable_inputs_violation(names);
+  if (served.empty()) throw Error("calibrated model: the measurements give no condition; nothing is left to serve");
+  const std::string violation = servable_inputs_violation(problem.data().condition_names);
   if (!violation.empty()) throw Error("calibrated model: " + violation);
   return served;
 }
@@ -67,42 +50,19 @@ Eigen::VectorXd column_medians(const Eigen::MatrixXd& rows) {
 
 }  // namespace
 
-CalibratedModel::CalibratedModel(std::shared_ptr<const GaussianProcess> emulator, Measurements data,
-                                 std::vector<std::string> parameters, std::vector<std::string> held, bool discrepancy,
-                                 const Eigen::MatrixXd& samples, CalibrationRecord record)
-    : FrictionModel(served_inputs(*emulator, data, held)),
-      emulator_(std::move(emulator)),
-      held_(std::move(held)),
-      served_column_(served_columns(data, held_)),
+CalibratedModel::CalibratedModel(std::shared_ptr<const CalibratedPosterior> posterior, CalibrationRecord record)
+    : FrictionModel(served_inputs(posterior->problem())),
+      emulator_(posterior->problem().emulator_pointer()),
+      posterior_(std::move(posterior)),
       record_(std::move(record)) {
-  held_values_ = Eigen::RowVectorXd::Zero(data.conditions.cols());
-  for (Eigen::Index c = 0; c < data.conditions.cols(); ++c) {
-    const bool served = std::find(served_column_.begin(), served_column_.end(), c) != served_column_.end();
-    if (served || data.conditions.rows() == 0) continue;
-    held_values_(c) = data.conditions(0, c);
-    if (!(data.conditions.col(c).array() == held_values_(c)).all()) {
-      throw Error("calibrated model: held input '" + data.condition_names[static_cast<size_t>(c)] +
-                  "' differs between measurements");
-    }
-  }
-  CalibrationPriors priors;  // the priors shaped the samples; a prediction needs only the samples
-  priors.discrepancy = discrepancy;
-  auto problem = std::make_shared<const CalibrationProblem>(emulator_, std::move(data), std::move(parameters), priors);
-  posterior_ = std::make_shared<const CalibratedPosterior>(std::move(problem), samples);
   sample_medians_ = column_medians(posterior_->samples());
   Eigen::RowVectorXd centre(inputs().size());
   for (size_t j = 0; j < inputs().size(); ++j) centre(static_cast<Eigen::Index>(j)) = 0.5 * (inputs()[j].lo + inputs()[j].hi);
   centre_parts_ = parts_at(centre);
 }
 
-Eigen::MatrixXd CalibratedModel::conditions_of(const QueryBatch& x) const {
-  Eigen::MatrixXd conditions = held_values_.replicate(x.rows(), 1);
-  for (size_t j = 0; j < served_column_.size(); ++j) conditions.col(served_column_[j]) = x.col(static_cast<Eigen::Index>(j));
-  return conditions;
-}
-
 CalibratedPrediction CalibratedModel::predict(const QueryBatch& x, int max_threads) const {
-  return posterior_->predict(conditions_of(x), max_threads);
+  return posterior_->predict(x, max_threads);
 }
 
 IntervalParts CalibratedModel::parts_at(const Eigen::RowVectorXd& x) const {
@@ -117,7 +77,7 @@ void CalibratedModel::attach_fast_evaluator(std::shared_ptr<const FastEvaluator>
 
 Eigen::VectorXd CalibratedModel::unit_length_scales() const {
   Eigen::VectorXd l(static_cast<Eigen::Index>(inputs().size()));
-  const double discrepancy_length = problem().discrepancy() ? sample_medians_(problem().parameter_count() + 1)
+  const double discrepancy_length = problem().discrepancy() ? sample_medians_(problem().discrepancy_offset() + 1)
                                                             : std::numeric_limits<double>::infinity();
   for (size_t j = 0; j < inputs().size(); ++j) {
     const auto at = std::find_if(emulator_->inputs().begin(), emulator_->inputs().end(),
@@ -200,7 +160,7 @@ Eigen::VectorXd CalibratedModel::patch_std_valid(const QueryBatch& x, const Eval
   // mean, a property of the roughness, not of what is known about θ.
   const CalibrationProblem& p = problem();
   const Eigen::VectorXd median_theta = sample_medians_.head(p.parameter_count());
-  return emulator_->patch_std(p.emulator_points(conditions_of(x), median_theta),
+  return emulator_->patch_std(p.emulator_points(x, median_theta),
                               what.exact_only() ? 0.0 : what.std_relative_tolerance);
 }
 
@@ -242,10 +202,15 @@ std::string CalibratedModel::summary() const {
     << (p.discrepancy() ? "on" : "off") << "\n";
   s << "  measurements: " << record_.data_source << "\n";
   if (!record_.priors.empty()) s << "  priors: " << record_.priors << "\n";
-  for (size_t j = 0; j < held_.size(); ++j) {
-    const auto c = static_cast<Eigen::Index>(std::find(p.data().condition_names.begin(), p.data().condition_names.end(), held_[j]) -
-                                             p.data().condition_names.begin());
-    s << "  held: " << held_[j] << " = " << held_values_(c) << "\n";
+  for (const auto& [name, value] : p.held()) s << "  held: " << name << " = " << format_human(value, kind_of_input(name)) << "\n";
+  for (size_t k = 0; k < p.data().data_sets.size(); ++k) {
+    s << "  data set " << p.data().data_sets[k] << ": "
+      << std::count(p.data().data_set_of_row.begin(), p.data().data_set_of_row.end(), static_cast<int>(k)) << " rows";
+    const auto biased = std::find(p.bias_sets().begin(), p.bias_sets().end(), static_cast<int>(k));
+    s << (biased == p.bias_sets().end() ? ", no bias" : ", with its own bias") << "\n";
+  }
+  if (p.latent_count() > 0) {
+    s << "  " << p.latent_count() << " measured conditions known only within an uncertainty, sampled with the coefficients\n";
   }
   for (const ParameterSummary& q : record_.posterior) {
     s << "  posterior " << q.name << ": mean " << q.mean << ", sd " << q.sd << ", 95 % " << q.lo95 << " .. " << q.hi95
@@ -256,7 +221,9 @@ std::string CalibratedModel::summary() const {
   const IntervalParts& c = centre_parts_;
   s << "  interval at the box centre: mu " << c.mu << ", sd " << c.sd << " = sqrt(law coefficients' posterior " << c.parameter_sd
     << "^2 + given the coefficients " << c.conditional_sd << "^2); given the data, the roughness mean alone " << c.emulator_sd
-    << ", the discrepancy alone " << c.discrepancy_sd << "\n";
+    << ", the discrepancy alone " << c.discrepancy_sd
+    << " (parts alone need not add up: given the data, what the coefficients explain the discrepancy need not, "
+       "and the other way round)\n";
   if (fast_) {
     s << "  fast evaluator: grid";
     for (const int cells : fast_->grid().cells()) s << " " << cells;

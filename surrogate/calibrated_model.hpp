@@ -42,12 +42,10 @@ struct IntervalParts {
 
 class CalibratedModel final : public FrictionModel {
  public:
-  // The served inputs: the measurements' conditions that are not `held` (inputs fixed for every
-  // measurement, e.g. a coefficient given by --fix), in the measurements' order, with the emulator's
-  // box. `samples`: posterior states in natural units (thinned to CalibratedPosterior's default).
-  // Throws Error naming the input when a served one is not on the wire (a law coefficient).
-  CalibratedModel(std::shared_ptr<const GaussianProcess> emulator, Measurements data, std::vector<std::string> parameters,
-                  std::vector<std::string> held, bool discrepancy, const Eigen::MatrixXd& samples, CalibrationRecord record);
+  // Served over the measurements' conditions, in their order, with the emulator's box; inputs held
+  // for every measurement (a coefficient given by --fix) stay at their value. Throws Error naming
+  // the input when a served one is not on the wire (a law coefficient).
+  CalibratedModel(std::shared_ptr<const CalibratedPosterior> posterior, CalibrationRecord record);
 
   std::string_view kind() const override { return "calibrated"; }
   bool has_uncertainty() const override { return true; }
@@ -69,7 +67,6 @@ class CalibratedModel final : public FrictionModel {
   const CalibrationProblem& problem() const { return posterior_->problem(); }
   const Eigen::MatrixXd& samples() const { return posterior_->samples(); }
   const CalibrationRecord& record() const { return record_; }
-  const std::vector<std::string>& held() const { return held_; }
 
   // The certified grid over the served box (FastEvaluator), as a GP's.
   void attach_fast_evaluator(std::shared_ptr<const FastEvaluator> fast);
@@ -84,15 +81,10 @@ class CalibratedModel final : public FrictionModel {
   Eigen::VectorXd patch_std_valid(const QueryBatch& x, const EvaluationRequest& what) const override;
 
  private:
-  // Measurement-condition rows (the problem's layout) for served points: the held columns filled.
-  Eigen::MatrixXd conditions_of(const QueryBatch& x) const;
   void evaluate_exact(const QueryBatch& x, const EvaluationRequest& what, Evaluation& out) const;
 
   std::shared_ptr<const GaussianProcess> emulator_;
   std::shared_ptr<const CalibratedPosterior> posterior_;
-  std::vector<std::string> held_;
-  std::vector<Eigen::Index> served_column_;  // condition column of each served input
-  Eigen::RowVectorXd held_values_;           // per condition column (served ones unused)
   CalibrationRecord record_;
   IntervalParts centre_parts_;
   // Per coordinate (θ, then σ_δ and ℓ_δ with δ on), the median of the kept posterior samples: the

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -120,6 +122,51 @@ std::string Prior::describe() const {
   return out.str();
 }
 
+namespace {
+// A difference of two SI values in the human unit of a kind (a temperature SD in K, not °C).
+std::string format_human_difference(double value_si, QuantityKind kind) {
+  char text[64];
+  const double scaled = si_to_human(value_si, kind) - si_to_human(0.0, kind);
+  std::snprintf(text, sizeof text, "%.4g", scaled);
+  return std::string(text) + (kind == QuantityKind::temperature ? " K" : std::string(human_unit(kind)));
+}
+
+double standard_normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+}  // namespace
+
+std::string Prior::describe(QuantityKind quantity) const {
+  if (quantity == QuantityKind::dimensionless) return describe();
+  switch (kind) {
+    case PriorKind::uniform: return "uniform(" + format_human(a, quantity) + ", " + format_human(b, quantity) + ")";
+    case PriorKind::normal: return "normal(" + format_human(a, quantity) + ", sd " + format_human_difference(b, quantity) + ")";
+    case PriorKind::log_normal: {
+      std::ostringstream sd;
+      sd << b;
+      return "log_normal(median " + format_human(a, quantity) + ", sd of log " + sd.str() + ")";
+    }
+    case PriorKind::half_normal: return "half_normal(" + format_human_difference(a, quantity) + ")";
+  }
+  return describe();
+}
+
+double Prior::mass_within(double lo, double hi) const {
+  if (!(hi > lo)) return 0.0;
+  switch (kind) {
+    case PriorKind::uniform: return std::max(0.0, std::min(hi, b) - std::max(lo, a)) / (b - a);
+    case PriorKind::normal: return standard_normal_cdf((hi - a) / b) - standard_normal_cdf((lo - a) / b);
+    case PriorKind::log_normal: {
+      if (hi <= 0.0) return 0.0;
+      const double below = lo <= 0.0 ? 0.0 : standard_normal_cdf((std::log(lo) - std::log(a)) / b);
+      return standard_normal_cdf((std::log(hi) - std::log(a)) / b) - below;
+    }
+    case PriorKind::half_normal: {
+      if (hi <= 0.0) return 0.0;
+      return 2.0 * (standard_normal_cdf(hi / a) - standard_normal_cdf(std::max(lo, 0.0) / a));
+    }
+  }
+  return 0.0;
+}
+
 void Prior::check(const std::string& where) const {
   const bool finite = std::isfinite(a) && std::isfinite(b);
   switch (kind) {
@@ -168,11 +215,97 @@ CalibrationPriors parse_calibration_priors(const std::string& json_text, const s
           throw Error(where + ": unknown key (enabled, amplitude, length_scale)");
         }
       }
+    } else if (key == "data_sets") {
+      if (!value.is_object()) throw Error(source + ": data_sets: an object of data set name → {\"bias\": prior}");
+      for (const auto& [name, setting] : value.items()) {
+        const std::string where = source + ": data_sets." + name;
+        if (!setting.is_object()) throw Error(where + ": an object, e.g. {\"bias\": {\"normal\": [0, 0.1]}}");
+        for (const auto& [field, prior] : setting.items()) {
+          if (field != "bias") throw Error(where + "." + field + ": unknown key (bias)");
+          priors.biases.emplace_back(name, parse_prior(prior, where + ".bias"));
+        }
+      }
     } else {
-      throw Error(source + ": " + key + ": unknown key (parameters, discrepancy)");
+      throw Error(source + ": " + key + ": unknown key (parameters, discrepancy, data_sets)");
     }
   }
   return priors;
+}
+
+bool Measurements::uncertain(Eigen::Index row, Eigen::Index condition) const {
+  return (condition_sd.size() > 0 && condition_sd(row, condition) > 0.0) ||
+         (condition_half_width.size() > 0 && condition_half_width(row, condition) > 0.0);
+}
+
+Prior Measurements::condition_prior(Eigen::Index row, Eigen::Index condition) const {
+  const double stated = conditions(row, condition);
+  if (condition_sd.size() > 0 && condition_sd(row, condition) > 0.0) return {PriorKind::normal, stated, condition_sd(row, condition)};
+  const double half = condition_half_width.size() > 0 ? condition_half_width(row, condition) : 0.0;
+  return {PriorKind::uniform, stated - half, stated + half};
+}
+
+Measurements completed(Measurements data) {
+  const Eigen::Index n = data.mu.size(), c = data.conditions.cols();
+  if (data.condition_sd.size() == 0) data.condition_sd = Eigen::MatrixXd::Zero(n, c);
+  if (data.condition_half_width.size() == 0) data.condition_half_width = Eigen::MatrixXd::Zero(n, c);
+  if (data.data_sets.empty()) {
+    data.data_sets = {"measurements"};
+    data.data_set_of_row.assign(static_cast<size_t>(n), 0);
+  }
+  return data;
+}
+
+Measurements combine_measurement_sets(const std::vector<Measurements>& sets) {
+  if (sets.empty()) throw Error("calibration: no measurements");
+  Measurements all;
+  all.condition_names = sets.front().condition_names;
+  const auto c = static_cast<Eigen::Index>(all.condition_names.size());
+  Eigen::Index n = 0;
+  for (const Measurements& set : sets) n += set.mu.size();
+  all.conditions.resize(n, c);
+  all.condition_sd.resize(n, c);
+  all.condition_half_width.resize(n, c);
+  all.mu.resize(n);
+  all.mu_sd.resize(n);
+  Eigen::Index at = 0;
+  for (const Measurements& given : sets) {
+    const Measurements set = completed(given);
+    const Eigen::Index rows = set.mu.size();
+    for (size_t k = 0; k < set.data_sets.size(); ++k) {
+      std::string name = set.data_sets[k];
+      for (int suffix = 2; std::find(all.data_sets.begin(), all.data_sets.end(), name) != all.data_sets.end(); ++suffix) {
+        name = set.data_sets[k] + "_" + std::to_string(suffix);
+      }
+      all.data_sets.push_back(name);
+    }
+    const int first_set = static_cast<int>(all.data_sets.size() - set.data_sets.size());
+    for (Eigen::Index j = 0; j < c; ++j) {
+      const std::string& name = all.condition_names[static_cast<size_t>(j)];
+      const auto found = std::find(set.condition_names.begin(), set.condition_names.end(), name);
+      if (found == set.condition_names.end()) {
+        throw Error("calibration: data set '" + all.data_sets[static_cast<size_t>(first_set)] + "' gives no " + name +
+                    ", which '" + all.data_sets.front() + "' gives: every data set must give the same conditions");
+      }
+      const auto column = static_cast<Eigen::Index>(found - set.condition_names.begin());
+      all.conditions.block(at, j, rows, 1) = set.conditions.col(column);
+      all.condition_sd.block(at, j, rows, 1) = set.condition_sd.col(column);
+      all.condition_half_width.block(at, j, rows, 1) = set.condition_half_width.col(column);
+    }
+    if (set.condition_names.size() != all.condition_names.size()) {
+      for (const std::string& name : set.condition_names) {
+        if (std::find(all.condition_names.begin(), all.condition_names.end(), name) == all.condition_names.end()) {
+          throw Error("calibration: data set '" + all.data_sets[static_cast<size_t>(first_set)] + "' gives " + name +
+                      ", which '" + all.data_sets.front() + "' does not: every data set must give the same conditions");
+        }
+      }
+    }
+    all.mu.segment(at, rows) = set.mu;
+    all.mu_sd.segment(at, rows) = set.mu_sd;
+    all.row_names.insert(all.row_names.end(), set.row_names.begin(), set.row_names.end());
+    for (const int k : set.data_set_of_row) all.data_set_of_row.push_back(first_set + k);
+    at += rows;
+  }
+  return all;
 }
 
 Measurements read_measurements(const std::string& path) {
@@ -182,39 +315,105 @@ Measurements read_measurements(const std::string& path) {
   Measurements data;
   const auto n = static_cast<Eigen::Index>(table.rows.size());
   if (n == 0) throw Error(path + ": no measurements");
-  std::vector<std::vector<double>> columns;
+  auto where = [&](size_t row, const std::string& column) {
+    return path + ": line " + std::to_string(table.line_of_row[row]) + ", column '" + column + "'";
+  };
+  // Each column is a condition's value, SD, minimum or maximum: "temperature", "temperature_sd", ...
+  auto split = [](const std::string& name) -> std::pair<std::string, std::string> {
+    for (const char* suffix : {"_sd", "_min", "_max"}) {
+      const std::string s = suffix;
+      if (name.size() > s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0) {
+        return {name.substr(0, name.size() - s.size()), s.substr(1)};
+      }
+    }
+    return {name, ""};
+  };
+  std::vector<std::string> names;
   for (const CsvColumn& c : table.columns) {
     if (c.name == "mu" || c.name == "mu_sd") continue;
-    const KnownInput* known = find_known_input(c.name);
+    const auto [condition, part] = split(c.name);
+    const KnownInput* known = find_known_input(condition);
     if (known == nullptr) {
       throw Error(path + ": column '" + c.name + "' is not a model input (conditions: contact_pressure, sliding_velocity, "
-                  "temperature, ...; values: mu, mu_sd)");
+                  "temperature, ...; with _sd, or _min and _max, for their uncertainty; values: mu, mu_sd)");
     }
-    data.condition_names.push_back(c.name);
-    columns.push_back(table.si_column(c.name, known->kind));
-    for (size_t i = 0; i < columns.back().size(); ++i) {
-      const std::string why = physical_range_violation(columns.back()[i], known->kind);
-      if (!why.empty()) throw Error(path + ": line " + std::to_string(table.line_of_row[i]) + ", column '" + c.name + "': " + why);
-    }
+    if (std::find(names.begin(), names.end(), condition) == names.end()) names.push_back(condition);
   }
-  data.conditions.resize(n, static_cast<Eigen::Index>(columns.size()));
-  for (size_t j = 0; j < columns.size(); ++j) {
-    data.conditions.col(static_cast<Eigen::Index>(j)) = Eigen::Map<const Eigen::VectorXd>(columns[j].data(), n);
+  const auto c = static_cast<Eigen::Index>(names.size());
+  data.condition_names = names;
+  data.conditions.resize(n, c);
+  data.condition_sd = Eigen::MatrixXd::Zero(n, c);
+  data.condition_half_width = Eigen::MatrixXd::Zero(n, c);
+  for (Eigen::Index j = 0; j < c; ++j) {
+    const std::string& name = names[static_cast<size_t>(j)];
+    const QuantityKind kind = find_known_input(name)->kind;
+    const bool has_value = table.has_column(name), has_sd = table.has_column(name + "_sd");
+    const bool has_min = table.has_column(name + "_min"), has_max = table.has_column(name + "_max");
+    if (has_min != has_max) {
+      throw Error(path + ": column '" + name + (has_min ? "_min" : "_max") + "' needs its partner '" + name +
+                  (has_min ? "_max" : "_min") + "' (a uniform range)");
+    }
+    if (has_sd && has_min) throw Error(path + ": " + name + " has both an SD and a range: give one of them");
+    if (!has_value && !has_min) throw Error(path + ": column '" + name + "_sd' needs the value column '" + name + "'");
+    std::vector<double> value, lo, hi, sd;
+    if (has_value) value = table.si_column(name, kind);
+    if (has_min) {
+      lo = table.si_column(name + "_min", kind);
+      hi = table.si_column(name + "_max", kind);
+    }
+    // An SD is a difference: a temperature SD in °C is the same number of kelvin.
+    if (has_sd) {
+      sd = table.si_column(name + "_sd", kind);
+      if (kind == QuantityKind::temperature) {
+        const double offset = unit_to_si(table.columns[table.column(name + "_sd")].unit).offset;
+        for (double& x : sd) x -= offset;
+      }
+    }
+    for (size_t i = 0; i < static_cast<size_t>(n); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      if (has_min) {
+        if (!(lo[i] <= hi[i])) throw Error(where(i, name + "_min") + ": the minimum is above the maximum");
+        const double middle = 0.5 * (lo[i] + hi[i]);
+        if (has_value && (value[i] < lo[i] || value[i] > hi[i])) {
+          throw Error(where(i, name) + ": the value lies outside its range " + name + "_min .. " + name + "_max");
+        }
+        data.conditions(r, j) = has_value ? value[i] : middle;
+        data.condition_half_width(r, j) = 0.5 * (hi[i] - lo[i]);
+        if (has_value && value[i] != middle) {
+          // A uniform range is centred on its middle: the stated value is the range's.
+          data.conditions(r, j) = middle;
+        }
+      } else {
+        data.conditions(r, j) = value[i];
+      }
+      if (has_sd) {
+        if (!(std::isfinite(sd[i]) && sd[i] >= 0.0)) throw Error(where(i, name + "_sd") + ": an SD must be zero or positive");
+        data.condition_sd(r, j) = sd[i];
+      }
+      for (const double x : {data.conditions(r, j) - data.condition_half_width(r, j), data.conditions(r, j) + data.condition_half_width(r, j)}) {
+        const std::string why = physical_range_violation(x, kind);
+        if (!why.empty()) throw Error(where(i, name) + ": " + why);
+      }
+    }
   }
   const std::vector<double> mu = table.si_column("mu", QuantityKind::dimensionless);
   const std::vector<double> sd = table.si_column("mu_sd", QuantityKind::dimensionless);
   data.mu = Eigen::Map<const Eigen::VectorXd>(mu.data(), n);
   data.mu_sd = Eigen::Map<const Eigen::VectorXd>(sd.data(), n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    data.row_names.push_back(path + " line " + std::to_string(table.line_of_row[static_cast<size_t>(i)]));
+    data.row_names.push_back(std::filesystem::path(path).filename().string() + " line " +
+                             std::to_string(table.line_of_row[static_cast<size_t>(i)]));
   }
+  data.data_sets = {std::filesystem::path(path).stem().string()};
+  data.data_set_of_row.assign(static_cast<size_t>(n), 0);
   return data;
 }
 
 CalibrationProblem::CalibrationProblem(std::shared_ptr<const GaussianProcess> emulator, Measurements data,
-                                       std::vector<std::string> parameters, CalibrationPriors priors)
-    : emulator_(std::move(emulator)), data_(std::move(data)), parameters_(std::move(parameters)),
-      priors_(std::move(priors)) {
+                                       std::vector<std::string> parameters, CalibrationPriors priors,
+                                       std::vector<std::pair<std::string, double>> held)
+    : emulator_(std::move(emulator)), data_(completed(std::move(data))), parameters_(std::move(parameters)),
+      priors_(std::move(priors)), held_(std::move(held)) {
   const InputSpace& inputs = emulator_->inputs();
   auto column_of = [&](const std::string& name) -> Eigen::Index {
     for (size_t j = 0; j < inputs.size(); ++j) {
@@ -230,26 +429,42 @@ CalibrationProblem::CalibrationProblem(std::shared_ptr<const GaussianProcess> em
     if (column < 0) throw Error("calibration: the model has no input '" + parameter + "' to calibrate (its inputs: " + names + ")");
     parameter_column_.push_back(column);
   }
+  for (const auto& [name, value] : held_) {
+    const Eigen::Index column = column_of(name);
+    if (column < 0) throw Error("calibration: the model has no input '" + name + "' to hold (its inputs: " + names + ")");
+    const InputSpec& input = inputs[static_cast<size_t>(column)];
+    if (!input.contains(value)) {
+      throw Error("calibration: " + name + " held at " + format_human(value, input.kind()) + ", outside the model's box " +
+                  format_human(input.lo, input.kind()) + " – " + format_human(input.hi, input.kind()));
+    }
+    held_column_.push_back(column);
+  }
   for (const std::string& condition : data_.condition_names) {
     const Eigen::Index column = column_of(condition);
     if (column < 0) throw Error("calibration: the measurements give '" + condition + "', which the model does not have (its inputs: " + names + ")");
     if (std::find(parameters_.begin(), parameters_.end(), condition) != parameters_.end()) {
       throw Error("calibration: '" + condition + "' is both measured and calibrated");
     }
+    if (std::find(held_column_.begin(), held_column_.end(), column) != held_column_.end()) {
+      throw Error("calibration: '" + condition + "' is both measured and held");
+    }
     condition_column_.push_back(column);
   }
   for (size_t j = 0; j < inputs.size(); ++j) {
     const auto column = static_cast<Eigen::Index>(j);
-    if (std::find(condition_column_.begin(), condition_column_.end(), column) == condition_column_.end() &&
-        std::find(parameter_column_.begin(), parameter_column_.end(), column) == parameter_column_.end()) {
-      throw Error("calibration: the model's input '" + inputs[j].name + "' is neither a measurement condition nor calibrated");
+    auto in = [column](const std::vector<Eigen::Index>& v) { return std::find(v.begin(), v.end(), column) != v.end(); };
+    if (!in(condition_column_) && !in(parameter_column_) && !in(held_column_)) {
+      throw Error("calibration: the model's input '" + inputs[j].name + "' is neither a measurement condition, held nor calibrated");
     }
   }
   const Eigen::Index n = data_.mu.size();
   if (n < 1) throw Error("calibration: no measurements");
-  if (data_.conditions.rows() != n || data_.conditions.cols() != static_cast<Eigen::Index>(data_.condition_names.size()) ||
-      data_.mu_sd.size() != n || static_cast<Eigen::Index>(data_.row_names.size()) != n) {
-    throw Error("calibration: the measurements' conditions, μ, SD and row names differ in size");
+  const auto c = static_cast<Eigen::Index>(data_.condition_names.size());
+  if (data_.conditions.rows() != n || data_.conditions.cols() != c || data_.mu_sd.size() != n ||
+      static_cast<Eigen::Index>(data_.row_names.size()) != n || data_.condition_sd.rows() != n ||
+      data_.condition_sd.cols() != c || data_.condition_half_width.rows() != n || data_.condition_half_width.cols() != c ||
+      static_cast<Eigen::Index>(data_.data_set_of_row.size()) != n) {
+    throw Error("calibration: the measurements' conditions, uncertainties, μ, SD, row names and data sets differ in size");
   }
   for (Eigen::Index i = 0; i < n; ++i) {
     const std::string& row = data_.row_names[static_cast<size_t>(i)];
@@ -257,10 +472,21 @@ CalibrationProblem::CalibrationProblem(std::shared_ptr<const GaussianProcess> em
     if (!(std::isfinite(data_.mu_sd(i)) && data_.mu_sd(i) > 0.0)) {
       throw Error(row + ": the measurement's SD must be positive and finite (a measurement without scatter cannot be weighed)");
     }
-    for (size_t c = 0; c < condition_column_.size(); ++c) {
-      const InputSpec& input = inputs[static_cast<size_t>(condition_column_[c])];
-      const double value = data_.conditions(i, static_cast<Eigen::Index>(c));
-      if (!input.contains(value)) {
+    const int set = data_.data_set_of_row[static_cast<size_t>(i)];
+    if (set < 0 || set >= static_cast<int>(data_.data_sets.size())) throw Error(row + ": no data set");
+    for (Eigen::Index j = 0; j < c; ++j) {
+      const InputSpec& input = inputs[static_cast<size_t>(condition_column_[static_cast<size_t>(j)])];
+      const double value = data_.conditions(i, j);
+      if (data_.uncertain(i, j)) {
+        const Prior prior = data_.condition_prior(i, j);
+        if (prior.mass_within(input.lo, input.hi) <= 0.0) {
+          throw Error(row + ": " + input.name + " " + prior.describe(input.kind()) + " lies wholly outside the model's box " +
+                      format_human(input.lo, input.kind()) + " – " + format_human(input.hi, input.kind()) +
+                      " (the emulator knows nothing there: run the campaign over it, or leave the row out)");
+        }
+        latent_cells_.emplace_back(i, j);
+        latent_priors_.push_back(prior);
+      } else if (!input.contains(value)) {
         throw Error(row + ": " + input.name + " " + format_human(value, input.kind()) + " lies outside the model's box " +
                     format_human(input.lo, input.kind()) + " – " + format_human(input.hi, input.kind()) +
                     " (the emulator knows nothing there: run the campaign over it, or leave the row out)");
@@ -280,18 +506,32 @@ CalibrationProblem::CalibrationProblem(std::shared_ptr<const GaussianProcess> em
     }
     parameter_priors_.push_back(prior);
   }
+  for (const auto& [name, prior] : priors_.biases) {
+    const auto found = std::find(data_.data_sets.begin(), data_.data_sets.end(), name);
+    if (found == data_.data_sets.end()) {
+      std::string sets;
+      for (const std::string& s : data_.data_sets) sets += (sets.empty() ? "" : ", ") + s;
+      throw Error("calibration: a bias is given for data set '" + name + "', which is not among the measurements' (" + sets + ")");
+    }
+    bias_sets_.push_back(static_cast<int>(found - data_.data_sets.begin()));
+    bias_priors_.push_back(prior);
+  }
   names_ = parameters_;
   if (priors_.discrepancy) {
     names_.emplace_back(kAmplitudeName);
     names_.emplace_back(kLengthScaleName);
   }
-  unit_data_conditions_ = unit_conditions(data_.conditions);
+  for (const int set : bias_sets_) names_.push_back("bias[" + data_.data_sets[static_cast<size_t>(set)] + "]");
+  for (const auto& [row, condition] : latent_cells_) {
+    names_.push_back(data_.condition_names[static_cast<size_t>(condition)] + " (" + data_.row_names[static_cast<size_t>(row)] + ")");
+  }
 }
 
 Eigen::MatrixXd CalibrationProblem::emulator_points(const Eigen::MatrixXd& conditions, const Eigen::VectorXd& theta) const {
   Eigen::MatrixXd points(conditions.rows(), static_cast<Eigen::Index>(emulator_->inputs().size()));
   for (size_t c = 0; c < condition_column_.size(); ++c) points.col(condition_column_[c]) = conditions.col(static_cast<Eigen::Index>(c));
   for (size_t k = 0; k < parameter_column_.size(); ++k) points.col(parameter_column_[k]).setConstant(theta(static_cast<Eigen::Index>(k)));
+  for (size_t h = 0; h < held_column_.size(); ++h) points.col(held_column_[h]).setConstant(held_[h].second);
   return points;
 }
 
@@ -309,26 +549,54 @@ Eigen::MatrixXd CalibrationProblem::discrepancy_covariance(const Eigen::MatrixXd
   return amplitude * amplitude * rbf_correlations(ua / length_scale, ub / length_scale);
 }
 
+PosteriorPoint CalibrationProblem::point_at(const Eigen::VectorXd& natural) const {
+  PosteriorPoint point;
+  point.theta = natural.head(parameter_count());
+  if (discrepancy()) {
+    point.amplitude = natural(discrepancy_offset());
+    point.length_scale = natural(discrepancy_offset() + 1);
+  }
+  point.biases = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(data_.data_sets.size()));
+  for (Eigen::Index b = 0; b < bias_count(); ++b) point.biases(bias_sets_[static_cast<size_t>(b)]) = natural(bias_offset() + b);
+  point.conditions = data_.conditions;
+  for (Eigen::Index l = 0; l < latent_count(); ++l) {
+    const auto& [row, condition] = latent_cells_[static_cast<size_t>(l)];
+    point.conditions(row, condition) = natural(latent_offset() + l);
+  }
+  return point;
+}
+
 double CalibrationProblem::log_posterior(const Eigen::VectorXd& coordinates) const {
   const Eigen::Index k = parameter_count();
-  const Eigen::VectorXd theta = coordinates.head(k);
   double log_density = 0.0;
   for (Eigen::Index j = 0; j < k; ++j) {
     const InputSpec& input = emulator_->inputs()[static_cast<size_t>(parameter_column_[static_cast<size_t>(j)])];
-    if (!input.contains(theta(j))) return kMinusInfinity;
-    log_density += parameter_priors_[static_cast<size_t>(j)].log_density(theta(j));
+    if (!input.contains(coordinates(j))) return kMinusInfinity;
+    log_density += parameter_priors_[static_cast<size_t>(j)].log_density(coordinates(j));
   }
-  double amplitude = 0.0, length_scale = 1.0;
+  Eigen::VectorXd natural = coordinates;
   if (priors_.discrepancy) {
     // Sampled as logs: the prior's density of σ, ℓ times the Jacobian σ, ℓ.
-    amplitude = std::exp(coordinates(k));
-    length_scale = std::exp(coordinates(k + 1));
-    log_density += priors_.discrepancy_amplitude.log_density(amplitude) + coordinates(k);
-    log_density += priors_.discrepancy_length_scale.log_density(length_scale) + coordinates(k + 1);
+    const Eigen::Index d = discrepancy_offset();
+    natural(d) = std::exp(coordinates(d));
+    natural(d + 1) = std::exp(coordinates(d + 1));
+    log_density += priors_.discrepancy_amplitude.log_density(natural(d)) + coordinates(d);
+    log_density += priors_.discrepancy_length_scale.log_density(natural(d + 1)) + coordinates(d + 1);
+  }
+  for (Eigen::Index b = 0; b < bias_count(); ++b) {
+    log_density += bias_priors_[static_cast<size_t>(b)].log_density(coordinates(bias_offset() + b));
+  }
+  for (Eigen::Index l = 0; l < latent_count(); ++l) {
+    const double value = coordinates(latent_offset() + l);
+    const Eigen::Index condition = latent_cells_[static_cast<size_t>(l)].second;
+    if (!emulator_->inputs()[static_cast<size_t>(condition_column_[static_cast<size_t>(condition)])].contains(value)) {
+      return kMinusInfinity;  // the emulator knows nothing there: the prior is cut to the box
+    }
+    log_density += latent_priors_[static_cast<size_t>(l)].log_density(value);
   }
   if (!std::isfinite(log_density)) return kMinusInfinity;
 
-  const Likelihood likelihood = likelihood_at(theta, amplitude, length_scale);
+  const Likelihood likelihood = likelihood_at(point_at(natural));
   if (likelihood.factor.info() != Eigen::Success) return kMinusInfinity;
   const Eigen::VectorXd whitened = likelihood.factor.matrixL().solve(likelihood.residual);
   const double log_determinant_half = likelihood.factor.matrixLLT().diagonal().array().log().sum();
@@ -336,15 +604,18 @@ double CalibrationProblem::log_posterior(const Eigen::VectorXd& coordinates) con
   return std::isfinite(value) ? value : kMinusInfinity;
 }
 
-CalibrationProblem::Likelihood CalibrationProblem::likelihood_at(const Eigen::VectorXd& theta, double amplitude,
-                                                                 double length_scale) const {
+CalibrationProblem::Likelihood CalibrationProblem::likelihood_at(const PosteriorPoint& point) const {
   Likelihood out;
-  out.measured = emulator_->latent_points(emulator_points(data_.conditions, theta));
+  out.measured = emulator_->latent_points(emulator_points(point.conditions, point.theta));
+  out.unit_conditions = unit_conditions(point.conditions);
   Eigen::MatrixXd covariance = emulator_->latent_covariance(out.measured, out.measured);
   covariance.diagonal().array() += data_.mu_sd.array().square() + kCovarianceJitter;
-  if (amplitude > 0.0) covariance += discrepancy_covariance(unit_data_conditions_, unit_data_conditions_, amplitude, length_scale);
+  if (point.amplitude > 0.0) {
+    covariance += discrepancy_covariance(out.unit_conditions, out.unit_conditions, point.amplitude, point.length_scale);
+  }
   out.factor.compute(covariance);
   out.residual = data_.mu - out.measured.mean;
+  for (Eigen::Index i = 0; i < out.residual.size(); ++i) out.residual(i) -= point.biases(data_.data_set_of_row[static_cast<size_t>(i)]);
   return out;
 }
 
@@ -358,8 +629,14 @@ Eigen::MatrixXd CalibrationProblem::draw_start(int walkers, std::uint64_t seed) 
       Eigen::VectorXd coordinates(dimension());
       for (Eigen::Index j = 0; j < k; ++j) coordinates(j) = draw_from(parameter_priors_[static_cast<size_t>(j)], random);
       if (priors_.discrepancy) {
-        coordinates(k) = std::log(draw_from(priors_.discrepancy_amplitude, random));
-        coordinates(k + 1) = std::log(draw_from(priors_.discrepancy_length_scale, random));
+        coordinates(discrepancy_offset()) = std::log(draw_from(priors_.discrepancy_amplitude, random));
+        coordinates(discrepancy_offset() + 1) = std::log(draw_from(priors_.discrepancy_length_scale, random));
+      }
+      for (Eigen::Index b = 0; b < bias_count(); ++b) {
+        coordinates(bias_offset() + b) = draw_from(bias_priors_[static_cast<size_t>(b)], random);
+      }
+      for (Eigen::Index l = 0; l < latent_count(); ++l) {
+        coordinates(latent_offset() + l) = draw_from(latent_priors_[static_cast<size_t>(l)], random);
       }
       if (std::isfinite(log_posterior(coordinates))) {
         start.row(w) = coordinates.transpose();
@@ -375,16 +652,35 @@ Eigen::MatrixXd CalibrationProblem::draw_start(int walkers, std::uint64_t seed) 
 }
 
 CalibrationResult calibrate(const CalibrationProblem& problem, const EnsembleOptions& options, const SamplerProgress& progress) {
-  const Eigen::MatrixXd start = problem.draw_start(options.walkers, options.seed);
-  const EnsembleChains chains = run_ensemble_sampler(
-      [&problem](const Eigen::VectorXd& c) { return problem.log_posterior(c); }, start, options, progress);
+  const LogDensity log_posterior = [&problem](const Eigen::VectorXd& c) { return problem.log_posterior(c); };
+  EnsembleChains chains = run_ensemble_sampler(log_posterior, problem.draw_start(options.walkers, options.seed), options, progress);
   CalibrationResult result;
   result.options = options;
-  result.acceptance = chains.acceptance;
   result.diagnostics = diagnose_chains(chains);
   result.convergence_failure = convergence_failure(result.diagnostics, problem.coordinate_names(), chains.steps());
+  // Not yet within the limits: run on from where the walkers are for as many steps as were run in all,
+  // and judge that latest run alone (the earlier steps become its burn-in: "run longer and discard the
+  // first half", BDA3 §11.4), while the whole stays within max_steps.
+  long long total = options.burn_in_steps + options.steps;
+  for (std::uint64_t stage = 1; !result.convergence_failure.empty() && 2 * total <= options.max_steps; ++stage) {
+    Eigen::MatrixXd last(options.walkers, problem.dimension());
+    for (int w = 0; w < options.walkers; ++w) last.row(w) = chains.states[static_cast<size_t>(w)].bottomRows(1);
+    EnsembleOptions more = options;
+    more.burn_in_steps = 0;
+    more.steps = static_cast<int>(total);
+    more.seed = options.seed + stage;
+    chains = run_ensemble_sampler(log_posterior, last, more, progress);
+    result.options.burn_in_steps = static_cast<int>(total);
+    result.options.steps = static_cast<int>(total);
+    total *= 2;
+    result.diagnostics = diagnose_chains(chains);
+    result.convergence_failure = convergence_failure(result.diagnostics, problem.coordinate_names(), chains.steps());
+  }
+  result.acceptance = chains.acceptance;
   result.samples = chains.pooled();
-  if (problem.discrepancy()) result.samples.rightCols(2) = result.samples.rightCols(2).array().exp().matrix();
+  if (problem.discrepancy()) {
+    result.samples.middleCols(problem.discrepancy_offset(), 2) = result.samples.middleCols(problem.discrepancy_offset(), 2).array().exp().matrix();
+  }
   for (Eigen::Index j = 0; j < problem.dimension(); ++j) {
     std::vector<double> values(result.samples.col(j).data(), result.samples.col(j).data() + result.samples.rows());
     std::sort(values.begin(), values.end());
@@ -412,18 +708,13 @@ CalibratedPosterior::CalibratedPosterior(std::shared_ptr<const CalibrationProble
                 std::to_string(problem_->dimension()));
   }
   const Eigen::Index used = std::max<Eigen::Index>(1, std::min(thinned, total));
-  const Eigen::Index k = problem_->parameter_count();
   kept_.resize(used, samples.cols());
   for (Eigen::Index s = 0; s < used; ++s) {
     // Evenly spaced through the pooled samples (walker by walker), so every walker contributes.
     kept_.row(s) = samples.row(s * total / used);
     Sample sample;
-    sample.theta = kept_.row(s).head(k).transpose();
-    if (problem_->discrepancy()) {
-      sample.amplitude = kept_(s, k);
-      sample.length_scale = kept_(s, k + 1);
-    }
-    sample.likelihood = problem_->likelihood_at(sample.theta, sample.amplitude, sample.length_scale);
+    sample.point = problem_->point_at(kept_.row(s).transpose());
+    sample.likelihood = problem_->likelihood_at(sample.point);
     if (sample.likelihood.factor.info() != Eigen::Success) {
       throw Error("calibrated prediction: the likelihood's covariance at posterior sample " + std::to_string(s) +
                   " is not positive definite");
@@ -440,36 +731,39 @@ CalibratedPrediction CalibratedPosterior::predict(const Eigen::MatrixXd& conditi
                              &out.emulator_sd, &out.conditional_sd}) {
     v->resize(q);
   }
+  Eigen::MatrixXd block(kPredictionBlockRows, conditions.cols());
   for (Eigen::Index first = 0; first < q; first += kPredictionBlockRows) {
     const Eigen::Index count = std::min(kPredictionBlockRows, q - first);
-    predict_block(conditions.middleRows(first, count), first, max_threads, out);
+    block.topRows(count) = conditions.middleRows(first, count);
+    for (Eigen::Index r = count; r < kPredictionBlockRows; ++r) block.row(r) = conditions.row(first + count - 1);
+    predict_block(block, count, first, max_threads, out);
   }
   return out;
 }
 
-void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen::Index first, int max_threads,
-                                        CalibratedPrediction& out) const {
+void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen::Index count, Eigen::Index first,
+                                        int max_threads, CalibratedPrediction& out) const {
   const CalibrationProblem& problem = *problem_;
   const GaussianProcess& emulator = problem.emulator();
   const Eigen::Index q = conditions.rows(), used = static_cast<Eigen::Index>(samples_.size());
-  const Eigen::MatrixXd unit_new = problem.unit_conditions(conditions);
-  const Eigen::MatrixXd& unit_data = problem.unit_data_conditions();
+  const Eigen::MatrixXd unit_new = problem.discrepancy() ? problem.unit_conditions(conditions) : Eigen::MatrixXd();
   Eigen::MatrixXd means(q, used), variances(q, used), discrepancy_means(q, used), discrepancy_variances(q, used),
       emulator_variances(q, used);
   auto predict_sample = [&](Eigen::Index s) {
     const Sample& sample = samples_[static_cast<size_t>(s)];
     const auto lower = sample.likelihood.factor.matrixL();
-    const GaussianProcess::LatentPoints at = emulator.latent_points(problem.emulator_points(conditions, sample.theta));
+    const GaussianProcess::LatentPoints at = emulator.latent_points(problem.emulator_points(conditions, sample.point.theta));
     // ζ(x) = η(x, θ) + δ(x) given y (KOH eq. 6): cov(η(x), y) = C_η(x, X), cov(δ(x), y) = K_δ(x, X).
     // diag(A C⁻¹ Aᵀ) = |L⁻¹Aᵀ|² per column, with C = LLᵀ the likelihood's factor.
     const Eigen::MatrixXd emulator_cross = emulator.latent_covariance(at, sample.likelihood.measured);
     const Eigen::MatrixXd emulator_explained = lower.solve(emulator_cross.transpose());
-    const double discrepancy_variance = sample.amplitude * sample.amplitude;
+    const double discrepancy_variance = sample.point.amplitude * sample.point.amplitude;
     const Eigen::VectorXd prior_emulator_variance = emulator.latent_variance(at);
     emulator_variances.col(s) = prior_emulator_variance - emulator_explained.colwise().squaredNorm().transpose();
     if (problem.discrepancy()) {
       const Eigen::MatrixXd discrepancy_cross =
-          CalibrationProblem::discrepancy_covariance(unit_new, unit_data, sample.amplitude, sample.length_scale);
+          CalibrationProblem::discrepancy_covariance(unit_new, sample.likelihood.unit_conditions, sample.point.amplitude,
+                                                     sample.point.length_scale);
       const Eigen::MatrixXd discrepancy_explained = lower.solve(discrepancy_cross.transpose());
       discrepancy_means.col(s) = discrepancy_cross * sample.weights;
       discrepancy_variances.col(s) =
@@ -496,14 +790,14 @@ void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen
   };
   const Eigen::VectorXd between = spread(means);
   const Eigen::VectorXd within = variances.rowwise().mean().cwiseMax(0.0);
-  out.mean.segment(first, q) = means.rowwise().mean();
-  out.parameter_sd.segment(first, q) = between.cwiseSqrt();
-  out.sd.segment(first, q) = (within + between).cwiseSqrt();
-  out.conditional_sd.segment(first, q) = within.cwiseSqrt();
-  out.emulator_sd.segment(first, q) = emulator_variances.rowwise().mean().cwiseMax(0.0).cwiseSqrt();
-  out.discrepancy_mean.segment(first, q) = discrepancy_means.rowwise().mean();
-  out.discrepancy_sd.segment(first, q) =
-      (discrepancy_variances.rowwise().mean().cwiseMax(0.0) + spread(discrepancy_means)).cwiseSqrt();
+  out.mean.segment(first, count) = means.rowwise().mean().head(count);
+  out.parameter_sd.segment(first, count) = between.cwiseSqrt().head(count);
+  out.sd.segment(first, count) = (within + between).cwiseSqrt().head(count);
+  out.conditional_sd.segment(first, count) = within.cwiseSqrt().head(count);
+  out.emulator_sd.segment(first, count) = emulator_variances.rowwise().mean().cwiseMax(0.0).cwiseSqrt().head(count);
+  out.discrepancy_mean.segment(first, count) = discrepancy_means.rowwise().mean().head(count);
+  out.discrepancy_sd.segment(first, count) =
+      (discrepancy_variances.rowwise().mean().cwiseMax(0.0) + spread(discrepancy_means)).cwiseSqrt().head(count);
 }
 
 CalibratedPrediction predict_calibrated(const CalibrationProblem& problem, const CalibrationResult& result,

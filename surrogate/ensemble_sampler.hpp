@@ -28,6 +28,9 @@ struct EnsembleOptions {
   int steps = 1500;          // steps kept
   double stretch = 2.0;      // a in g(z) ∝ 1/√z on [1/a, a]; Goodman & Weare's value
   std::uint64_t seed = 1;    // the whole run (start and moves) follows from it, bit for bit
+  // calibrate() only: a run that fails the convergence limits is continued, its length doubling, up
+  // to this many steps in all (0: never), and judged on its latest part (CalibrationResult says).
+  int max_steps = 0;
 };
 
 struct EnsembleChains {

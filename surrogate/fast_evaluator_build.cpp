@@ -287,4 +287,19 @@ FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluator
   }
 }
 
+double default_fast_evaluator_work(Eigen::Index training_points) {
+  const auto n = static_cast<double>(training_points);
+  return std::max(kLeastFastEvaluatorWork, kFitLikeEvaluations * n * n * n);
+}
+
+std::string short_grid_refusal(const FastEvaluator& fast, const FastEvaluatorOptions& options) {
+  if (fast.meets(options.mu_tolerance, options.std_relative_tolerance)) return "";
+  if (fast.meets(kShortGridUsefulFactor * options.mu_tolerance, kShortGridUsefulFactor * options.std_relative_tolerance)) return "";
+  char text[256];
+  std::snprintf(text, sizeof text, "its bounds (mu %.3g, std %.3g relative) are more than %g times the tolerances (%.3g, %.3g)",
+                fast.bounds().mu_absolute, fast.bounds().std_relative, kShortGridUsefulFactor, options.mu_tolerance,
+                options.std_relative_tolerance);
+  return text;
+}
+
 }  // namespace mufric

@@ -58,6 +58,28 @@ FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluator
 // The GP's own: its length scales and exact_point_work.
 FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options);
 
+// The default work budget of a GP's grid (FastEvaluatorOptions::max_work), counted in work, never in
+// seconds: a model file must not depend on how busy the machine was (issue 49: a 900-point model was
+// written without its grid on a loaded machine, with it on an idle one). A grid pays off in
+// proportion to the exact model's cost per point, which grows with n as the fit's does: the budget is
+// about what a fit of n points costs, ~100 likelihood evaluations of ~n³ each, and at least
+// kLeastFastEvaluatorWork: a wavy noise-free 900-point model certifies its σ (the wells at its
+// training points) only at 1.7e12 (issue 63: at the earlier 1e11 it stored none and answered at the
+// exact GP's 35 µs a point instead of 0.3; bench/RESULTS.md, "The fast evaluator's default budget").
+inline constexpr double kLeastFastEvaluatorWork = 3e12;
+inline constexpr double kFitLikeEvaluations = 100.0;
+double default_fast_evaluator_work(Eigen::Index training_points);
+
+// One policy for a grid that stops short of its tolerances (train, upgrade and calibrate alike): it is
+// kept with the bound it certified when that bound is within this factor of each tolerance asked —
+// requests that ask no more than the bound use it (the C ABI's std_tolerance=2e-3, say), the others
+// the exact model — and dropped otherwise: a grid no request would use only weighs on the file
+// (issue 30: 57.7 MB for a 2-point model).
+inline constexpr double kShortGridUsefulFactor = 10.0;
+// "" when `fast` is worth storing (it meets the options' tolerances, or comes within the factor);
+// else why not, with the bounds it reached.
+std::string short_grid_refusal(const FastEvaluator& fast, const FastEvaluatorOptions& options);
+
 // The largest errors of `fast` against the exact `model` at the points x (SI, one row each): what
 // the bound is measured from, and what a test checks it with.
 FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const FrictionModel& model, const Eigen::MatrixXd& x);

@@ -12,6 +12,7 @@
 Usage: python_client_test.py --mufric EXE --stubs DIR --examples DIR --c-example EXE --c-driver EXE
                              [--fortran-driver EXE] [--vfriction EXE]"""
 import argparse
+import math
 import os
 import signal
 import subprocess
@@ -35,6 +36,7 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 from mufric.v1 import friction_pb2, friction_pb2_grpc  # noqa: E402
 import evaluate_block  # noqa: E402
+import mufric_channel  # noqa: E402
 
 failures = []
 
@@ -129,11 +131,37 @@ with tempfile.TemporaryDirectory() as tmp:
                 break
             time.sleep(0.05)
         address = (tmp / "address").read_text().strip()
-        answer = evaluate_block.main(address, "law")
+        points = {"contact_pressure": [50e6, 120e6, 180e6], "sliding_velocity": [0.1, 10.0 / 60.0, 14.0 / 60.0],
+                  "fibre_angle": [math.pi / 2] * 3}
+        answer = evaluate_block.main(address, "law", points)
         for mu, p, v in zip(answer.mu, [50.0, 120.0, 180.0], [6.0, 10.0, 14.0]):
             expected = min(max(0.149911 + 0.013133 * v - 0.000753 * p, 0.093755565), 0.322395506)
             check(abs(mu - expected) < 1e-12, f"mu at {p} MPa, {v} m/min = {mu:.9f} (closed form {expected:.9f})")
-        check(list(answer.ignored_inputs) == ["temperature"], "temperature reported as ignored by the law")
+        # Without points, the example asks at the law's own inputs (no temperature: the law has none).
+        spread = evaluate_block.main(address, "law")
+        check(len(spread.mu) == 3 and list(spread.ignored_inputs) == [], "the example reads the law's inputs from DescribeModel")
+        stub = friction_pb2_grpc.FrictionServiceStub(grpc.insecure_channel(address))
+        with_temperature = stub.Evaluate(friction_pb2.EvaluateRequest(model="law", temperature=[293.15] * 3, **points), timeout=10)
+        check(list(with_temperature.ignored_inputs) == ["temperature"], "temperature reported as ignored by the law")
+        # A refusal with the server's retry hint is retried after it; any other error is raised.
+        calls, pauses = [], []
+
+        class Refused(grpc.RpcError):
+            def code(self):
+                return grpc.StatusCode.RESOURCE_EXHAUSTED
+
+            def trailing_metadata(self):
+                return (("mufric-retry-after-ms", "250"),)
+
+        def busy_then_ok(request, timeout, wait_for_ready):
+            calls.append(request)
+            if len(calls) < 3:
+                raise Refused()
+            return "answered"
+
+        result = mufric_channel.call_with_retry(busy_then_ok, "request", timeout=1, sleep=pauses.append)
+        check(result == "answered" and len(calls) == 3 and pauses == [0.25, 0.25],
+              f"call_with_retry: waited the hint twice, then answered ({len(calls)} calls, pauses {pauses})")
         stub = friction_pb2_grpc.FrictionServiceStub(grpc.insecure_channel(address))
         try:
             stub.Evaluate(friction_pb2.EvaluateRequest(model="nope"), timeout=10)

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <string>
 #include <algorithm>
+#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -202,6 +203,8 @@ TEST_F(Cli, TrainWritesTheExactModelWhenNoGridFitsTheCap) {
   const CommandResult r = run("train --data " + path("db.h5") + " --out " + path("gp.h5") + " --restarts 0 --fast-max-mb 0.001");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("fast evaluator (model): not stored: the coarsest grid needs"), std::string::npos) << r.output;
+  // The last line says so (issue 63: a user read only that line and took the exact GP for the fast one).
+  EXPECT_NE(r.output.find("; no fast evaluator: the exact GP answers every request"), std::string::npos) << r.output;
   EXPECT_TRUE(std::filesystem::exists(path("gp.h5")));
   EXPECT_NE(run("describe " + path("gp.h5")).output.find("fast evaluator: none"), std::string::npos);
 }
@@ -245,6 +248,7 @@ TEST_F(Cli, AModelTrainedOnNoiseFreeDataLoadsInEveryCommand) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("noise variance is at its lower bound"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("meets the tolerances"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("; its fast evaluator answers default requests"), std::string::npos) << r.output;
   r = run("describe " + path("gp.h5"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("measured bound: mu"), std::string::npos) << r.output;
@@ -966,7 +970,7 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
     EXPECT_EQ(server.stop(), 0);
   }
 
-  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --steps 8 --burn-in 0 --out " +
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --steps 8 --burn-in 0 --max-steps 0 --out " +
           path("short.csv"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("the posterior is not usable, nothing written: shear_factor"), std::string::npos) << r.output;
@@ -978,7 +982,8 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   EXPECT_NE(r.output.find("outside.csv line 3: contact_pressure 1500MPa lies outside the model's box 300MPa – 1300MPa"), std::string::npos) << r.output;
   r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --fix shear_factor=0.5");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("no input is calibrated"), std::string::npos) << r.output;  // held, nothing left to calibrate
+  EXPECT_NE(r.output.find("every law coefficient of the model (shear_factor) is fixed or measured: nothing to calibrate"),
+            std::string::npos) << r.output;  // held, nothing left to calibrate
   r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --fix sliding_velocity=3m/s");
   EXPECT_NE(r.output.find("--fix 'sliding_velocity=3m/s': the measurements already give sliding_velocity"), std::string::npos)
       << r.output;
@@ -986,6 +991,71 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   r = run("calibrate --model " + path("campaign.h5") + " --data " + path("measured.csv") + " --priors " + path("priors.json"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("parameters.shear_factor.uniform"), std::string::npos) << r.output;
+}
+
+// Data a new user brings that cannot be calibrated, or should not be without a word (issue 63): each
+// refusal names the real cause, each suspicion is a warning, and the output says how to read itself.
+TEST_F(Cli, CalibrateRefusesWhatCannotBeFrictionAndNamesTheCause) {
+  auto synthetic_mu = [](double p_mpa, double v_m_min, double m) {
+    return 0.1 + 0.5 * m * (1.0 - 0.3 * (p_mpa - 300.0) / 1000.0) - 0.05 * (v_m_min - 22.5) / 177.5;
+  };
+  {
+    std::ofstream train(path("campaign.csv")), plain(path("plain.csv"));
+    train << "contact_pressure[MPa],sliding_velocity[m/min],shear_factor,mu\n";
+    plain << "contact_pressure[MPa],sliding_velocity[m/min],mu\n";
+    for (int i = 0; i < 64; ++i) {
+      const double p = 300.0 + 1000.0 * (i % 4) / 3.0, v = 22.5 + 177.5 * ((i / 4) % 4) / 3.0, m = 0.2 + 0.7 * (i / 16) / 3.0;
+      train << p << "," << v << "," << m << "," << synthetic_mu(p, v, m) << "\n";
+      if (i < 16) plain << p << "," << v << "," << synthetic_mu(p, v, 0.5) << "\n";
+    }
+  }
+  ASSERT_EQ(run("train --data " + path("campaign.csv") + " --out " + path("campaign.h5") + " --restarts 1").exit_code, 0);
+  ASSERT_EQ(run("train --data " + path("plain.csv") + " --out " + path("plain.h5") + " --restarts 0").exit_code, 0);
+  auto measurements = [&](const std::string& name, const std::string& header, const std::vector<std::string>& rows) {
+    std::ofstream out(path(name));
+    out << header << "\n";
+    for (const std::string& row : rows) out << row << "\n";
+    return path(name);
+  };
+  const std::string good = measurements("good.csv", "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd",
+                                        {"400,30,0.341,0.01", "800,60,0.318,0.01", "1200,90,0.296,0.01"});
+  const std::string calibrate = "calibrate --model " + path("campaign.h5") + " --walkers 12 --burn-in 200 --steps 600 --data ";
+  // A condition the data forget is an error naming its column, not a coefficient to calibrate.
+  CommandResult r = run(calibrate + measurements("forgot.csv", "contact_pressure[MPa],mu,mu_sd", {"400,0.34,0.01"}));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("the measurements give no sliding_velocity, a condition of the model: add a column "
+                          "sliding_velocity[m/min]"), std::string::npos) << r.output;
+  // Values that cannot be friction, or that nothing in the box reaches.
+  r = run(calibrate + measurements("negative.csv", "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd", {"400,30,-0.3,0.01"}));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("negative.csv line 2: μ -0.3 is negative"), std::string::npos) << r.output;
+  r = run(calibrate + measurements("five.csv", "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd", {"400,30,5,0.05"}));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("five.csv line 2: μ 5 lies"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no coefficient in the model's box reaches it"), std::string::npos) << r.output;
+  // Suspicious but allowed: identical rows, a prior mostly outside the box.
+  std::ofstream(path("edge.json")) << R"({"parameters": {"shear_factor": {"normal": [0.95, 0.1]}}})";
+  r = run(calibrate + measurements("twice.csv", "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd",
+                                   {"400,30,0.341,0.01", "400,30,0.341,0.01", "800,60,0.318,0.01"}) +
+          " --priors " + path("edge.json"));
+  EXPECT_NE(r.output.find("warning: twice.csv line 2 and twice.csv line 3 are identical"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("warning: prior of shear_factor: only 31 % of its prior normal(0.95, 0.1) lies inside the model's box"),
+            std::string::npos) << r.output;
+  // A held value outside the box, a model with nothing to calibrate.
+  r = run(calibrate + good + " --fix shear_factor=1.5");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--fix 'shear_factor=1.5': 1.5 is outside the model's box for shear_factor (0.2 – 0.9)"),
+            std::string::npos) << r.output;
+  r = run("calibrate --model " + path("plain.h5") + " --data " + good);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("this model has no law coefficient to calibrate (its inputs: contact_pressure, sliding_velocity)"),
+            std::string::npos) << r.output;
+  // The reader's guide, and split-R^ to enough digits to see why 1.05042 fails 1.05.
+  r = run("calibrate --model " + path("campaign.h5") + " --walkers 12 --burn-in 300 --steps 1200 --seed 5 --data " + good);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("how to read it: split-R^ compares"), std::string::npos) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("shear_factor +[0-9.]+ +[0-9.]+ +[0-9.]+ \\.\\. [0-9.]+ +1\\.[0-9]{4} ")))
+      << r.output;
 }
 
 // A plan varies a law coefficient as an input when the scene's law reads it, and refuses otherwise.

@@ -766,7 +766,7 @@ TEST_F(Service, AnEvaluationWhoseDeadlinePassedStopsEarly) {
 
 // The memory budget's arithmetic against sums done by hand.
 TEST(MemoryBudget, AdmitsWhatFitsBesideTheCallsInFlightAndALoneCallWhateverItsSize) {
-  server::MemoryBudget budget(100, /*trim_after_bytes=*/150);
+  server::MemoryBudget budget(100);
   auto first = budget.try_reserve(60);
   ASSERT_TRUE(first);
   EXPECT_FALSE(budget.try_reserve(41));  // 60 + 41 > 100
@@ -776,14 +776,25 @@ TEST(MemoryBudget, AdmitsWhatFitsBesideTheCallsInFlightAndALoneCallWhateverItsSi
   first.release();
   second = {};
   EXPECT_EQ(budget.in_use(), 0u);
-  EXPECT_EQ(budget.trims(), 0);  // 100 bytes since idle: under the 150 that asks for a trim
   {
     const auto alone = budget.try_reserve(1000);  // larger than the budget, but nothing else runs
     ASSERT_TRUE(alone);
     EXPECT_FALSE(budget.try_reserve(1));
   }
   EXPECT_EQ(budget.in_use(), 0u);
-  EXPECT_EQ(budget.trims(), 1);  // 1000 bytes went through since the last idle moment
+}
+
+// Freed memory goes back once per busy spell, on its transition to idle (issue 63: it was trimmed
+// every second while the resident size stayed high for reasons a trim cannot fix).
+TEST(IdleTrimmer, TrimsOnceOnEachTransitionFromBusyToIdle) {
+  server::IdleTrimmer trimmer;
+  EXPECT_FALSE(trimmer.poll(0, true));   // nothing served yet
+  EXPECT_FALSE(trimmer.poll(5, false));  // busy
+  EXPECT_TRUE(trimmer.poll(5, true));    // idle after a spell: once
+  for (int second = 0; second < 10; ++second) EXPECT_FALSE(trimmer.poll(5, true));  // still idle: never again
+  EXPECT_FALSE(trimmer.poll(9, false));
+  EXPECT_TRUE(trimmer.poll(9, true));
+  EXPECT_EQ(trimmer.trims(), 2);
 }
 
 // evaluation_bytes counts the request, the batch and the answer twice.
@@ -1050,7 +1061,7 @@ TEST_F(Service, ExtrapolationPolicyIsChosenPerRequest) {
 // file, unary gRPC, the stream and the C ABI — and DescribeModel carries what it was calibrated on
 // and its interval's parts (a campaign over p, v, T and a shear factor m; measurements at m = 0.5).
 TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration) {
-  auto simulator = [](const Eigen::RowVectorXd& x) {
+  auto simulator = [](const Eigen::RowVector4d& x) {  // fixed size: GCC 12 saw a null data pointer in a dynamic one
     const double ps = (x(0) - 300e6) / 1000e6, vs = (x(1) - 0.375) / 2.958, ts = (x(2) - 298.15) / 875.0;
     return 0.1 + 0.5 * x(3) * (1.0 - 0.3 * ps) - 0.05 * vs - 0.03 * ts;
   };
@@ -1085,7 +1096,16 @@ TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration)
     data.mu(i) = simulator(x);
     data.row_names.push_back("row " + std::to_string(i + 1));
   }
-  const CalibrationProblem problem(emulator, data, {"shear_factor"}, {});
+  // Two data sets, the second with a bias of its own, and three temperatures known within 30 K
+  // (issue 60): what the posterior samples of such a model hold must reach every client alike.
+  data.condition_sd = Eigen::MatrixXd::Zero(6, 3);
+  for (const Eigen::Index i : {0, 2, 4}) data.condition_sd(i, 2) = 30.0;
+  data.data_sets = {"cut", "tribometer"};
+  data.data_set_of_row = {0, 0, 0, 1, 1, 1};
+  CalibrationPriors priors;
+  priors.biases.emplace_back("tribometer", Prior{PriorKind::normal, 0.0, 0.05});
+  const CalibrationProblem problem(emulator, data, {"shear_factor"}, priors);
+  ASSERT_EQ(problem.dimension(), 5);
   EnsembleOptions sampler;
   sampler.walkers = 12;
   sampler.burn_in_steps = 200;
@@ -1094,7 +1114,9 @@ TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration)
   CalibrationRecord record;
   record.data_source = "six synthetic rows";
   record.posterior = result.summary;
-  save_model((dir_ / "calibrated.h5").string(), CalibratedModel(emulator, data, {"shear_factor"}, {}, false, result.samples, record));
+  save_model((dir_ / "calibrated.h5").string(),
+             CalibratedModel(std::make_shared<const CalibratedPosterior>(std::make_shared<const CalibrationProblem>(problem), result.samples),
+                             record));
   // A second calibrated model in the folder at start: it is checked in a child forked after the first
   // was loaded (and its OpenMP team started) in the server's process (issue 63).
   std::filesystem::copy_file(dir_ / "calibrated.h5", dir_ / "calibrated_copy.h5");
@@ -1136,14 +1158,28 @@ TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration)
   ASSERT_TRUE(d.has_calibration());
   EXPECT_EQ(d.calibration().data_source(), "six synthetic rows");
   EXPECT_EQ(d.calibration().measurements(), 6u);
-  ASSERT_EQ(d.calibration().parameters_size(), 1);
+  // Every posterior coordinate, SI: the coefficient, the tribometer's bias, the three temperatures.
+  ASSERT_EQ(d.calibration().parameters_size(), 5);
   EXPECT_EQ(d.calibration().parameters(0).name(), "shear_factor");
+  EXPECT_EQ(d.calibration().parameters(1).name(), "bias[tribometer]");
+  EXPECT_EQ(d.calibration().parameters(2).name(), "temperature (row 1)");
   EXPECT_LE(d.calibration().parameters(0).lo95(), 0.5);
   EXPECT_GE(d.calibration().parameters(0).hi95(), 0.5);
   const auto& parts = d.calibration().at_box_centre();
   EXPECT_NEAR(parts.sd() * parts.sd(), parts.parameter_sd() * parts.parameter_sd() + parts.conditional_sd() * parts.conditional_sd(),
               1e-12);
   EXPECT_GT(parts.parameter_sd(), 0.0);
+  // The C++ client's ModelInfo carries the same, structured, in-process and over gRPC.
+  for (const std::string& uri : std::vector<std::string>{"file://" + (dir_ / "calibrated.h5").string(), "grpc://" + server.address() + "/calibrated"}) {
+    const client::ModelInfo info = client::connect(uri)->describe();
+    ASSERT_TRUE(info.calibration.has_value()) << uri;
+    ASSERT_EQ(info.calibration->parameters.size(), 5u) << uri;
+    EXPECT_EQ(info.calibration->parameters[1].name, "bias[tribometer]") << uri;
+    EXPECT_EQ(info.calibration->parameters[0].lo95, d.calibration().parameters(0).lo95()) << uri;
+    EXPECT_EQ(info.calibration->sd, parts.sd()) << uri;
+    EXPECT_EQ(info.calibration->measurements, 6) << uri;
+  }
+  EXPECT_FALSE(client::connect("grpc://" + server.address() + "/gp")->describe().calibration.has_value());
   // A GP's description carries none.
   grpc::ClientContext gp_context;
   request.set_model("gp");

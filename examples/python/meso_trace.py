@@ -16,7 +16,7 @@ import math
 import grpc
 import numpy as np
 from mufric.v1 import friction_pb2, friction_pb2_grpc
-from mufric_channel import open_channel
+from mufric_channel import call_with_retry, open_channel
 
 HUMAN = {"contact_pressure": (1e-6, "MPa"), "sliding_velocity": (60.0, "m/min"), "temperature": (1.0, "K")}
 
@@ -31,7 +31,7 @@ def human(name, value):
 def evaluate(stub, model, p, v, t):
     request = friction_pb2.EvaluateRequest(model=model, contact_pressure=p, sliding_velocity=v, temperature=t,
                                            std=True, ci_level=0.95)
-    return stub.Evaluate(request, timeout=30, wait_for_ready=True)
+    return call_with_retry(stub.Evaluate, request, timeout=30)
 
 
 def trace(stub, model, box, points, increments, seed):
