@@ -60,32 +60,15 @@ QuantityKind coordinate_kind(const CalibrationProblem& problem, Eigen::Index j) 
   return QuantityKind::dimensionless;
 }
 
-std::string human(double value_si, QuantityKind kind) {
-  if (kind == QuantityKind::dimensionless) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.4g", value_si);
-    return text;
-  }
-  return format_human(value_si, kind);
-}
-
-std::string human_difference(double value_si, QuantityKind kind) {
-  if (kind == QuantityKind::temperature) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.4g K", value_si);
-    return text;
-  }
-  return human(value_si, kind);
-}
 
 void print_summary(const CalibrationProblem& problem, const CalibrationResult& result, double seconds) {
   std::printf("%-40s %12s %12s %27s %9s %7s\n", "parameter", "mean", "sd", "95 % credible interval", "split-R^", "ESS");
   for (size_t j = 0; j < result.summary.size(); ++j) {
     const ParameterSummary& s = result.summary[j];
     const QuantityKind kind = coordinate_kind(problem, static_cast<Eigen::Index>(j));
-    const std::string interval = human(s.lo95, kind) + " .. " + human(s.hi95, kind);
-    std::printf("%-40s %12s %12s %27s %9.4f %7.0f\n", s.name.c_str(), human(s.mean, kind).c_str(),
-                human_difference(s.sd, kind).c_str(), interval.c_str(), s.split_rhat, s.effective_sample_size);
+    const std::string interval = format_human(s.lo95, kind) + " .. " + format_human(s.hi95, kind);
+    std::printf("%-40s %12s %12s %27s %9.4f %7.0f\n", s.name.c_str(), format_human(s.mean, kind).c_str(),
+                format_human_difference(s.sd, kind).c_str(), interval.c_str(), s.split_rhat, s.effective_sample_size);
   }
   std::printf("%d walkers x %d steps after %d burn-in, seed %llu; acceptance %.2f; %.1f s\n", result.options.walkers,
               result.options.steps, result.options.burn_in_steps, static_cast<unsigned long long>(result.options.seed),
@@ -181,7 +164,7 @@ void calibrate_command(const CalibrateOptions& o) {
     std::printf("  prior of %s: %s\n", name.c_str(), problem.prior_of(k).describe(kind_of_input(name)).c_str());
   }
   for (const auto& [name, value] : problem.held()) {
-    std::printf("  held: %s = %s\n", name.c_str(), human(value, kind_of_input(name)).c_str());
+    std::printf("  held: %s = %s\n", name.c_str(), format_human(value, kind_of_input(name)).c_str());
   }
   for (const auto& [set, prior] : problem.priors().biases) {
     std::printf("  bias of data set %s: %s\n", set.c_str(), prior.describe().c_str());

@@ -159,6 +159,12 @@ double si_to_human(double value_si, QuantityKind kind) {
   }
 }
 
+std::string format_human_difference(double value_si, QuantityKind kind, int precision) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*g", precision, si_to_human(value_si, kind) - si_to_human(0.0, kind));
+  return std::string(text) + (kind == QuantityKind::temperature ? " K" : std::string(human_unit(kind)));
+}
+
 std::string format_human(double value_si, QuantityKind kind, int precision) {
   char text[64];
   std::snprintf(text, sizeof text, "%.*g", precision, si_to_human(value_si, kind));

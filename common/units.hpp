@@ -32,6 +32,9 @@ double parse_quantity(std::string_view text, QuantityKind expected, std::string_
 
 // Formats an SI value in the unit people use for that kind (MPa, m/min, °C, deg).
 std::string format_human(double value_si, QuantityKind kind, int precision = 4);
+// A difference of two SI values (an SD, a half-width) in the same human unit, without the offset of
+// °C: a temperature difference in K ("50 K").
+std::string format_human_difference(double value_si, QuantityKind kind, int precision = 4);
 // The human unit used by format_human, e.g. "MPa".
 std::string_view human_unit(QuantityKind kind);
 double si_to_human(double value_si, QuantityKind kind);

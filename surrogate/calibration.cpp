@@ -123,14 +123,6 @@ std::string Prior::describe() const {
 }
 
 namespace {
-// A difference of two SI values in the human unit of a kind (a temperature SD in K, not °C).
-std::string format_human_difference(double value_si, QuantityKind kind) {
-  char text[64];
-  const double scaled = si_to_human(value_si, kind) - si_to_human(0.0, kind);
-  std::snprintf(text, sizeof text, "%.4g", scaled);
-  return std::string(text) + (kind == QuantityKind::temperature ? " K" : std::string(human_unit(kind)));
-}
-
 double standard_normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 }  // namespace
 

@@ -317,7 +317,8 @@ ContactInterface zorev_law(double shear_factor, double adhesive_coefficient, dou
   return with_law(std::make_shared<ZorevLaw>(LawCoefficients{adhesive_coefficient, shear_factor}), tangential);
 }
 
-// The same slid flat chip under the shear-factor law, τ = m k in slip whatever the pressure, and
+// The same slid flat chip under the shear-factor law, τ = m k in slip (within e^−20 of it at these
+// pressures, its onset aside: 2e-9, inside the tolerance), and
 // under Zorev's, τ = min(μ_a p, m k): the Coulomb branch below the switch, the shear branch above it
 // (closed forms).
 TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
@@ -387,7 +388,10 @@ TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
   const auto table = std::make_shared<const AdhesionTable>(AdhesionTable::read(table_path.string()));
   const std::vector<Case> cases = {
       {with_law(std::make_shared<CoulombLaw>(mu_a, mu_wet), tangential), mu_a * pressure, mu_wet * pressure},
-      {with_law(std::make_shared<ShearFactorLaw>(m, m_wet), tangential), m * k, m_wet * k},
+      // m k reached from an opening point by the law's steep Childs onset: 1 − e^(−μ₀ P/(m k)) of it.
+      {with_law(std::make_shared<ShearFactorLaw>(m, m_wet), tangential),
+       -m * k * std::expm1(-kShearFactorOnsetCoefficient * pressure / (m * k)),
+       -m_wet * k * std::expm1(-kShearFactorOnsetCoefficient * pressure / (m_wet * k))},
       {with_law(std::make_shared<TableLaw>(table, mu_wet), tangential), 0.4 * pressure, mu_wet * pressure}};
   for (const Case& c : cases) {
     solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
@@ -524,6 +528,31 @@ TEST(ChildsLaw, BlendsCoulombIntoTheYieldShearWithTheSlopeItsLimitHas) {
 // Childs' tangent against central differences on the rough pair, with points in stick and in slip on
 // the blend: k at each point is set from its pressure so that μ_a P/(m k) is 0.5, 1 or 2 (the
 // pressure depends on the gap alone, so k does not move it), where neither asymptote is the law.
+// The shear-factor law reaches m k from an opening point (issue 63: taken as m k at any P > 0 it jumped
+// where asperity contacts open and close, and the default scene cut back 883 times without finishing):
+// 0 as P → 0 with slope μ₀, m k within e^−20 from P = m k on, and its slope the limit's derivative.
+TEST(ShearFactorLaw, ReachesMKFromAnOpeningPointWithTheSlopeItsLimitHas) {
+  const double m = 0.5, k = 2e8, mk = m * k;
+  const ShearFactorLaw law(m);
+  ContactPointState point;
+  point.shear_strength = k;
+  point.pressure = 1e-3 * mk;  // barely in contact: Coulomb-like, μ₀ P
+  EXPECT_NEAR(law.slip_limit(point).shear, kShearFactorOnsetCoefficient * point.pressure, 0.02 * kShearFactorOnsetCoefficient * point.pressure);
+  for (const double share : {1.0, 3.0, 30.0}) {
+    point.pressure = share * mk;
+    EXPECT_NEAR(law.slip_limit(point).shear, mk, 2.1e-9 * mk) << share;
+  }
+  for (const double share : {0.01, 0.05, 0.2, 1.0}) {
+    point.pressure = share * mk;
+    const double h = 1e-6 * point.pressure;
+    ContactPointState above = point, below = point;
+    above.pressure += h;
+    below.pressure -= h;
+    const double slope = (law.slip_limit(above).shear - law.slip_limit(below).shear) / (2.0 * h);
+    EXPECT_NEAR(law.slip_limit(point).dshear_dpressure, slope, 1e-6 * kShearFactorOnsetCoefficient) << share;
+  }
+}
+
 TEST(ChildsLaw, ContactTangentIsTheExactLinearisationOnTheBlend) {
   const auto [chip_surface, tool_surface] = rough_surfaces_in_contact();
   solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(chip_surface, -0.5, 2, 3)),

@@ -109,19 +109,16 @@ TEST(Scene, ShippedScenesStateTheBuiltInDefaultsExceptTheirDeclaredChoices) {
 TEST(Scene, TheTi6Al4VSceneHoldsItsSourcesMaterialTable) {
   const std::string file = std::string(MUFRIC_SOURCE_DIR) + "/micro/scene/ti6al4v_tin.json";
   const Scene scene = parse_scene(read_scene_json(file), file);
-  const auto& jc = scene.material;
-  EXPECT_DOUBLE_EQ(jc.youngs_modulus, 113.8e9);
-  EXPECT_DOUBLE_EQ(jc.poisson_ratio, 0.34);
-  EXPECT_DOUBLE_EQ(jc.density, 4430.0);
-  EXPECT_DOUBLE_EQ(jc.a, 997.9e6);
-  EXPECT_DOUBLE_EQ(jc.b, 653.1e6);
-  EXPECT_DOUBLE_EQ(jc.c, 0.0198);
-  EXPECT_DOUBLE_EQ(jc.m, 0.7);
-  EXPECT_DOUBLE_EQ(jc.n, 0.45);
-  EXPECT_DOUBLE_EQ(jc.reference_strain_rate, 1.0);
-  EXPECT_DOUBLE_EQ(jc.transition_temperature, 293.0);
-  EXPECT_DOUBLE_EQ(jc.melting_temperature, 1873.0);
-  EXPECT_DOUBLE_EQ(jc.specific_heat, 531.0);
+  const std::vector<std::pair<double solid::JohnsonCookParameters::*, double>> table = {
+      {&solid::JohnsonCookParameters::youngs_modulus, 113.8e9}, {&solid::JohnsonCookParameters::poisson_ratio, 0.34},
+      {&solid::JohnsonCookParameters::density, 4430.0},         {&solid::JohnsonCookParameters::a, 997.9e6},
+      {&solid::JohnsonCookParameters::b, 653.1e6},              {&solid::JohnsonCookParameters::c, 0.0198},
+      {&solid::JohnsonCookParameters::m, 0.7},                  {&solid::JohnsonCookParameters::n, 0.45},
+      {&solid::JohnsonCookParameters::reference_strain_rate, 1.0},
+      {&solid::JohnsonCookParameters::transition_temperature, 293.0},
+      {&solid::JohnsonCookParameters::melting_temperature, 1873.0},
+      {&solid::JohnsonCookParameters::specific_heat, 531.0}};
+  for (size_t k = 0; k < table.size(); ++k) EXPECT_DOUBLE_EQ(scene.material.*table[k].first, table[k].second) << "row " << k;
   EXPECT_DOUBLE_EQ(scene.conductivity, 6.3);
   EXPECT_EQ(scene.contact_interface.law->name(), "childs");
   EXPECT_TRUE(scene.warnings.empty());

@@ -169,5 +169,16 @@ TEST(Ploughing, AWedgeOnAPerfectlyPlasticChipFollowsTheWaveModel) {
   std::filesystem::remove_all(dir);
 }
 
+// The shear-factor law at the default point, the README's own example (issue 63: it stopped after 883
+// cut-backs, out of its 900 s): one draw of the default scene completes, with few cut-backs.
+TEST(InterfaceLawRuns, TheShearFactorLawCompletesAtTheDefaultPoint) {
+  nlohmann::json j = default_scene_json();
+  for (const char* o : {"protocol.realisations=1", "contact.law=\"shear-factor\"", "contact.shear_factor=0.5"}) apply_override(j, o);
+  const MuMeasurement m = measure(j, "shear factor");
+  ASSERT_TRUE(m.completed) << m.reason;
+  EXPECT_GT(m.mu, 0.25);  // adhesion on top of the default scene's ploughing (0.18)
+  EXPECT_LT(m.draws.front().result.solver.cutbacks.size(), 40U);
+}
+
 }  // namespace
 }  // namespace mufric::scene

@@ -45,7 +45,11 @@ ShearFactorLaw::ShearFactorLaw(double shear_factor, double wetted_shear_factor)
     : CoefficientLaw({.shear_factor = shear_factor}, {.shear_factor = wetted_shear_factor}) {}
 
 SlipLimit ShearFactorLaw::slip_limit(const ContactPointState& point) const {
-  return {at(point).shear_factor * point.shear_strength, 0.0};
+  // L = m k (1 − e^−x), x = μ₀ P/(m k); dL/dP = μ₀ e^−x.
+  const double yield_shear = at(point).shear_factor * point.shear_strength;
+  if (!(yield_shear > 0.0) || !(point.pressure > 0.0)) return {0.0, 0.0};
+  const double x = kShearFactorOnsetCoefficient * point.pressure / yield_shear;
+  return {-yield_shear * std::expm1(-x), kShearFactorOnsetCoefficient * std::exp(-x)};
 }
 
 ZorevLaw::ZorevLaw(LawCoefficients dry, LawCoefficients wetted) : CoefficientLaw(dry, wetted) {}

@@ -71,7 +71,13 @@ class CoulombLaw final : public CoefficientLaw {
   SlipLimit slip_limit(const ContactPointState& point) const override;
 };
 
-// |τ| ≤ m k, k the chip's shear yield stress at the point (Johnson–Cook / √3).
+// |τ| ≤ m k, k the chip's shear yield stress at the point (Johnson–Cook / √3), reached smoothly from
+// an opening contact point: m k [1 − exp(−μ₀ P/(m k))] with μ₀ = kShearFactorOnsetCoefficient, i.e.
+// Childs' smooth law (Childs 2006, Wear 260:310) with n = 1 and a steep Coulomb onset. Taken as
+// written (m k at any P > 0, nothing at P = 0), the limit jumps where an asperity's contact opens or
+// closes, and Newton cut back 883 times at the default point without finishing (issue 63); with the
+// onset it is m k to within e^−20 (2e-9) wherever P ≥ m k, which is every point carrying load.
+inline constexpr double kShearFactorOnsetCoefficient = 20.0;
 class ShearFactorLaw final : public CoefficientLaw {
  public:
   explicit ShearFactorLaw(double shear_factor, double wetted_shear_factor = kDefaultWettedShearFactor);
