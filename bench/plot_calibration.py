@@ -3,17 +3,19 @@
 above all) and any measurements CSV `mufric calibrate` reads (conditions with units, optional
 NAME_sd / NAME_min / NAME_max columns, mu, mu_sd).
 
-Left: the measured mu (error bars: +-1.96 mu_sd) and what the model serves at each row's stated
-conditions (mu and its 95 % interval), against one condition (--x); between neighbouring rows the
+Left: the measured mu (error bars: +-1.96 mu_sd) and what each model serves at each row's stated
+conditions (mu and its 95 % interval), against one condition (--x); between neighbouring rows a
 model is also drawn along the straight line joining their conditions, so a trend along a cutting
-speed (where pressure, velocity and temperature all move) shows as a band. Right, with --posterior:
-each calibrated coefficient's posterior histogram (calibrate --out's CSV; columns that are not model
-inputs' law coefficients are left out).
+speed (where pressure, velocity and temperature all move) shows as a band. Right, with --posterior
+(repeatable, one per model, or one): each calibrated coefficient's posterior histogram (calibrate
+--out's CSV; only the law's coefficients), and with --truth NAME=VALUE the value that made the data,
+when it is known (a recovery study).
 
   /usr/bin/python3 bench/plot_calibration.py --mufric build/app/mufric --model ti6al4v_tin \\
       --data data/cirp2022_ti6al4v_tin/rake_face_mu_0deg.csv --x sliding_velocity --out mu.png
-Several --data files are drawn each in its colour; --label names them (default: the file's stem);
---compare FILE:LABEL adds a CSV of (x, mu) rows to draw as a line (e.g. a tabulated law)."""
+Several --data files are drawn each in its marker; --label names them (default: the file's stem);
+--model is repeatable, --model-label names each; --compare FILE:LABEL adds a CSV of (x, mu) rows to
+draw as a line (e.g. a tabulated law). bench/recovery_calibration.sh draws its study with it."""
 import argparse
 import csv
 import io
@@ -90,11 +92,13 @@ def predict(mufric, model, columns, points):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--mufric", default="mufric")
-    parser.add_argument("--model", required=True, help="a model URI or file mufric predict reads")
+    parser.add_argument("--model", action="append", required=True, help="a model URI or file mufric predict reads (repeatable)")
+    parser.add_argument("--model-label", action="append", help="a label per --model")
     parser.add_argument("--data", action="append", required=True, help="a measurements CSV (repeatable)")
     parser.add_argument("--label", action="append", help="a label per --data")
     parser.add_argument("--x", help="the condition along the horizontal axis (default: the first column)")
-    parser.add_argument("--posterior", help="calibrate --out's CSV: the coefficients' histograms")
+    parser.add_argument("--posterior", action="append", default=[], help="calibrate --out's CSV (repeatable, per --model)")
+    parser.add_argument("--truth", action="append", default=[], help="NAME=VALUE: a coefficient's known value")
     parser.add_argument("--compare", action="append", default=[], help="CSV:LABEL of (x, mu) rows drawn as a line")
     parser.add_argument("--title", default="")
     parser.add_argument("--out", required=True)
@@ -113,30 +117,37 @@ def main():
         sys.exit(f"plot_calibration: --x {args.x} is not among the conditions {columns}")
     x_index = columns.index(x_column)
 
+    models = args.model
+    model_labels = args.model_label or [os.path.splitext(os.path.basename(m))[0] for m in models]
+    if len(model_labels) != len(models):
+        sys.exit("plot_calibration: give one --model-label per --model")
     panels = 2 if args.posterior else 1
     fig, axes = plt.subplots(1, panels, figsize=(6.2 * panels, 4.4), squeeze=False)
     left = axes[0][0]
-    colours = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
+    colours = ["tab:blue", "tab:orange", "tab:green", "tab:purple"]
+    markers = ["s", "^", "D", "v"]
     for k, (rows, label) in enumerate(zip(sets, labels)):
-        colour = colours[k % len(colours)]
         points = np.array([[stated(r, c) for c in columns] for r in rows])
         mu = np.array([float(r["mu"]) for r in rows])
         sd = np.array([float(r["mu_sd"]) for r in rows])
         order = np.argsort(points[:, x_index])
         points, mu, sd = points[order], mu[order], sd[order]
-        left.errorbar(points[:, x_index], mu, yerr=1.96 * sd, fmt="s", color=colour, capsize=3,
+        left.errorbar(points[:, x_index], mu, yerr=1.96 * sd, fmt=markers[k % len(markers)], color="k", capsize=3,
                       label=f"{label}: measured (±1.96 SD)")
-        # The model along the straight lines between neighbouring rows' conditions.
+        # Each model along the straight lines between neighbouring rows' conditions.
         path = [points[0]]
         for a, b in zip(points[:-1], points[1:]):
             for t in np.linspace(0.0, 1.0, 21)[1:]:
                 path.append(a + t * (b - a))
         path = np.array(path)
-        served, lo, hi = predict(args.mufric, args.model, columns, path)
-        left.fill_between(path[:, x_index], lo, hi, color=colour, alpha=0.18, lw=0)
-        left.plot(path[:, x_index], served, color=colour, lw=1.2, label=f"{label}: model, 95 % interval")
-        at_rows, lo_rows, hi_rows = predict(args.mufric, args.model, columns, points)
-        left.plot(points[:, x_index], at_rows, "o", color=colour, mfc="white", ms=5)
+        for j, (model, model_label) in enumerate(zip(models, model_labels)):
+            colour = colours[j % len(colours)]
+            served, lo, hi = predict(args.mufric, model, columns, path)
+            left.fill_between(path[:, x_index], lo, hi, color=colour, alpha=0.18, lw=0)
+            left.plot(path[:, x_index], served, color=colour, lw=1.2,
+                      label=f"{model_label}, 95 % interval" if k == 0 else None)
+            at_rows, _, _ = predict(args.mufric, model, columns, points)
+            left.plot(points[:, x_index], at_rows, "o", color=colour, mfc="white", ms=5)
     for spec in args.compare:
         path, _, label = spec.partition(":")
         rows = read_rows(path)
@@ -145,19 +156,24 @@ def main():
     left.set_xlabel(x_column)
     left.set_ylabel("μ")
     left.legend(fontsize=7)
-    left.set_title(args.title or f"{args.model} against the measurements")
+    left.set_title(args.title or "served against the measurements")
 
     if args.posterior:
         right = axes[0][1]
-        samples = read_rows(args.posterior)
-        for k, name in enumerate(c for c in samples[0] if c in LAW_COEFFICIENTS):
-            values = np.array([float(r[name]) for r in samples])
-            lo, hi = np.quantile(values, [0.025, 0.975])
-            right.hist(values, bins=60, density=True, histtype="step", lw=1.5, color=colours[k % len(colours)],
-                       label=f"{name}: 95 % {lo:.3g}–{hi:.3g}")
+        for j, path in enumerate(args.posterior):
+            samples = read_rows(path)
+            owner = model_labels[j] if len(args.posterior) == len(models) else os.path.basename(path)
+            for k, name in enumerate(c for c in samples[0] if c in LAW_COEFFICIENTS):
+                values = np.array([float(r[name]) for r in samples])
+                lo, hi = np.quantile(values, [0.025, 0.975])
+                right.hist(values, bins=60, density=True, histtype="step", lw=1.5,
+                           color=colours[(j + k) % len(colours)], label=f"{owner}: {name}, 95 % {lo:.3g}–{hi:.3g}")
+        for truth in args.truth:
+            name, _, value = truth.partition("=")
+            right.axvline(float(value), color="k", ls="--", label=f"{name}* = {value}")
         right.set_xlabel("coefficient")
         right.set_ylabel("posterior density")
-        right.legend(fontsize=8)
+        right.legend(fontsize=7)
         right.set_title("the law's coefficients")
     fig.tight_layout()
     fig.savefig(args.out, dpi=130)

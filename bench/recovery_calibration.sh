@@ -3,7 +3,7 @@
 # the micro-model made at m* = 0.55 (campaigns/recovery_childs/measure.sh), through the GP of the
 # campaign over (p, v, T, m) (campaigns/recovery_childs/run.sh; its samples so far). Prints m's
 # posterior with and without the discrepancy delta, whether m* lies inside its 95 % credible
-# interval, writes the calibrated models and draws recovery.png (bench/plot_recovery.py); figures go to
+# interval, writes the calibrated models and draws recovery.png (bench/plot_calibration.py); figures go to
 # bench/RESULTS.md by hand.
 #   bash bench/recovery_calibration.sh [--mufric PATH] [--out DIR]
 set -euo pipefail
@@ -61,4 +61,13 @@ for variant in "" "--discrepancy"; do
     "$out/calibrate${variant}.txt"
 done
 # The picture: m's posterior against m*, and what each calibrated model serves at the measured conditions.
-/usr/bin/python3 "$here/bench/plot_recovery.py" "$mufric" "$out" "$m_star" "$out/recovery.png"
+models=() posteriors=()
+for variant in "" "--discrepancy"; do
+  if [[ -f $out/calibrated${variant}.h5 ]]; then
+    models+=(--model "$out/calibrated${variant}.h5" --model-label "calibrated, δ ${variant:+on}${variant:-off}")
+    posteriors+=(--posterior "$out/posterior${variant}.csv")
+  fi
+done
+((${#models[@]} > 0)) && /usr/bin/python3 "$here/bench/plot_calibration.py" --mufric "$mufric" "${models[@]}" "${posteriors[@]}" \
+  --data "$out/measured.csv" --label "micro-model at m*" --x temperature --truth "shear_factor=$m_star" \
+  --title "recovery: served at the measured conditions (a fit, not a held-out check)" --out "$out/recovery.png"
