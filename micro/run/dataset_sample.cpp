@@ -44,12 +44,10 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     for (size_t j = 0; j < known.size(); ++j) corner.push_back({known[j]->scene_key, upper ? inputs[j].hi : inputs[j].lo, known[j]->kind});
     const Scene read = scene_with_values(scene, corner);
     for (const KnownInput* k : known) {
-      const std::string unread = std::string(k->scene_key) + " is read but has no effect";
-      for (const std::string& warning : read.warnings) {
-        if (warning.rfind(unread, 0) == 0) {
-          throw Error("input '" + std::string(k->name) + "' sets " + std::string(k->scene_key) + ", which has no effect" +
-                      warning.substr(unread.size()) + " (choose a law that reads it with --set contact.law=...)");
-        }
+      const auto unread = read.ineffective_keys.find(std::string(k->scene_key));
+      if (unread != read.ineffective_keys.end()) {
+        throw Error("input '" + std::string(k->name) + "' sets " + std::string(k->scene_key) + ", which has no effect: " +
+                    unread->second + " (choose a law that reads it with --set contact.law=...)");
       }
     }
   }

@@ -10,109 +10,14 @@
 #include "common/files.hpp"
 #include "common/units.hpp"
 #include "micro/contact/interface_laws.hpp"
+#include "micro/settings/option_keys.hpp"
 
 namespace mufric::scene {
 namespace {
 
 using nlohmann::json;
 
-// One JSON object of the scene: typed reads with ranges, and a check that no key was left unread.
-class Section {
- public:
-  Section(const json& j, std::string path, const std::string& source) : j_(j), path_(std::move(path)), source_(source) {
-    if (!j_.is_object()) fail("", "must be an object");
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& message) const {
-    throw Error(source_ + ": " + name(key) + ": " + message);
-  }
-  std::string name(const std::string& key) const { return path_.empty() ? key : key.empty() ? path_ : path_ + "." + key; }
-  bool has(const std::string& key) const { return j_.contains(key); }
-  const json* take(const std::string& key) {
-    used_.insert(key);
-    return j_.contains(key) ? &j_.at(key) : nullptr;
-  }
-  double quantity(const std::string& key, QuantityKind kind, double fallback, double lo, double hi) {
-    const json* v = take(key);
-    if (v == nullptr) return fallback;
-    if (!v->is_string()) {
-      fail(key, "give a value with its unit as a string, e.g. \"" + std::string(example_quantity(kind)) + "\"");
-    }
-    double x = 0.0;
-    try {
-      x = parse_quantity(v->get<std::string>(), kind, name(key));
-    } catch (const Error& e) {
-      throw Error(source_ + ": " + e.what());  // the file too, as for every other key's error
-    }
-    if (!(x >= lo && x <= hi)) {
-      fail(key, v->get<std::string>() + " is outside [" + format_human(lo, kind) + ", " + format_human(hi, kind) + "]");
-    }
-    return x;
-  }
-  double number(const std::string& key, double fallback, double lo, double hi) {
-    const json* v = take(key);
-    if (v == nullptr) return fallback;
-    if (!v->is_number()) fail(key, "must be a number");
-    const double x = v->get<double>();
-    if (!(x >= lo && x <= hi)) fail(key, std::to_string(x) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return x;
-  }
-  int integer(const std::string& key, int fallback, int lo, int hi) {
-    const json* v = take(key);
-    if (v == nullptr) return fallback;
-    if (!v->is_number_integer()) fail(key, "must be an integer");
-    const auto x = v->get<long long>();
-    if (x < lo || x > hi) fail(key, std::to_string(x) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return static_cast<int>(x);
-  }
-  bool boolean(const std::string& key, bool fallback) {
-    const json* v = take(key);
-    if (v == nullptr) return fallback;
-    if (!v->is_boolean()) fail(key, "must be true or false");
-    return v->get<bool>();
-  }
-  std::string text(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
-    const json* v = take(key);
-    if (v == nullptr) return fallback;
-    if (!v->is_string()) fail(key, "must be a string");
-    const auto s = v->get<std::string>();
-    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(key, "'" + s + "' is not one of: " + list);
-    }
-    return s;
-  }
-  // A word from the choice's one table (SceneChoice<E>::names).
-  template <class E>
-  E choice(const std::string& key, E fallback) {
-    const json* v = take(key);
-    if (v == nullptr) return fallback;
-    if (!v->is_string()) fail(key, "must be a string");
-    const auto word = v->get<std::string>();
-    std::string list;
-    for (const auto& c : SceneChoice<E>::names) {
-      if (word == c.name) return c.value;
-      list += (list.empty() ? "" : ", ") + std::string(c.name);
-    }
-    fail(key, "'" + word + "' is not one of: " + list);
-  }
-  Section child(const std::string& key) {
-    static const json empty = json::object();
-    const json* v = take(key);
-    return Section(v ? *v : empty, name(key), source_);
-  }
-  void finish() const {
-    for (const auto& [key, value] : j_.items()) {
-      if (!used_.count(key)) fail(key, "unknown key");
-    }
-  }
-
- private:
-  const json& j_;
-  std::string path_;
-  const std::string& source_;
-  std::set<std::string> used_;
-};
+using Section = OptionKeys;
 
 constexpr double kHuge = 1e300;
 
@@ -204,16 +109,12 @@ class SceneLawKeys final : public contact::LawKeys {
 
 // Another law's key that this one leaves unread is a warning, not an error: switching laws with
 // --set keeps a scene's other coefficients.
-void warn_about_other_laws_keys(Section& contact, Section& wetted, const contact::InterfaceLawEntry& law, Scene& s) {
+void warn_about_other_laws_keys(Section& contact, Section& wetted, const contact::InterfaceLawEntry& law) {
   for (const auto& other : contact::interface_laws()) {
     for (const std::string_view key : other.keys) {
       if (std::find(law.keys.begin(), law.keys.end(), key) != law.keys.end()) continue;
       auto [section, name] = law_key_section(key, contact, wetted);
-      if (!section.has(name)) continue;
-      section.take(name);
-      const std::string warning = "contact." + std::string(key) + " is read but has no effect: contact.law is " +
-                                  std::string(law.name);
-      if (std::find(s.warnings.begin(), s.warnings.end(), warning) == s.warnings.end()) s.warnings.push_back(warning);
+      section.ineffective(name, "contact.law is " + std::string(law.name));
     }
   }
 }
@@ -232,29 +133,27 @@ void read_contact(Section c, Scene& s, const std::string& base_directory) {
   SceneLawKeys keys(c, wetted, entry, base_directory);
   contact::ContactInterface& interface = s.contact_interface;
   interface.law = entry.read(keys);
-  warn_about_other_laws_keys(c, wetted, entry, s);
+  warn_about_other_laws_keys(c, wetted, entry);
   wetted.finish();
   const bool frictional = interface.law->frictional();
-  for (const char* key : {"tangential_penalty", "heat_partition"}) {
-    if (!frictional && c.has(key)) {
-      s.warnings.push_back("contact." + std::string(key) + " is read but has no effect: contact.law is " + law_name);
-    }
-  }
   // Stick's regularisation; absent, 0: the contact's default, a tenth of the normal penalty
-  // (contact::kTangentialPenaltyRatio, applied in one place, MortarContact).
-  interface.tangential_penalty = c.number("tangential_penalty", 0.0, 1e3, 1e30);
-  // The share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
-  interface.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, contact::kHeatPartitionRange.lo,
-                                      contact::kHeatPartitionRange.hi);
+  // (contact::kTangentialPenaltyRatio, applied in one place, MortarContact). The heat partition: the
+  // share of the frictional heat that enters the chip (contact::kDefaultHeatPartition says why 0.5).
+  if (frictional) {
+    interface.tangential_penalty = c.number("tangential_penalty", 0.0, 1e3, 1e30);
+    interface.heat_partition = c.number("heat_partition", contact::kDefaultHeatPartition, contact::kHeatPartitionRange.lo,
+                                        contact::kHeatPartitionRange.hi);
+  } else {
+    for (const char* key : {"tangential_penalty", "heat_partition"}) c.ineffective(key, "contact.law is " + law_name);
+  }
   // Wetted spots take the law's wetted coefficients (contact::kDefaultWetted* say where the defaults
   // come from); only a lubricated scene has a film to wet them.
   if (has_wetted && frictional && s.physics != Physics::lubricated) {
-    s.warnings.push_back("contact.wetted is read but has no effect: the scene's physics is dry (no film wets a spot)");
+    c.report().warn("contact.wetted is read but has no effect: the scene's physics is dry (no film wets a spot)");
   }
   if (frictional && !s.heat_conduction()) {
-    s.warnings.push_back("the frictional heat of contact.law " + law_name +
-                         " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in "
-                         "through the surface)");
+    c.report().warn("the frictional heat of contact.law " + law_name +
+                    " is not passed to the chip: thermal.model is adiabatic (only conduction takes heat in through the surface)");
   }
   c.finish();
 }
@@ -492,7 +391,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   s.source = source;
   s.base_directory = base_directory;
   s.effective = j;
-  Section root(j, "", source);
+  OptionReport report;
+  Section root(j, "", source, report);
   s.physics = root.choice("physics", s.physics);
   read_geometry(root.child("geometry"), s, base_directory);
   read_discretisation(root.child("discretisation"), s);
@@ -506,8 +406,14 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   read_solver(root.child("solver"), s);
   root.finish();
   if (s.physics == Physics::dry && j.contains("lubricant")) {
-    s.warnings.push_back("lubricant.* is read but has no effect: the scene's physics is dry (physics=lubricated to use it)");
+    // Every lubricant key given is without effect (a dataset varying one would vary nothing).
+    for (const auto& [key, value] : j.at("lubricant").items()) {
+      report.ineffective_keys.emplace("lubricant." + key, "the scene's physics is dry");
+    }
+    report.warn("lubricant.* is read but has no effect: the scene's physics is dry (physics=lubricated to use it)");
   }
+  s.warnings = report.warnings;
+  s.ineffective_keys = report.ineffective_keys;
   refuse_a_scene_that_cannot_fit(s);
   return s;
 }

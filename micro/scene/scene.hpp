@@ -3,12 +3,14 @@
 // are strings with units ("800MPa", "10um", "500C", "5ns"); counts and ratios are numbers. Unknown
 // keys and out-of-range values are errors that name the key (e.g. "load.pressure").
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "common/units.hpp"
+#include "micro/settings/option_keys.hpp"
 
 #include "micro/contact/interface_laws.hpp"
 #include "micro/contact/mortar_contact.hpp"
@@ -27,22 +29,11 @@ constexpr double micrometres(double x) { return 1e-6 * x; }
 constexpr double nanometres(double x) { return 1e-9 * x; }
 constexpr double nanoseconds(double x) { return 1e-9 * x; }
 
-// A choice a scene file spells as a word ("lubricated", "iqn-ils"): parsed once into its enum, and
-// spelled back from the same table (SceneChoice<E>::names, below the enums) in messages and results.
-template <class E>
-struct NamedChoice {
-  const char* name;
-  E value;
-};
-template <class E>
-struct SceneChoice;
-template <class E>
-const char* choice_name(E value) {
-  for (const auto& c : SceneChoice<E>::names) {
-    if (c.value == value) return c.name;
-  }
-  return "unknown";
-}
+// A choice a scene file spells as a word ("lubricated", "iqn-ils") is parsed once into its enum, and
+// spelled back from the same table (OptionChoice<E>::names, micro/settings/option_keys.hpp).
+using mufric::choice_name;
+using mufric::NamedChoice;
+using mufric::OptionChoice;
 
 // One rough surface: a measured profile (CSV), a synthetic one, or flat; fitted by a periodic spline.
 struct SurfaceSpec {
@@ -221,79 +212,87 @@ struct Scene {
   // replaying a sample rest on it, and parse_scene of it gives these very values (every key is read,
   // unknown keys are errors), so it cannot say more or less than the run used.
   nlohmann::json effective;
-  std::vector<std::string> warnings;  // keys read but without effect (lubricant.* in a dry scene)
+  std::vector<std::string> warnings;  // keys read but without effect (lubricant.* in a dry scene), one line each
+  std::map<std::string, std::string> ineffective_keys;  // their full paths ("contact.shear_factor") → why, to ask by key
   // Every value alike, the file's words (effective, source) and the warnings included.
   bool operator==(const Scene&) const = default;
 };
 
+}  // namespace mufric::scene
+
+namespace mufric {
 // The words of the scene file, in the order its error messages list them.
 template <>
-struct SceneChoice<Physics> {
-  static constexpr std::array<NamedChoice<Physics>, 2> names{{{"dry", Physics::dry}, {"lubricated", Physics::lubricated}}};
+struct OptionChoice<scene::Physics> {
+  static constexpr std::array<NamedChoice<scene::Physics>, 2> names{{{"dry", scene::Physics::dry}, {"lubricated", scene::Physics::lubricated}}};
 };
 template <>
-struct SceneChoice<ThermalModel> {
-  static constexpr std::array<NamedChoice<ThermalModel>, 2> names{
-      {{"adiabatic", ThermalModel::adiabatic}, {"conduction", ThermalModel::conduction}}};
+struct OptionChoice<scene::ThermalModel> {
+  static constexpr std::array<NamedChoice<scene::ThermalModel>, 2> names{
+      {{"adiabatic", scene::ThermalModel::adiabatic}, {"conduction", scene::ThermalModel::conduction}}};
 };
 template <>
-struct SceneChoice<Protocol> {
-  static constexpr std::array<NamedChoice<Protocol>, 2> names{
-      {{"press-slide", Protocol::press_slide}, {"seed-000", Protocol::seed000}}};
+struct OptionChoice<scene::Protocol> {
+  static constexpr std::array<NamedChoice<scene::Protocol>, 2> names{
+      {{"press-slide", scene::Protocol::press_slide}, {"seed-000", scene::Protocol::seed000}}};
 };
 template <>
-struct SceneChoice<DrawnSurfaces> {
-  static constexpr std::array<NamedChoice<DrawnSurfaces>, 2> names{
-      {{"tools", DrawnSurfaces::tools}, {"tools-and-chip", DrawnSurfaces::tools_and_chip}}};
+struct OptionChoice<scene::DrawnSurfaces> {
+  static constexpr std::array<NamedChoice<scene::DrawnSurfaces>, 2> names{
+      {{"tools", scene::DrawnSurfaces::tools}, {"tools-and-chip", scene::DrawnSurfaces::tools_and_chip}}};
 };
 template <>
-struct SceneChoice<solid::TimeScheme> {
+struct OptionChoice<solid::TimeScheme> {
   static constexpr std::array<NamedChoice<solid::TimeScheme>, 2> names{
       {{"generalized-alpha", solid::TimeScheme::generalized_alpha}, {"quasi-static", solid::TimeScheme::quasi_static}}};
 };
 template <>
-struct SceneChoice<solid::VolumetricTreatment> {
+struct OptionChoice<solid::VolumetricTreatment> {
   static constexpr std::array<NamedChoice<solid::VolumetricTreatment>, 2> names{
       {{"full", solid::VolumetricTreatment::full}, {"mean-dilatation", solid::VolumetricTreatment::mean_dilatation}}};
 };
 template <>
-struct SceneChoice<numerics::LinearSolverKind> {
+struct OptionChoice<numerics::LinearSolverKind> {
   static constexpr std::array<NamedChoice<numerics::LinearSolverKind>, 2> names{
       {{"lu", numerics::LinearSolverKind::lu}, {"cholesky", numerics::LinearSolverKind::cholesky}}};
 };
 template <>
-struct SceneChoice<Compressibility> {
-  static constexpr std::array<NamedChoice<Compressibility>, 3> names{{{"none", Compressibility::none},
-                                                                      {"linear", Compressibility::linear},
-                                                                      {"dowson-higginson", Compressibility::dowson_higginson}}};
+struct OptionChoice<scene::Compressibility> {
+  static constexpr std::array<NamedChoice<scene::Compressibility>, 3> names{{{"none", scene::Compressibility::none},
+                                                                      {"linear", scene::Compressibility::linear},
+                                                                      {"dowson-higginson", scene::Compressibility::dowson_higginson}}};
 };
 template <>
-struct SceneChoice<FilmFill> {
-  static constexpr std::array<NamedChoice<FilmFill>, 2> names{
-      {{"gap", FilmFill::gap}, {"after-pressing", FilmFill::after_pressing}}};
+struct OptionChoice<scene::FilmFill> {
+  static constexpr std::array<NamedChoice<scene::FilmFill>, 2> names{
+      {{"gap", scene::FilmFill::gap}, {"after-pressing", scene::FilmFill::after_pressing}}};
 };
 template <>
-struct SceneChoice<CavitationModel> {
-  static constexpr std::array<NamedChoice<CavitationModel>, 2> names{
-      {{"none", CavitationModel::none}, {"mass-conserving", CavitationModel::mass_conserving}}};
+struct OptionChoice<scene::CavitationModel> {
+  static constexpr std::array<NamedChoice<scene::CavitationModel>, 2> names{
+      {{"none", scene::CavitationModel::none}, {"mass-conserving", scene::CavitationModel::mass_conserving}}};
 };
 template <>
-struct SceneChoice<LeakModel> {
-  static constexpr std::array<NamedChoice<LeakModel>, 3> names{
-      {{"none", LeakModel::none}, {"ambient", LeakModel::ambient}, {"cell-mean", LeakModel::cell_mean}}};
+struct OptionChoice<scene::LeakModel> {
+  static constexpr std::array<NamedChoice<scene::LeakModel>, 3> names{
+      {{"none", scene::LeakModel::none}, {"ambient", scene::LeakModel::ambient}, {"cell-mean", scene::LeakModel::cell_mean}}};
 };
 template <>
-struct SceneChoice<coupling::FilmMeshMotion> {
+struct OptionChoice<coupling::FilmMeshMotion> {
   static constexpr std::array<NamedChoice<coupling::FilmMeshMotion>, 2> names{
       {{"columns", coupling::FilmMeshMotion::columns}, {"elastic", coupling::FilmMeshMotion::elastic}}};
 };
 template <>
-struct SceneChoice<coupling::Acceleration> {
+struct OptionChoice<coupling::Acceleration> {
   static constexpr std::array<NamedChoice<coupling::Acceleration>, 3> names{
       {{"iqn-ils", coupling::Acceleration::iqn_ils},
        {"aitken", coupling::Acceleration::aitken},
        {"relaxation", coupling::Acceleration::constant_relaxation}}};
 };
+
+}  // namespace mufric
+
+namespace mufric::scene {
 
 // What a scene costs before it runs: unknowns, stored nonzeros and a lower bound of the memory the
 // solid's stiffness, its quadrature state and its vectors take (the factor and the lubricant come
