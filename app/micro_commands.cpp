@@ -259,8 +259,8 @@ void run_check(const RunCommandOptions& o) {
   const scene::SceneCost cost = scene::estimate_scene_cost(sc);
   const scene::Scene reference = scene::load_scene("", {});
   const scene::SceneCost base = scene::estimate_scene_cost(reference);
-  std::printf("%s: %s, %d x %d elements of degree %d\n", sc.source.c_str(), scene::choice_name(sc.physics), sc.elements_x,
-              sc.elements_y, sc.degree);
+  std::printf("%s: %s, %d x %d elements of degree %d\n", sc.source.c_str(), scene::choice_name(sc.physics), sc.discretisation.elements_x,
+              sc.discretisation.elements_y, sc.discretisation.degree);
   std::printf("  %lld solid unknowns (%.3gx the default scene's %lld), %lld stiffness nonzeros\n", cost.dofs,
               static_cast<double>(cost.dofs) / static_cast<double>(base.dofs), base.dofs, cost.stiffness_nonzeros);
   std::printf("  memory: at least %.3g MB (stiffness, quadrature state, vectors; the factor comes on top), this machine "
@@ -281,7 +281,7 @@ std::string level_setting(const scene::Scene& sc, const std::string& parameter) 
   } else if (parameter == "phases") {
     std::snprintf(text, sizeof text, "%d x %d", sc.protocol.phases, sc.protocol.realisations);
   } else {
-    std::snprintf(text, sizeof text, "%d x %d", sc.elements_x, sc.elements_y);
+    std::snprintf(text, sizeof text, "%d x %d", sc.discretisation.elements_x, sc.discretisation.elements_y);
   }
   return text;
 }
@@ -294,8 +294,8 @@ void refine(scene::Scene& sc, const RunCommandOptions& o) {
   } else if (o.parameter == "phases") {
     sc.protocol.phases *= 2;
   } else {
-    if (o.direction != "y") sc.elements_x *= 2;
-    if (o.direction != "x") sc.elements_y *= 2;
+    if (o.direction != "y") sc.discretisation.elements_x *= 2;
+    if (o.direction != "x") sc.discretisation.elements_y *= 2;
   }
 }
 

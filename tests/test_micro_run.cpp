@@ -119,8 +119,8 @@ TEST(Scene, TheTi6Al4VSceneHoldsItsSourcesMaterialTable) {
       {&solid::JohnsonCookParameters::melting_temperature, 1873.0},
       {&solid::JohnsonCookParameters::specific_heat, 531.0}};
   for (size_t k = 0; k < table.size(); ++k) EXPECT_DOUBLE_EQ(scene.material.*table[k].first, table[k].second) << "row " << k;
-  EXPECT_DOUBLE_EQ(scene.conductivity, 6.3);
-  EXPECT_EQ(scene.contact_interface.law->name(), "childs");
+  EXPECT_DOUBLE_EQ(scene.thermal.conductivity, 6.3);
+  EXPECT_EQ(scene.contact.interface.law->name(), "childs");
   EXPECT_TRUE(scene.warnings.empty());
 }
 
@@ -152,12 +152,12 @@ TEST(Scene, AKnownInputsSceneKeySetsItsValueToTheLastBit) {
   EXPECT_EQ(set.pressure, value_of.at(input_name::contact_pressure));
   EXPECT_EQ(set.velocity, value_of.at(input_name::sliding_velocity));
   EXPECT_EQ(set.temperature, value_of.at(input_name::temperature));
-  const auto& law = dynamic_cast<const contact::ChildsLaw&>(*set.contact_interface.law);
+  const auto& law = dynamic_cast<const contact::ChildsLaw&>(*set.contact.interface.law);
   EXPECT_EQ(law.dry().adhesive_coefficient, value_of.at(input_name::adhesive_coefficient));
   EXPECT_EQ(law.dry().shear_factor, value_of.at(input_name::shear_factor));
   EXPECT_EQ(law.exponent(), value_of.at(input_name::childs_exponent));
   EXPECT_EQ(set.interval, base.interval);  // the rest as it was
-  EXPECT_EQ(set.contact_interface.heat_partition, base.contact_interface.heat_partition);
+  EXPECT_EQ(set.contact.interface.heat_partition, base.contact.interface.heat_partition);
   try {
     scene_with_values(base, {{"load.pressure", 2e11, QuantityKind::pressure}});
     ADD_FAILURE() << "a pressure above the physical range was set";
@@ -221,10 +221,10 @@ TEST(Scene, ErrorsNameTheKey) {
     apply_override(bad, assignment);
     EXPECT_NE(error_of(bad).find(expected), std::string::npos) << assignment << ": " << error_of(bad);
   }
-  EXPECT_EQ(parse_scene(j, "s").volumetric, solid::VolumetricTreatment::full);  // seed 000's element by default
+  EXPECT_EQ(parse_scene(j, "s").discretisation.volumetric, solid::VolumetricTreatment::full);  // seed 000's element by default
   nlohmann::json f_bar = j;
   apply_override(f_bar, "discretisation.volumetric=\"mean-dilatation\"");
-  EXPECT_EQ(parse_scene(f_bar, "s").volumetric, solid::VolumetricTreatment::mean_dilatation);
+  EXPECT_EQ(parse_scene(f_bar, "s").discretisation.volumetric, solid::VolumetricTreatment::mean_dilatation);
   nlohmann::json drained = j;
   apply_override(drained, "lubricant.fill=\"after-pressing\"");
   EXPECT_NO_THROW(parse_scene(drained, "scene.json"));
@@ -235,12 +235,12 @@ TEST(Scene, ErrorsNameTheKey) {
   apply_override(coulomb, "contact.law=\"coulomb\"");
   apply_override(coulomb, "contact.adhesive_coefficient=0.15");
   const Scene with_friction = parse_scene(coulomb, "s");
-  const auto* coulomb_law = dynamic_cast<const contact::CoulombLaw*>(with_friction.contact_interface.law.get());
+  const auto* coulomb_law = dynamic_cast<const contact::CoulombLaw*>(with_friction.contact.interface.law.get());
   ASSERT_NE(coulomb_law, nullptr);
   EXPECT_DOUBLE_EQ(coulomb_law->dry().adhesive_coefficient, 0.15);
-  EXPECT_EQ(with_friction.contact_interface.tangential_penalty, 0.0);  // the contact's default, applied there
+  EXPECT_EQ(with_friction.contact.interface.tangential_penalty, 0.0);  // the contact's default, applied there
   apply_override(coulomb, "contact.tangential_penalty=2e17");
-  EXPECT_EQ(parse_scene(coulomb, "s").contact_interface.tangential_penalty, 2e17);
+  EXPECT_EQ(parse_scene(coulomb, "s").contact.interface.tangential_penalty, 2e17);
   apply_override(coulomb, "contact.tangential_penalty=null");
   apply_override(coulomb, "contact.adhesive_coefficient=-0.1");
   EXPECT_NE(error_of(coulomb).find("contact.adhesive_coefficient: "), std::string::npos) << error_of(coulomb);
@@ -256,16 +256,16 @@ TEST(Scene, ErrorsNameTheKey) {
       << error_of(zorev);
   apply_override(zorev, "contact.adhesive_coefficient=0.2");
   const Scene with_zorev = parse_scene(zorev, "s");
-  const auto* zorev_law = dynamic_cast<const contact::ZorevLaw*>(with_zorev.contact_interface.law.get());
+  const auto* zorev_law = dynamic_cast<const contact::ZorevLaw*>(with_zorev.contact.interface.law.get());
   ASSERT_NE(zorev_law, nullptr);
   EXPECT_DOUBLE_EQ(zorev_law->dry().shear_factor, 0.8);
   EXPECT_DOUBLE_EQ(zorev_law->dry().adhesive_coefficient, 0.2);
   EXPECT_TRUE(zorev_law->needs().shear_strength);
-  EXPECT_DOUBLE_EQ(with_zorev.contact_interface.heat_partition, contact::kDefaultHeatPartition);
+  EXPECT_DOUBLE_EQ(with_zorev.contact.interface.heat_partition, contact::kDefaultHeatPartition);
   apply_override(zorev, "contact.heat_partition=1.5");
   EXPECT_NE(error_of(zorev).find("contact.heat_partition"), std::string::npos) << error_of(zorev);
   apply_override(zorev, "contact.heat_partition=0.8");
-  EXPECT_DOUBLE_EQ(parse_scene(zorev, "s").contact_interface.heat_partition, 0.8);
+  EXPECT_DOUBLE_EQ(parse_scene(zorev, "s").contact.interface.heat_partition, 0.8);
   EXPECT_TRUE(parse_scene(zorev, "s").warnings.empty());
   apply_override(zorev, "thermal.model=\"adiabatic\"");
   const Scene adiabatic = parse_scene(zorev, "s");
@@ -277,8 +277,8 @@ TEST(Scene, ErrorsNameTheKey) {
   apply_override(ignored, "contact.adhesive_coefficient=0.15");
   apply_override(ignored, "contact.wetted.shear_factor=0.3");
   const Scene frictionless = parse_scene(ignored, "s");
-  EXPECT_EQ(frictionless.contact_interface.law->name(), "frictionless");
-  EXPECT_FALSE(frictionless.contact_interface.law->frictional());
+  EXPECT_EQ(frictionless.contact.interface.law->name(), "frictionless");
+  EXPECT_FALSE(frictionless.contact.interface.law->frictional());
   ASSERT_EQ(frictionless.warnings.size(), 2U);
   EXPECT_NE(frictionless.warnings[0].find("contact.adhesive_coefficient is read but has no effect: contact.law is frictionless"),
             std::string::npos) << frictionless.warnings[0];
@@ -289,7 +289,7 @@ TEST(Scene, ErrorsNameTheKey) {
   apply_override(ignored, "contact.law=\"shear-factor\"");
   apply_override(ignored, "contact.shear_factor=0.5");
   const Scene shear_factor = parse_scene(ignored, "s");
-  EXPECT_EQ(shear_factor.contact_interface.law->name(), "shear-factor");
+  EXPECT_EQ(shear_factor.contact.interface.law->name(), "shear-factor");
   ASSERT_EQ(shear_factor.warnings.size(), 2U);  // adhesive_coefficient (coulomb's) and childs_exponent (childs')
   apply_override(ignored, "contact.stiction=0.5");
   EXPECT_NE(error_of(ignored).find("contact.stiction: unknown key"), std::string::npos) << error_of(ignored);
@@ -299,11 +299,11 @@ TEST(Scene, ErrorsNameTheKey) {
   apply_override(wet, "physics=\"lubricated\"");
   apply_override(wet, "thermal.model=\"conduction\"");
   const Scene wetted_default = parse_scene(wet, "s");
-  const auto& wetted_law = dynamic_cast<const contact::ZorevLaw&>(*wetted_default.contact_interface.law);
+  const auto& wetted_law = dynamic_cast<const contact::ZorevLaw&>(*wetted_default.contact.interface.law);
   EXPECT_DOUBLE_EQ(wetted_law.wetted().adhesive_coefficient, contact::kDefaultWettedAdhesiveCoefficient);
   EXPECT_DOUBLE_EQ(wetted_law.wetted().shear_factor, contact::kDefaultWettedShearFactor);
   apply_override(wet, "contact.wetted.adhesive_coefficient=0.03");
-  EXPECT_DOUBLE_EQ(dynamic_cast<const contact::ZorevLaw&>(*parse_scene(wet, "s").contact_interface.law).wetted().adhesive_coefficient,
+  EXPECT_DOUBLE_EQ(dynamic_cast<const contact::ZorevLaw&>(*parse_scene(wet, "s").contact.interface.law).wetted().adhesive_coefficient,
                    0.03);
   apply_override(wet, "contact.wetted.shear_factor=1.2");
   EXPECT_NE(error_of(wet).find("contact.wetted.shear_factor"), std::string::npos) << error_of(wet);
@@ -806,7 +806,7 @@ TEST(Lubricated, TheDefaultLubricatedSceneIsTheDryOneWithTheLubricant) {
   nlohmann::json wet = read_scene_json(path), dry = default_scene_json();
   const Scene scene = parse_scene(wet, path);
   EXPECT_EQ(scene.physics, Physics::lubricated);
-  const LubricantSpec written = scene.lubricant, absent = parse_scene(dry, "dry").lubricant;
+  const coupling::LubricantSettings written = scene.lubricant, absent = parse_scene(dry, "dry").lubricant;
   EXPECT_EQ(written.fill, absent.fill);
   EXPECT_EQ(written.cavitation, absent.cavitation);
   EXPECT_DOUBLE_EQ(written.min_film, absent.min_film);

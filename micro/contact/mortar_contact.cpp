@@ -253,7 +253,7 @@ void MortarContact::commit(const Eigen::VectorXd& u) {
   bool ok = true;
   int projections = 0;
   std::string reason;
-  const std::vector<PointGap> g = gaps(u, projections, reason, ok);
+  const std::vector<PointGap> g = gaps(u, projections, reason, ok, &committed_positions_);
   if (!ok) throw Error("contact: committing the accepted state: " + reason);
   const Eigen::VectorXd p = node_pressures(g);
   std::fill(step_dissipation_.begin(), step_dissipation_.end(), 0.0);

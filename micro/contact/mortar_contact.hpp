@@ -111,6 +111,8 @@ class MortarContact final : public solid::BoundaryInteraction {
   bool wetted(size_t point) const { return states_ && states_->state(point).wetted; }
   // Reference position of each surface quadrature point.
   std::vector<Eigen::Vector2d> surface_positions() const;
+  // Each surface point's position at the last commit (a frictional law's; empty before the first).
+  const std::vector<Eigen::Vector2d>& committed_positions() const { return committed_positions_; }
   ContactState state(const Eigen::VectorXd& u) const;
   const RigidTool& tool() const { return tool_; }
   double penalty() const { return penalty_; }
@@ -169,6 +171,7 @@ class MortarContact final : public solid::BoundaryInteraction {
   // Per surface point, the tool parameter where its tangential offset is zero (committed state);
   // none where the point was not searched at the last commit.
   std::vector<std::optional<double>> anchor_;
+  std::vector<Eigen::Vector2d> committed_positions_;  // at the last commit (frictional laws)
   std::vector<double> step_dissipation_;  // per surface point, J/m, in the last accepted step
   double step_dissipated_energy_ = 0.0, dissipated_energy_ = 0.0;
   std::shared_ptr<const spline::ProjectionSeeds> seeds_;  // the tool's seeding samples, computed once

@@ -9,6 +9,8 @@
 
 #include <Eigen/Sparse>
 
+#include "micro/settings/option_keys.hpp"
+
 namespace mufric::numerics {
 
 enum class LinearSolverKind { lu, cholesky };
@@ -63,3 +65,11 @@ class LinearSolver {
 };
 
 }  // namespace mufric::numerics
+
+namespace mufric {
+template <>
+struct OptionChoice<numerics::LinearSolverKind> {
+  static constexpr std::array<NamedChoice<numerics::LinearSolverKind>, 2> names{
+      {{"lu", numerics::LinearSolverKind::lu}, {"cholesky", numerics::LinearSolverKind::cholesky}}};
+};
+}  // namespace mufric

@@ -73,41 +73,6 @@ std::vector<double> heights_on_grid(const spline::SplineCurve& c, double interva
 
 double ramp(double t, double ramp_time) { return ramp_time > 0.0 ? std::min(t / ramp_time, 1.0) : 1.0; }
 
-coupling::LubricantOptions lubricant_options(const Scene& scene, double slide_start) {
-  const LubricantSpec& l = scene.lubricant;
-  coupling::LubricantOptions o;
-  o.fluid = {l.density, l.viscosity, l.compressibility == Compressibility::none ? 0.0 : l.bulk_modulus,
-             l.compressibility == Compressibility::dowson_higginson ? fluid::kDowsonHigginsonStiffening : 0.0};
-  o.mesh.degree = 2;  // equal-order quadratic velocity and pressure
-  o.mesh.elements_x = l.elements_x > 0 ? l.elements_x : scene.elements_x;
-  o.mesh.elements_y = l.elements_y;
-  o.mesh.min_film = l.min_film;
-  o.mesh_motion = l.mesh_motion;
-  o.mesh_update.stiffening_exponent = l.mesh_stiffening;
-  o.robin_weight = l.robin_weight;
-  o.robin_stiffness = l.robin_stiffness;
-  o.chip_mass_per_area = scene.material.density * scene.chip_height;
-  o.shortest_weight_step = scene.dt;
-  o.film_from = l.fill == FilmFill::after_pressing ? slide_start : 0.0;
-  o.contact_fade = l.contact_fade;
-  if (l.leak != LeakModel::none) o.leak = l.leak == LeakModel::ambient ? fluid::LeakTarget::ambient : fluid::LeakTarget::mean;
-  o.leak_length = l.leak_length;
-  if (l.cavitation == CavitationModel::mass_conserving) o.cavitation_pressure = l.cavitation_pressure;
-  o.coupling.acceleration = l.acceleration;
-  o.coupling.relaxation = l.relaxation;
-  o.coupling.reuse_steps = l.reuse_steps;
-  o.coupling.qr_filter = l.qr_filter;
-  o.coupling.relative_tolerance = l.coupling_tolerance;
-  if (scene.pressure_controlled && l.traction_tolerance > 0.0) {
-    o.coupling.load_tolerance = l.traction_tolerance * std::abs(scene.pressure);
-  }
-  o.coupling.kinematic_tolerance = l.volume_tolerance;
-  o.coupling.max_iterations = l.max_coupling_iterations;
-  o.coupling.stall_iterations = l.stall_iterations;
-  o.coupling.max_restarts = l.coupling_restarts;
-  return o;
-}
-
 std::vector<size_t> nearest_quadrature_points(const solid::IgaSpace& space, const std::vector<Eigen::Vector2d>& at) {
   std::vector<size_t> nearest;
   nearest.reserve(at.size());
@@ -142,62 +107,65 @@ SceneGeometry build_geometry(const Scene& scene) {
   return {chip, tool};
 }
 
-void refresh_chip_state_at_contact(const Scene& scene, const LoadedChip& chip) {
-  if (chip.surface_quadrature.empty()) return;
-  const auto& states = chip.problem->states();
-  std::vector<double> k, temperature;
-  k.reserve(chip.surface_quadrature.size());
-  temperature.reserve(chip.surface_quadrature.size());
-  for (const size_t q : chip.surface_quadrature) {
-    const auto& st = states[q];
-    k.push_back(solid::johnson_cook_yield_stress(scene.material, st.equivalent_plastic_strain, st.plastic_strain_rate,
-                                                 st.temperature) /
-                std::sqrt(3.0));
-    temperature.push_back(st.temperature);
-  }
-  const contact::PointStateNeeds needs = scene.contact_interface.law->needs();
-  if (needs.shear_strength) chip.point_states->set_shear_strength(std::move(k));
-  if (needs.temperature) chip.point_states->set_temperature(std::move(temperature));
+ChipPointStates::ChipPointStates(const solid::SolidProblem& problem, std::vector<size_t> surface_quadrature,
+                                 double sliding_velocity, contact::PointStateNeeds needs)
+    : problem_(problem), surface_quadrature_(std::move(surface_quadrature)), sliding_velocity_(sliding_velocity), needs_(needs) {
+  latch();
 }
 
-void refresh_wetted_contact(const Scene& scene, const LoadedChip& chip, const coupling::LubricatedChip* lubricant,
-                            const contact::ContactState& contact) {
-  if (lubricant == nullptr || !scene.contact_interface.law->frictional()) return;
-  std::vector<char> wetted(contact.point_position.size(), 0);
-  for (size_t q = 0; q < wetted.size(); ++q) wetted[q] = lubricant->wetted_at(contact.point_position[q].x()) ? 1 : 0;
-  chip.point_states->set_wetted(std::move(wetted));
+contact::ContactPointState ChipPointStates::state(size_t point) const {
+  if (point < latched_.size()) return latched_[point];
+  contact::ContactPointState s;
+  s.sliding_velocity = sliding_velocity_;
+  return s;
+}
+
+std::optional<std::string> ChipPointStates::missing(const contact::PointStateNeeds&) const { return std::nullopt; }
+
+void ChipPointStates::attach_lubricant(const coupling::LubricatedChip* lubricant, const contact::MortarContact* contact) {
+  lubricant_ = lubricant;
+  contact_ = contact;
+}
+
+void ChipPointStates::latch() {
+  const bool wetting = lubricant_ != nullptr && !contact_->committed_positions().empty();
+  const size_t points = std::max(surface_quadrature_.size(), wetting ? contact_->committed_positions().size() : size_t{0});
+  latched_.assign(points, contact::ContactPointState{.sliding_velocity = sliding_velocity_});
+  const auto& states = problem_.states();
+  for (size_t q = 0; q < surface_quadrature_.size(); ++q) {
+    const solid::MaterialState& at = states[surface_quadrature_[q]];
+    if (needs_.shear_strength) latched_[q].shear_strength = problem_.material().shear_yield_stress(at);
+    if (needs_.temperature) latched_[q].temperature = at.temperature;
+  }
+  if (wetting) {
+    for (size_t q = 0; q < points; ++q) latched_[q].wetted = lubricant_->wetted_at(contact_->committed_positions()[q].x());
+  }
 }
 
 LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const BottomMotion& motion) {
   const auto fit_spans = static_cast<int>(geometry.chip_surface.basis().breakpoints().size()) - 1;
-  if (scene.elements_x < fit_spans) {
-    throw Error(scene.source + ": discretisation.elements_x (" + std::to_string(scene.elements_x) +
+  if (scene.discretisation.elements_x < fit_spans) {
+    throw Error(scene.source + ": discretisation.elements_x (" + std::to_string(scene.discretisation.elements_x) +
                 ") must be at least the chip surface fit's " + std::to_string(fit_spans) + " spans");
   }
   const spline::SplineSurface patch =
-      solid::chip_patch(geometry.chip_surface, {.degree = scene.degree,
-                                                .spans_x = scene.elements_x,
-                                                .spans_y = scene.elements_y,
-                                                .y_bottom = -scene.chip_height,
-                                                .grading = scene.grading});
+      solid::chip_patch(geometry.chip_surface, scene.discretisation.mesh(scene.chip_height));
   solid::MaterialState initial;
   initial.temperature = scene.temperature;
   LoadedChip chip;
   chip.problem = std::make_unique<solid::SolidProblem>(solid::IgaSpace(patch),
                                                        std::make_shared<solid::J2JohnsonCook>(scene.material), initial,
-                                                       scene.volumetric);
+                                                       scene.discretisation.volumetric);
   solid::SolidProblem& problem = *chip.problem;
   chip.contact = std::make_shared<contact::MortarContact>(problem.space(), contact::RigidTool{geometry.tool_surface},
-                                                          scene.penalty, scene.contact_points_per_span,
-                                                          scene.contact_interface);
-  chip.point_states = std::make_shared<contact::SampledPointStates>(chip.contact->surface_positions().size(),
-                                                                    std::abs(scene.velocity));
+                                                          scene.contact.penalty, scene.discretisation.contact_points_per_span,
+                                                          scene.contact.interface);
+  const contact::PointStateNeeds needs = scene.contact.interface.law->needs();
+  chip.point_states = std::make_shared<ChipPointStates>(
+      problem, needs.any() ? nearest_quadrature_points(problem.space(), chip.contact->surface_positions()) : std::vector<size_t>{},
+      std::abs(scene.velocity), needs);
   chip.contact->set_point_states(chip.point_states);
   problem.add_interaction(chip.contact);
-  if (scene.contact_interface.law->needs().any()) {
-    chip.surface_quadrature = nearest_quadrature_points(problem.space(), chip.contact->surface_positions());
-    refresh_chip_state_at_contact(scene, chip);
-  }
   const double velocity = scene.velocity, ramp_time = scene.ramp;
   if (scene.protocol.name == Protocol::seed000) {
     problem.fix_side(numerics::Side::bottom, 0, velocity, [](double t) { return t; });
@@ -216,22 +184,14 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
 
 solid::TimeIntegrationOptions integration_options(const Scene& scene, const BottomMotion& motion) {
   const bool seed000 = scene.protocol.name == Protocol::seed000;
-  solid::TimeIntegrationOptions o;
-  o.scheme = scene.scheme;
-  o.spectral_radius = scene.spectral_radius;
-  o.dt = scene.dt;
-  o.max_dt = scene.max_dt;
+  solid::TimeIntegrationOptions o = solid::integration_options(scene.time, scene.newton);
   o.end_time = seed000 ? scene.duration : motion.end_time();
-  o.relative_tolerance = scene.relative_tolerance;
-  o.max_newton_iterations = scene.max_newton_iterations;
-  o.max_cutbacks = scene.max_cutbacks;
-  o.linear_solver = scene.linear_solver;
   if (!seed000) {
     // Once sliding, steps are sized by distance: inertia plays no part at these sliding speeds
     // (an asperity passes in ~100 ns, the chip's slowest mode rings at ~5 ns), so slow sliding
     // costs no more steps than fast sliding.
     const double sliding_step = scene.protocol.step_distance / std::abs(scene.velocity);
-    const double pressing_step = scene.max_dt, slide_start = motion.slide_start();
+    const double pressing_step = scene.time.max_dt, slide_start = motion.slide_start();
     o.max_dt_at = [=](double t) { return t < slide_start ? pressing_step : sliding_step; };
   }
   return o;
@@ -240,14 +200,10 @@ solid::TimeIntegrationOptions integration_options(const Scene& scene, const Bott
 std::unique_ptr<solid::HeatConduction> add_heat_conduction(const Scene& scene, const LoadedChip& chip,
                                                            solid::TimeIntegrationOptions& o) {
   solid::SolidProblem& problem = *chip.problem;
-  if (!scene.heat_conduction()) return nullptr;
+  if (!scene.thermal.conducts()) return nullptr;
   auto heat = std::make_unique<solid::HeatConduction>(
-      problem.space(), solid::HeatConductionOptions{.conductivity = scene.conductivity,
-                                                    .density = scene.material.density,
-                                                    .specific_heat = scene.material.specific_heat,
-                                                    .held_side = numerics::Side::bottom,
-                                                    .held_temperature = scene.temperature});
-  const bool frictional = scene.contact_interface.law->frictional();
+      problem.space(), solid::heat_conduction_options(scene.thermal, scene.material, scene.temperature));
+  const bool frictional = scene.contact.interface.law->frictional();
   o.after_step = [&problem, conduction = heat.get(), contact = chip.contact.get(), frictional](
                      double, double dt, const Eigen::VectorXd& u, std::string& reason) {
     std::vector<solid::MaterialState> states = problem.states();
@@ -263,8 +219,14 @@ std::unique_ptr<coupling::LubricatedChip> add_lubricant(const Scene& scene, soli
                                                         const SceneGeometry& geometry, const BottomMotion& motion,
                                                         solid::TimeIntegrationOptions& o) {
   if (scene.physics != Physics::lubricated) return nullptr;
+  const coupling::LubricantRun run{
+      .chip_elements_x = scene.discretisation.elements_x,
+      .chip_mass_per_area = scene.material.density * scene.chip_height,
+      .first_step = scene.time.dt,
+      .slide_start = motion.slide_start(),
+      .applied_pressure = scene.pressure_controlled ? std::optional<double>(scene.pressure) : std::nullopt};
   auto lubricant = std::make_unique<coupling::LubricatedChip>(problem, geometry.tool_surface,
-                                                              lubricant_options(scene, motion.slide_start()));
+                                                              coupling::lubricant_options(scene.lubricant, run));
   o.coupled_step = [film = lubricant.get()](solid::TimeIntegrator& integrator, double t0, double dt,
                                             std::string& reason) { return film->step(integrator, t0, dt, reason); };
   return lubricant;

@@ -55,27 +55,41 @@ class BottomMotion {
 // temperature, mortar contact with the rigid tool, and Γ_B dragged along x (at the sliding velocity
 // from t = 0 for seed 000; after pressing for press-slide) and pushed toward the tool by p (or moved
 // by a prescribed vertical displacement), the vertical load ramped over `ramp`.
+// The contact points' state beyond their pressure, which the provider reads itself from the chip
+// (the material computes k at the bulk quadrature point nearest each surface point; T there) and from
+// the lubricant (whether it wets the point at its position in the contact's last commit), for what
+// the law needs. Read at step boundaries (latch: at load and after every accepted step, once its heat
+// and record are done), so that every evaluation within a step — its Newton iterations, the
+// contact's commit and the step's record — sees the state it started from: lagged one step, which
+// keeps ∂k/∂u out of the tangent and the recorded shear the one the step solved for.
+class ChipPointStates final : public contact::PointStateProvider {
+ public:
+  ChipPointStates(const solid::SolidProblem& problem, std::vector<size_t> surface_quadrature, double sliding_velocity,
+                  contact::PointStateNeeds needs);
+  contact::ContactPointState state(size_t point) const override;
+  std::optional<std::string> missing(const contact::PointStateNeeds& needs) const override;
+  // The lubricant, and the contact at whose committed positions it wets points (a lubricated run's).
+  void attach_lubricant(const coupling::LubricatedChip* lubricant, const contact::MortarContact* contact);
+  // Reads the chip's committed state and the lubricant's wetted spots for the next step.
+  void latch();
+
+ private:
+  const solid::SolidProblem& problem_;
+  std::vector<size_t> surface_quadrature_;  // the bulk quadrature point nearest each surface point
+  double sliding_velocity_;
+  contact::PointStateNeeds needs_;
+  const coupling::LubricatedChip* lubricant_ = nullptr;
+  const contact::MortarContact* contact_ = nullptr;
+  std::vector<contact::ContactPointState> latched_;
+};
+
 struct LoadedChip {
   std::unique_ptr<solid::SolidProblem> problem;
   std::shared_ptr<contact::MortarContact> contact;
-  // The contact points' state beyond their pressure, for the interface law: the chip's k and T
-  // beneath each point and whether the lubricant wets it, refreshed after every accepted step.
-  std::shared_ptr<contact::SampledPointStates> point_states;
-  // For the laws that use the chip's state: the bulk quadrature point nearest each contact surface
-  // point (reference positions), whose state gives k and T there.
-  std::vector<size_t> surface_quadrature;
+  std::shared_ptr<ChipPointStates> point_states;
 };
 
 LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const BottomMotion& motion);
-// The chip's state at each contact surface point, from the committed state of its nearest bulk
-// quadrature point: k = σ_JC(ε̄ᵖ, ε̇ᵖ, T)/√3 (von Mises) and T, for the laws that use them (they see
-// the last accepted state's).
-void refresh_chip_state_at_contact(const Scene& scene, const LoadedChip& chip);
-// The contact points the lubricant wets after the last accepted step (their current positions in
-// `contact`, that step's state), for the law's wetted coefficients in the next step — lagged a step
-// like k and T. A frictionless law has none: its points report no wetted spot.
-void refresh_wetted_contact(const Scene& scene, const LoadedChip& chip, const coupling::LubricatedChip* lubricant,
-                            const contact::ContactState& contact);
 // The scene's time-integration choices, and the protocol's step lengths.
 solid::TimeIntegrationOptions integration_options(const Scene& scene, const BottomMotion& motion);
 // Heat conduction through the chip, staggered after every accepted mechanical step (the plastic work

@@ -221,8 +221,8 @@ void record_outcome(const Scene& scene, const StepRecorder& recorder, MicroResul
 }  // namespace
 
 std::string explain_stop(const Scene& scene, const std::string& reason) {
-  const bool sealed_incompressible = scene.physics == Physics::lubricated && scene.lubricant.leak == LeakModel::none &&
-                                     scene.lubricant.compressibility == Compressibility::none;
+  const bool sealed_incompressible = scene.physics == Physics::lubricated && scene.lubricant.leak == coupling::LeakModel::none &&
+                                     scene.lubricant.compressibility == coupling::Compressibility::none;
   if (!sealed_incompressible || !coupling::is_interface_failure(reason)) return reason;
   // Küttler, Förster & Wall 2006 (Comput. Mech. 38:417): a Dirichlet-Neumann iteration around an
   // enclosed incompressible fluid cannot converge, since no chip motion but one of zero volume fits it.
@@ -248,8 +248,9 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   limit.watch_failed_attempts(o);
   const auto heat = add_heat_conduction(scene, chip, o);
   const auto lubricant = add_lubricant(scene, problem, geometry, motion, o);
+  if (lubricant && scene.contact.interface.law->frictional()) chip.point_states->attach_lubricant(lubricant.get(), chip.contact.get());
   solid::TimeIntegrator integrator(problem, o);
-  if (scene.protocol.name == Protocol::seed000 && scene.scheme == solid::TimeScheme::generalized_alpha) {
+  if (scene.protocol.name == Protocol::seed000 && scene.time.scheme == solid::TimeScheme::generalized_alpha) {
     // The chip starts moving with Γ_B: a rigid translation at the sliding velocity.
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(problem.dof_count());
     for (Eigen::Index i = 0; i < v0.size(); i += 2) v0(i) = scene.velocity;
@@ -258,8 +259,7 @@ MicroResult run_micro(const Scene& scene, const RunOptions& options) {
   StepRecorder recorder(scene, motion, *chip.contact, lubricant.get());
   result.solver = integrator.run([&](const solid::StepView& view) {
     const MicroStep& step = recorder.record(view);
-    refresh_chip_state_at_contact(scene, chip);  // after the step's own record: the next step's k and T
-    refresh_wetted_contact(scene, chip, lubricant.get(), recorder.last_contact());  // and its wetted spots
+    chip.point_states->latch();  // after the step's own record: the next step's k, T and wetted spots
     if (options.on_step) options.on_step(step, scene);
     limit.check_accepted_step(step, recorder.history().size());
   });

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/error.hpp"
 #include "micro/solid/dual.hpp"
@@ -326,6 +327,12 @@ void J2JohnsonCook::stress_and_tangent(const Eigen::Matrix2d& f, const MaterialS
       out.tangent.row(2 * i + j) = p(i, j).d.transpose();
     }
   }
+}
+
+double Material::shear_yield_stress(const MaterialState&) const { return std::numeric_limits<double>::infinity(); }
+
+double J2JohnsonCook::shear_yield_stress(const MaterialState& at) const {
+  return johnson_cook_yield_stress(p_, at.equivalent_plastic_strain, at.plastic_strain_rate, at.temperature) / std::sqrt(3.0);
 }
 
 }  // namespace mufric::solid

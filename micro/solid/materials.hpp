@@ -41,6 +41,9 @@ class Material {
                                 bool with_tangent, const MaterialState* iterate) const = 0;
   virtual double density() const = 0;  // kg/m³ (reference configuration)
   virtual bool finite_strain() const = 0;
+  // k, Pa: the shear stress at which the material yields in the state `at` (von Mises: σ_y/√3); an
+  // elastic material never does (+∞).
+  virtual double shear_yield_stress(const MaterialState& at) const;
 };
 
 enum class PlaneKind { strain, stress };
@@ -99,6 +102,8 @@ class J2JohnsonCook final : public Material {
                         const MaterialState* iterate) const override;
   double density() const override { return p_.density; }
   bool finite_strain() const override { return true; }
+  // σ_JC(ε̄ᵖ, ε̇ᵖ, T)/√3 at the state's plastic strain, its last step's rate and its temperature.
+  double shear_yield_stress(const MaterialState& at) const override;
   const JohnsonCookParameters& parameters() const { return p_; }
   double shear_modulus() const { return mu_; }
   double bulk_modulus() const { return kappa_; }
