@@ -153,7 +153,7 @@ class InProcessClient final : public FrictionClient {
             model_->has_uncertainty(),
             model_->summary(),
             model_->has_patch_scatter(),
-            model_->calibration_description()};
+            model_->kind_description().calibration};
   }
 
  private:

@@ -105,7 +105,8 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
   out.set_extrapolation(static_cast<mufric::v1::Extrapolation>(model.default_extrapolation()));
   out.set_mu_min(model.mu_min());
   out.set_mu_max(model.mu_max());
-  if (const auto training = model.training_description()) {
+  const KindDescription kind = model.kind_description();
+  if (const auto& training = kind.training) {
     out.set_training_points(static_cast<uint64_t>(training->training_points));
     out.set_loo_mean_relative_error(training->loo_mean_relative_error);
     out.set_loo_max_relative_error(training->loo_max_relative_error);
@@ -114,7 +115,7 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
     out.set_interval(training->interval);
     out.set_micro_std_error(training->micro_std_error);
   }
-  if (const auto calibration = model.calibration_description()) {
+  if (const auto& calibration = kind.calibration) {
     auto* c = out.mutable_calibration();
     c->set_data_source(calibration->data_source);
     c->set_measurements(static_cast<uint64_t>(calibration->measurements));

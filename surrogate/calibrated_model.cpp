@@ -8,6 +8,7 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "surrogate/fast_evaluator_build.hpp"
+#include "surrogate/fast_evaluator_file.hpp"
 
 namespace mufric {
 namespace {
@@ -164,19 +165,16 @@ Eigen::VectorXd CalibratedModel::patch_std_valid(const QueryBatch& x, const Eval
                               what.exact_only() ? 0.0 : what.std_relative_tolerance);
 }
 
-std::optional<TrainingDescription> CalibratedModel::training_description() const {
-  std::optional<TrainingDescription> t = emulator_->training_description();
+KindDescription CalibratedModel::kind_description() const {
+  KindDescription out{.training = emulator_->kind_description().training, .calibration = CalibrationDescription{}};
+  std::optional<TrainingDescription>& t = out.training;
   t->interval = "calibrated";
   t->interval_meaning =
       "posterior predictive of measured friction's mean: the campaign's interval of the mean (roughness draws), "
       "the law coefficients' posterior and the model discrepancy delta given " +
       std::to_string(problem().data().mu.size()) + " measurements";
   t->micro_std_error = 0.0;
-  return t;
-}
-
-std::optional<CalibrationDescription> CalibratedModel::calibration_description() const {
-  CalibrationDescription d;
+  CalibrationDescription& d = *out.calibration;
   d.data_source = record_.data_source;
   d.measurements = problem().data().mu.size();
   d.posterior_samples = samples().rows();
@@ -189,7 +187,7 @@ std::optional<CalibrationDescription> CalibratedModel::calibration_description()
   d.conditional_sd = c.conditional_sd;
   d.emulator_sd = c.emulator_sd;
   d.discrepancy_sd = c.discrepancy_sd;
-  return d;
+  return out;
 }
 
 std::string CalibratedModel::summary() const {
@@ -233,5 +231,207 @@ std::string CalibratedModel::summary() const {
   }
   return s.str();
 }
+
+// ---- the model file (/calibrated) -----------------------------------------------------------
+
+namespace {
+constexpr const char* kCalibratedGroup = "/calibrated";
+const std::vector<std::string> kPosteriorColumns = {"mean", "sd", "lo95", "median", "hi95", "split_rhat", "effective_sample_size"};
+
+std::string attribute_list(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ",") + name;
+  return text;
+}
+
+std::vector<std::string> attribute_names(const std::string& text) {
+  std::vector<std::string> names;
+  std::string name;
+  for (const char c : text + ",") {
+    if (c != ',') {
+      name += c;
+    } else if (!name.empty()) {
+      names.push_back(name);
+      name.clear();
+    }
+  }
+  return names;
+}
+}  // namespace
+
+void CalibratedModel::write(h5::Writer& out) const {
+  const std::string g = kCalibratedGroup;
+  const CalibrationProblem& p = problem();
+  out.group(g);
+  out.string_attribute(g, "meaning",
+                       "mu(x) = mean over posterior samples s of E[eta(x, theta_s) + delta(x) | measurements]; std the "
+                       "mixture's (Kennedy & O'Hagan 2001, eq. 6); the emulator is the campaign's GP over the conditions "
+                       "and the law's coefficients");
+  write_input_space(out, emulator_->inputs(), g + "/emulator_inputs");
+  emulator_->write_group(out, g + "/emulator");
+  const Measurements& data = p.data();
+  out.group(g + "/measurements");
+  out.strings(g + "/measurements/condition_names", data.condition_names);
+  out.matrix(g + "/measurements/conditions", data.conditions);
+  out.doubles(g + "/measurements/mu", data.mu);
+  out.doubles(g + "/measurements/mu_sd", data.mu_sd);
+  out.strings(g + "/measurements/row_names", data.row_names);
+  // Conditions known within an uncertainty, and the data sets (both absent in files before them).
+  out.matrix(g + "/measurements/condition_sd", data.condition_sd);
+  out.matrix(g + "/measurements/condition_half_width", data.condition_half_width);
+  out.strings(g + "/measurements/data_sets", data.data_sets);
+  out.ints(g + "/measurements/data_set_of_row", std::vector<long long>(data.data_set_of_row.begin(), data.data_set_of_row.end()));
+  out.string_attribute(g, "parameters", attribute_list(p.parameters()));
+  // Held inputs: names and values (files before them held an input as a constant condition column).
+  std::vector<std::string> held_names;
+  std::vector<double> held_values;
+  for (const auto& [name, value] : p.held()) {
+    held_names.push_back(name);
+    held_values.push_back(value);
+  }
+  out.string_attribute(g, "held", "");
+  out.strings(g + "/held_inputs", held_names);
+  out.doubles(g + "/held_values", held_values);
+  out.int_attribute(g, "discrepancy", p.discrepancy() ? 1 : 0);
+  // Each biased data set's name and its prior (kind, a, b): what the posterior's bias columns mean.
+  std::vector<std::string> bias_sets;
+  h5::RowMatrix bias_priors(static_cast<Eigen::Index>(p.priors().biases.size()), 3);
+  for (size_t b = 0; b < p.priors().biases.size(); ++b) {
+    const auto& [name, prior] = p.priors().biases[b];
+    bias_sets.push_back(name);
+    bias_priors.row(static_cast<Eigen::Index>(b)) << static_cast<double>(prior.kind), prior.a, prior.b;
+  }
+  out.strings(g + "/bias_sets", bias_sets);
+  out.matrix(g + "/bias_priors", bias_priors);
+  out.matrix(g + "/samples", samples());
+  out.string_attribute(g, "data_source", record_.data_source);
+  out.string_attribute(g, "priors", record_.priors);
+  out.int_attribute(g, "walkers", record_.walkers);
+  out.int_attribute(g, "steps", record_.steps);
+  out.int_attribute(g, "burn_in_steps", record_.burn_in_steps);
+  out.int_attribute(g, "seed", static_cast<long long>(record_.seed));
+  out.double_attribute(g, "acceptance", record_.acceptance);
+  std::vector<std::string> names;
+  Eigen::MatrixXd table(static_cast<Eigen::Index>(record_.posterior.size()), static_cast<Eigen::Index>(kPosteriorColumns.size()));
+  for (size_t j = 0; j < record_.posterior.size(); ++j) {
+    const ParameterSummary& q = record_.posterior[j];
+    names.push_back(q.name);
+    table.row(static_cast<Eigen::Index>(j)) << q.mean, q.sd, q.lo95, q.median, q.hi95, q.split_rhat, q.effective_sample_size;
+  }
+  out.group(g + "/posterior");
+  out.string_attribute(g + "/posterior", "columns", attribute_list(kPosteriorColumns));
+  out.strings(g + "/posterior/names", names);
+  out.matrix(g + "/posterior/summary", table);
+  if (fast_) write_fast_evaluator(out, *fast_, g + "/fast_evaluator");
+}
+
+CalibratedModel CalibratedModel::read(const h5::Reader& in, InputSpace inputs) {
+  const std::string g = kCalibratedGroup;
+  InputSpace emulator_inputs = read_input_space(in, g + "/emulator_inputs");
+  auto emulator = std::make_shared<const GaussianProcess>(GaussianProcess::read_group(in, emulator_inputs, g + "/emulator"));
+  Measurements data;
+  data.condition_names = in.strings(g + "/measurements/condition_names");
+  data.conditions = in.matrix(g + "/measurements/conditions");
+  const auto rows = data.conditions.rows();
+  if (data.conditions.cols() != static_cast<Eigen::Index>(data.condition_names.size())) {
+    in.fail(g + "/measurements/conditions", "has " + std::to_string(data.conditions.cols()) + " columns for " +
+                                               std::to_string(data.condition_names.size()) + " condition names");
+  }
+  data.mu = in.vector(g + "/measurements/mu", rows);
+  data.mu_sd = in.vector(g + "/measurements/mu_sd", rows);
+  data.row_names = in.strings(g + "/measurements/row_names");
+  if (static_cast<Eigen::Index>(data.row_names.size()) != rows) in.fail(g + "/measurements/row_names", "not one per measurement");
+  if (in.has(g + "/measurements/condition_sd")) {
+    data.condition_sd = in.matrix(g + "/measurements/condition_sd");
+    data.condition_half_width = in.matrix(g + "/measurements/condition_half_width");
+    for (const auto* m : {&data.condition_sd, &data.condition_half_width}) {
+      if (m->rows() != rows || m->cols() != data.conditions.cols() || !m->allFinite() || (m->array() < 0.0).any()) {
+        in.fail(g + "/measurements/condition_sd", "the conditions' uncertainties must be finite, non-negative, one per condition");
+      }
+    }
+    data.data_sets = in.strings(g + "/measurements/data_sets");
+    for (const long long k : in.ints(g + "/measurements/data_set_of_row")) {
+      if (k < 0 || k >= static_cast<long long>(data.data_sets.size())) in.fail(g + "/measurements/data_set_of_row", "names no data set");
+      data.data_set_of_row.push_back(static_cast<int>(k));
+    }
+    if (static_cast<Eigen::Index>(data.data_set_of_row.size()) != rows) in.fail(g + "/measurements/data_set_of_row", "not one per measurement");
+  }
+  std::vector<std::pair<std::string, double>> held;
+  if (in.has(g + "/held_inputs")) {
+    const std::vector<std::string> names = in.strings(g + "/held_inputs");
+    const std::vector<double> values = in.doubles(g + "/held_values");
+    if (names.size() != values.size()) in.fail(g + "/held_values", "not one per held input");
+    for (size_t h = 0; h < names.size(); ++h) held.emplace_back(names[h], values[h]);
+  }
+  // Files before held inputs had their own: a constant condition column named in "held".
+  for (const std::string& name : attribute_names(in.string_attribute(g, "held"))) {
+    const auto found = std::find(data.condition_names.begin(), data.condition_names.end(), name);
+    if (found == data.condition_names.end()) in.fail(g, "held input '" + name + "' is not among the measurements' conditions");
+    const auto c = static_cast<Eigen::Index>(found - data.condition_names.begin());
+    if (!(data.conditions.col(c).array() == data.conditions(0, c)).all()) in.fail(g, "held input '" + name + "' differs between rows");
+    held.emplace_back(name, data.conditions(0, c));
+    data.condition_names.erase(found);
+    auto drop = [c](Eigen::MatrixXd& m) {
+      if (m.size() == 0) return;
+      Eigen::MatrixXd kept(m.rows(), m.cols() - 1);
+      kept << m.leftCols(c), m.rightCols(m.cols() - c - 1);
+      m = kept;
+    };
+    drop(data.conditions);
+    drop(data.condition_sd);
+    drop(data.condition_half_width);
+  }
+  CalibrationPriors priors;
+  priors.discrepancy = in.int_attribute(g, "discrepancy") != 0;
+  if (in.has(g + "/bias_sets")) {
+    const std::vector<std::string> sets = in.strings(g + "/bias_sets");
+    const Eigen::MatrixXd bias_priors = in.matrix(g + "/bias_priors");
+    if (bias_priors.rows() != static_cast<Eigen::Index>(sets.size()) || (!sets.empty() && bias_priors.cols() != 3)) {
+      in.fail(g + "/bias_priors", "one row (kind, a, b) per biased data set");
+    }
+    for (size_t b = 0; b < sets.size(); ++b) {
+      const double kind = bias_priors(static_cast<Eigen::Index>(b), 0);
+      if (!(kind >= 0.0 && kind <= static_cast<double>(PriorKind::half_normal) && kind == std::floor(kind))) {
+        in.fail(g + "/bias_priors", "an unknown prior kind");
+      }
+      Prior prior{static_cast<PriorKind>(static_cast<int>(kind)), bias_priors(static_cast<Eigen::Index>(b), 1),
+                  bias_priors(static_cast<Eigen::Index>(b), 2)};
+      try {
+        prior.check(g + "/bias_priors");
+      } catch (const Error& e) {
+        in.fail(g + "/bias_priors", e.what());
+      }
+      priors.biases.emplace_back(sets[b], prior);
+    }
+  }
+  const std::vector<std::string> parameters = attribute_names(in.string_attribute(g, "parameters"));
+  const Eigen::MatrixXd samples = in.matrix(g + "/samples");
+  auto problem = std::make_shared<const CalibrationProblem>(emulator, std::move(data), parameters, priors, held);
+  if (samples.cols() != problem->dimension() || samples.rows() < 1 || !samples.allFinite()) {
+    in.fail(g + "/samples", "must hold one finite row per posterior sample, " + std::to_string(problem->dimension()) + " columns");
+  }
+  CalibrationRecord record;
+  record.data_source = in.string_attribute(g, "data_source");
+  record.priors = in.string_attribute(g, "priors");
+  record.walkers = static_cast<int>(in.int_attribute(g, "walkers"));
+  record.steps = static_cast<int>(in.int_attribute(g, "steps"));
+  record.burn_in_steps = static_cast<int>(in.int_attribute(g, "burn_in_steps"));
+  record.seed = static_cast<unsigned long long>(in.int_attribute(g, "seed"));
+  record.acceptance = in.double_attribute(g, "acceptance");
+  const std::vector<std::string> names = in.strings(g + "/posterior/names");
+  const Eigen::MatrixXd table = in.matrix(g + "/posterior/summary");
+  if (table.rows() != static_cast<Eigen::Index>(names.size()) || table.cols() != static_cast<Eigen::Index>(kPosteriorColumns.size())) {
+    in.fail(g + "/posterior/summary", "must have one row per name and " + std::to_string(kPosteriorColumns.size()) + " columns");
+  }
+  for (size_t j = 0; j < names.size(); ++j) {
+    const auto r = table.row(static_cast<Eigen::Index>(j));
+    record.posterior.push_back({names[j], r(0), r(1), r(2), r(4), r(3), r(5), r(6)});
+  }
+  CalibratedModel model(std::make_shared<const CalibratedPosterior>(std::move(problem), samples), std::move(record));
+  if (!same_input_space(model.inputs(), inputs)) in.fail("/inputs", "are not the calibrated model's served inputs");
+  if (in.has(g + "/fast_evaluator")) model.attach_fast_evaluator(read_fast_evaluator(in, model, g + "/fast_evaluator"));
+  return model;
+}
+
 
 }  // namespace mufric

@@ -52,8 +52,7 @@ class CalibratedModel final : public FrictionModel {
   bool has_patch_scatter() const override { return emulator_->has_patch_scatter(); }
   void write(h5::Writer& out) const override;
   std::string summary() const override;
-  std::optional<TrainingDescription> training_description() const override;
-  std::optional<CalibrationDescription> calibration_description() const override;
+  KindDescription kind_description() const override;
 
   static CalibratedModel read(const h5::Reader& in, InputSpace inputs);
 

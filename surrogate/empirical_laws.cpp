@@ -215,4 +215,51 @@ MlrLaw fit_mlr_law(const std::string& csv_path, MlrFitReport* report) {
   return MlrLaw(std::move(rows), "fitted to " + csv_path, std::move(box));
 }
 
+// ---- the model file (/coulomb, /mlr) ---------------------------------------------------------
+
+namespace {
+std::vector<double> column(const std::vector<MlrRow>& rows, double MlrRow::*field) {
+  std::vector<double> values;
+  for (const auto& r : rows) values.push_back(r.*field);
+  return values;
+}
+}  // namespace
+
+void CoulombLaw::write(h5::Writer& out) const {
+  out.group("/coulomb");
+  out.double_attribute("/coulomb", "mu", mu_);
+}
+
+CoulombLaw CoulombLaw::read(const h5::Reader& in, InputSpace inputs) {
+  return CoulombLaw(in.double_attribute("/coulomb", "mu"), std::move(inputs));
+}
+
+// ---- MLR -----------------------------------------------------------------------------------
+void MlrLaw::write(h5::Writer& out) const {
+  out.group("/mlr");
+  out.string_attribute("/mlr", "source", source_);
+  out.string_attribute("/mlr", "units", "mu = beta0 + beta1*v[m/min] + beta2*p[MPa]; angles in degrees");
+  out.doubles("/mlr/fibre_angle_deg", column(rows_, &MlrRow::fibre_angle_deg));
+  out.doubles("/mlr/beta0", column(rows_, &MlrRow::beta0));
+  out.doubles("/mlr/beta1_per_m_min", column(rows_, &MlrRow::beta1_per_m_min));
+  out.doubles("/mlr/beta2_per_mpa", column(rows_, &MlrRow::beta2_per_mpa));
+  out.doubles("/mlr/mu_min", column(rows_, &MlrRow::mu_min));
+  out.doubles("/mlr/mu_max", column(rows_, &MlrRow::mu_max));
+  out.doubles("/mlr/r_squared", column(rows_, &MlrRow::r_squared));
+}
+
+MlrLaw MlrLaw::read(const h5::Reader& in, InputSpace inputs) {
+  const auto angles = in.doubles("/mlr/fibre_angle_deg");
+  const auto k = static_cast<Eigen::Index>(angles.size());
+  const Eigen::VectorXd b0 = in.vector("/mlr/beta0", k), b1 = in.vector("/mlr/beta1_per_m_min", k),
+                        b2 = in.vector("/mlr/beta2_per_mpa", k), lo = in.vector("/mlr/mu_min", k),
+                        hi = in.vector("/mlr/mu_max", k), r2 = in.vector("/mlr/r_squared", k);
+  std::vector<MlrRow> rows;
+  for (Eigen::Index i = 0; i < k; ++i) {
+    rows.push_back({angles[static_cast<size_t>(i)], b0(i), b1(i), b2(i), lo(i), hi(i), r2(i)});
+  }
+  return MlrLaw(std::move(rows), in.string_attribute("/mlr", "source"), std::move(inputs));
+}
+
+
 }  // namespace mufric

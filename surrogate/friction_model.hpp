@@ -77,7 +77,7 @@ struct Evaluation {
 };
 
 // What a trained model knows of its training, for `describe` and the service's DescribeModel; a law
-// has none (FrictionModel::training_description).
+// has none (FrictionModel::kind_description).
 struct TrainingDescription {
   long long training_points = 0;
   double loo_mean_relative_error = 0.0, loo_max_relative_error = 0.0, loo_coverage_95 = 0.0;
@@ -98,6 +98,12 @@ struct CalibrationDescription {
   bool discrepancy = false;
   std::vector<Parameter> parameters;
   double mu = 0.0, sd = 0.0, parameter_sd = 0.0, conditional_sd = 0.0, emulator_sd = 0.0, discrepancy_sd = 0.0;
+};
+
+// The structured description of a kind: the parts it has.
+struct KindDescription {
+  std::optional<TrainingDescription> training;
+  std::optional<CalibrationDescription> calibration;
 };
 
 class FrictionModel {
@@ -130,10 +136,9 @@ class FrictionModel {
 
   // Free text: provenance, accuracy figures (shown by describe/train).
   virtual std::string summary() const = 0;
-  // Its training, for a model that was trained; nothing for a law.
-  virtual std::optional<TrainingDescription> training_description() const { return std::nullopt; }
-  // What it was calibrated on, for a calibrated model; nothing otherwise.
-  virtual std::optional<CalibrationDescription> calibration_description() const { return std::nullopt; }
+  // What the kind can say of itself beyond the summary, structured (describe, DescribeModel, the
+  // clients' ModelInfo): a law nothing, a trained model its training, a calibrated one its calibration.
+  virtual KindDescription kind_description() const { return {}; }
 
  protected:
   explicit FrictionModel(InputSpace inputs) : inputs_(std::move(inputs)) {}

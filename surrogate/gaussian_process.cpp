@@ -544,15 +544,16 @@ Eigen::VectorXd GaussianProcess::std_from_log_variance(const GaussianProcess& lo
   return out;
 }
 
-std::optional<TrainingDescription> GaussianProcess::training_description() const {
+KindDescription GaussianProcess::kind_description() const {
   const auto& t = state_.summary;
-  return TrainingDescription{.training_points = static_cast<long long>(state_.x_train.rows()),
+  return {.training = TrainingDescription{.training_points = static_cast<long long>(state_.x_train.rows()),
                              .loo_mean_relative_error = t.loo_mean_relative_error,
                              .loo_max_relative_error = t.loo_max_relative_error,
                              .loo_coverage_95 = t.loo_coverage_95,
                              .interval = std::string(to_string(interval_meaning())),
                              .interval_meaning = gp_interval_meaning(interval_meaning()),
-                             .micro_std_error = state_.micro_std_error};
+                             .micro_std_error = state_.micro_std_error},
+          .calibration = std::nullopt};
 }
 
 std::string leave_one_out_text(const GpTrainingSummary& t, bool noisy_samples) {

@@ -120,7 +120,7 @@ class GaussianProcess final : public FrictionModel {
   bool has_patch_scatter() const override { return patch_scatter_ != nullptr; }
   void write(h5::Writer& out) const override;
   std::string summary() const override;
-  std::optional<TrainingDescription> training_description() const override;
+  KindDescription kind_description() const override;
   const State& state() const { return state_; }
 
   // Rebuilds a model from the file's groups; refuses inconsistent contents (names the field).

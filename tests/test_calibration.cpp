@@ -616,7 +616,7 @@ TEST(CalibratedModel, ServesTheMixtureOfTheKennedyOHaganPredictivesOverItsPoster
               1e-12);
   EXPECT_GT(centre.discrepancy_sd, 0.0);
   EXPECT_GT(centre.emulator_sd, 0.0);
-  EXPECT_EQ(model.training_description()->interval, "calibrated");
+  EXPECT_EQ(model.kind_description().training->interval, "calibrated");
   // The exact gradient: a central difference over a much wider step agrees to the curvature's size.
   EvaluationRequest with_gradient = exact;
   with_gradient.gradient = true;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "common/error.hpp"
+#include "common/registry.hpp"
 
 namespace mufric::contact {
 namespace {
@@ -173,18 +174,9 @@ const std::vector<InterfaceLawEntry>& interface_laws() {
   return laws;
 }
 
-const InterfaceLawEntry* find_interface_law(std::string_view name) {
-  for (const auto& law : interface_laws()) {
-    if (law.name == name) return &law;
-  }
-  return nullptr;
-}
+const InterfaceLawEntry* find_interface_law(std::string_view name) { return find_entry(interface_laws(), name); }
 
-std::string interface_law_names() {
-  std::string names;
-  for (const auto& law : interface_laws()) names += (names.empty() ? "" : ", ") + std::string(law.name);
-  return names;
-}
+std::string interface_law_names() { return entry_names(interface_laws()); }
 
 // ---- sampled point states -----------------------------------------------------------------------
 
