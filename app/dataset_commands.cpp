@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/input_flags.hpp"
 #include "campaign/dataset_generation.hpp"
 #include "campaign/campaign_summary.hpp"
 #include "campaign/refine.hpp"
@@ -46,12 +47,12 @@ std::pair<double, double> parse_range(const std::string& text, QuantityKind kind
 }
 
 // The inputs a micro-model scene can set besides p, v, T: the interface law's coefficients.
-std::vector<const KnownInput*> law_coefficient_inputs() {
-  std::vector<const KnownInput*> coefficients;
+std::vector<const scene::SettableInput*> law_coefficient_inputs() {
+  std::vector<const scene::SettableInput*> coefficients;
   const InputSpace box = default_friction_box();
-  for (const KnownInput& input : known_inputs()) {
-    const bool in_box = std::any_of(box.begin(), box.end(), [&](const InputSpec& s) { return s.name == input.name; });
-    if (!input.scene_key.empty() && !in_box) coefficients.push_back(&input);
+  for (const scene::SettableInput& input : scene::settable_inputs()) {
+    const bool in_box = std::any_of(box.begin(), box.end(), [&](const InputSpec& s) { return s.name == input.input; });
+    if (!in_box) coefficients.push_back(&input);
   }
   return coefficients;
 }
@@ -75,15 +76,15 @@ struct PlanOptions {
 void plan_command(const PlanOptions& o) {
   InputSpace box = default_friction_box();
   for (auto& input : box) {
-    const std::string flag(find_known_input(input.name)->flag);
+    const std::string flag(flag_of(input.name));
     const auto text = o.ranges.find(flag);
     if (text != o.ranges.end() && !text->second.empty()) std::tie(input.lo, input.hi) = parse_range(text->second, input.kind(), flag);
   }
   // A law coefficient given a range becomes an input of the plan, after p, v, T (a calibration's θ).
-  for (const KnownInput* coefficient : law_coefficient_inputs()) {
-    const auto text = o.ranges.find(std::string(coefficient->flag));
+  for (const scene::SettableInput* coefficient : law_coefficient_inputs()) {
+    const auto text = o.ranges.find(std::string(flag_of(coefficient->input)));
     if (text == o.ranges.end() || text->second.empty()) continue;
-    InputSpec input{std::string(coefficient->name), std::string(si_unit(coefficient->kind)), 0.0, 0.0};
+    InputSpec input{std::string(coefficient->input), std::string(si_unit(coefficient->kind)), 0.0, 0.0};
     std::tie(input.lo, input.hi) = parse_range(text->second, coefficient->kind, text->first);
     box.push_back(input);
   }
@@ -349,15 +350,15 @@ void add_dataset_commands(CLI::App& app) {
   plan->add_option("--design", p->design, "sobol, lhs (Latin hypercube) or random")->capture_default_str();
   plan->add_option("--seed", p->seed, "Seed (Sobol: 0 = unshifted, else a random digital shift)")->capture_default_str();
   for (const InputSpec& input : default_friction_box()) {  // --p, --v, --T
-    const std::string flag(find_known_input(input.name)->flag);
+    const std::string flag(flag_of(input.name));
     plan->add_option(flag, p->ranges[flag],
                      "Range of " + input.name + ", e.g. " + format_human(input.lo, input.kind()) + ":" +
                          format_human(input.hi, input.kind()) + " (default: that, seed 000's box)");
   }
-  for (const KnownInput* coefficient : law_coefficient_inputs()) {  // --shear-factor, ...
-    const std::string flag(coefficient->flag);
+  for (const scene::SettableInput* coefficient : law_coefficient_inputs()) {  // --shear-factor, ...
+    const std::string flag(flag_of(coefficient->input));
     plan->add_option(flag, p->ranges[flag],
-                     "Vary the interface law's " + std::string(coefficient->name) + " (" + std::string(coefficient->scene_key) +
+                     "Vary the interface law's " + std::string(coefficient->input) + " (" + coefficient->scene_key +
                          ") over lo:hi, e.g. 0.2:0.9, as an input after p, v, T (a calibration campaign); the scene's "
                          "law must read it");
   }

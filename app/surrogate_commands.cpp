@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/input_flags.hpp"
 #include "client/friction_client.hpp"
 #include "campaign/campaign_summary.hpp"
 #include "common/csv_table.hpp"
@@ -393,7 +394,7 @@ void add_predict(CLI::App& app) {
   cmd->add_option("--model", o->model, "Model: file:///path/model.h5 (or a path), a shipped model's name (dry_default), or grpc://host:port/model")->required();
   for (const KnownInput& input : known_inputs()) {  // --p, --v, --T, --angle: what a client carries
     if (!input.on_the_wire) continue;
-    const std::string flag(input.flag);
+    const std::string flag(flag_of(input.name));
     cmd->add_option(flag, o->values[flag],
                     "The " + std::string(input.name) + " with its unit, e.g. " + std::string(example_quantity(input.kind)));
   }
@@ -421,15 +422,15 @@ void add_predict(CLI::App& app) {
     PredictPoints points;
     if (from_csv) {
       for (const KnownInput& input : known_inputs()) {
-        if (input.on_the_wire && !o->values[std::string(input.flag)].empty()) throw Error(std::string(input.flag) + " and --csv exclude each other");
+        const std::string flag(flag_of(input.name));
+        if (input.on_the_wire && !o->values[flag].empty()) throw Error(flag + " and --csv exclude each other");
       }
       points = points_from_csv(o->csv, inputs);
     } else {
       if (!o->out.empty()) throw Error("--out goes with --csv");
       for (const auto& input : inputs) {
-        const KnownInput* known = find_known_input(input.name);
-        if (known == nullptr) throw Error("model input '" + input.name + "' has no command-line flag (use --csv)");
-        const std::string flag(known->flag);
+        const std::string flag(flag_of(input.name));
+        if (flag.empty()) throw Error("model input '" + input.name + "' has no command-line flag (use --csv)");
         const std::string& text = o->values[flag];
         if (text.empty()) throw Error(flag + " is required: the model's input " + input.name + " (e.g. " + flag + " " +
                                       std::string(example_quantity(input.kind())) + ")");
@@ -438,8 +439,9 @@ void add_predict(CLI::App& app) {
       for (const KnownInput& known : known_inputs()) {
         if (!known.on_the_wire) continue;
         const bool used = std::any_of(inputs.begin(), inputs.end(), [&](const InputSpec& s) { return s.name == known.name; });
-        if (!used && !o->values[std::string(known.flag)].empty()) {
-          throw Error(std::string(known.flag) + " was given but the model has no input " + std::string(known.name));
+        const std::string flag(flag_of(known.name));
+        if (!used && !o->values[flag].empty()) {
+          throw Error(flag + " was given but the model has no input " + std::string(known.name));
         }
       }
     }

@@ -7,6 +7,8 @@
 #include <limits>
 #include <string>
 
+#include "common/registry.hpp"
+
 #include "common/error.hpp"
 #include "common/wording.hpp"
 
@@ -173,13 +175,13 @@ std::string format_human(double value_si, QuantityKind kind, int precision) {
 
 const std::vector<KnownInput>& known_inputs() {
   static const std::vector<KnownInput> inputs{
-      {input_name::contact_pressure, QuantityKind::pressure, "--p", "load.pressure"},
-      {input_name::sliding_velocity, QuantityKind::velocity, "--v", "load.velocity"},
-      {input_name::temperature, QuantityKind::temperature, "--T", "load.temperature"},
-      {input_name::fibre_angle, QuantityKind::angle, "--angle", ""},  // the empirical FRP law's, no scene
-      {input_name::adhesive_coefficient, QuantityKind::dimensionless, "--adhesive-coefficient", "contact.adhesive_coefficient", false},
-      {input_name::shear_factor, QuantityKind::dimensionless, "--shear-factor", "contact.shear_factor", false},
-      {input_name::childs_exponent, QuantityKind::dimensionless, "--childs-exponent", "contact.childs_exponent", false}};
+      {input_name::contact_pressure, QuantityKind::pressure},
+      {input_name::sliding_velocity, QuantityKind::velocity},
+      {input_name::temperature, QuantityKind::temperature},
+      {input_name::fibre_angle, QuantityKind::angle},  // the empirical FRP law's
+      {input_name::adhesive_coefficient, QuantityKind::dimensionless, false},
+      {input_name::shear_factor, QuantityKind::dimensionless, false},
+      {input_name::childs_exponent, QuantityKind::dimensionless, false}};
   return inputs;
 }
 
@@ -190,18 +192,13 @@ std::string servable_inputs_violation(const std::vector<std::string>& input_name
     if (!known->on_the_wire) {
       return "its input '" + name +
              "' is a coefficient of the interface law, which a served model must not leave open: calibrate it against "
-             "measured friction (mufric calibrate) and serve the calibrated model";
+             "measured friction and serve the calibrated model";
     }
   }
   return "";
 }
 
-const KnownInput* find_known_input(std::string_view input_name) {
-  for (const KnownInput& input : known_inputs()) {
-    if (input.name == input_name) return &input;
-  }
-  return nullptr;
-}
+const KnownInput* find_known_input(std::string_view input_name) { return find_entry(known_inputs(), input_name); }
 
 const std::vector<std::string>& known_input_names() {
   static const std::vector<std::string> names = [] {

@@ -52,17 +52,15 @@ inline constexpr std::string_view shear_factor = "shear_factor";
 inline constexpr std::string_view childs_exponent = "childs_exponent";
 }  // namespace input_name
 
-// The model inputs mufric knows, the one table of them: in their usual order (the C ABI's argument
-// order, a dataset's columns), each with its kind of quantity (so its SI unit), the command-line
-// flag that gives its value or range (predict, dataset plan), the scene key a micro-model dataset
-// sets it through (empty: no scene has it), and whether the wire and the clients carry it (a served
-// model's inputs must; a law coefficient that a calibration integrates out need not, and a model
-// that still has one is not served: servable_inputs_violation).
+// The model inputs mufric knows, the vocabulary of its files and its wire: in their usual order (the
+// C ABI's argument order, a dataset's columns), each with its kind of quantity (so its SI unit), and
+// whether the wire and the clients carry it (a meso code's contact conditions; a law coefficient
+// that a calibration integrates out is not, and a model that still has one is not served:
+// servable_inputs_violation). What sets an input elsewhere is its owner's: a scene key in
+// micro/scene (scene::settable_inputs), a command-line flag in app/ (app/input_flags.hpp).
 struct KnownInput {
   std::string_view name;
   QuantityKind kind;
-  std::string_view flag;
-  std::string_view scene_key;
   bool on_the_wire = true;
 };
 const std::vector<KnownInput>& known_inputs();

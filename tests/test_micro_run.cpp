@@ -142,10 +142,9 @@ TEST(Scene, AKnownInputsSceneKeySetsItsValueToTheLastBit) {
                                                      {input_name::shear_factor, 0.6 + 1.0 / 7000.0},
                                                      {input_name::childs_exponent, 3.0 + 1.0 / 3.0}};
   std::vector<SceneValue> values;
-  for (const KnownInput& input : known_inputs()) {
-    if (input.scene_key.empty()) continue;
-    ASSERT_EQ(value_of.count(input.name), 1U) << input.name << ": a new input with a scene key needs its value here";
-    values.push_back({input.scene_key, value_of.at(input.name), input.kind});
+  for (const SettableInput& input : settable_inputs()) {
+    ASSERT_EQ(value_of.count(input.input), 1U) << input.input << ": a new input with a scene key needs its value here";
+    values.push_back({input.scene_key, value_of.at(input.input), input.kind});
   }
   ASSERT_EQ(values.size(), 6U);
   const Scene set = scene_with_values(base, values);

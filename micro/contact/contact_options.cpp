@@ -101,4 +101,11 @@ ContactOptions ContactOptions::read(OptionKeys& c, const std::string& base_direc
   return o;
 }
 
+const std::vector<CoefficientInput>& coefficient_inputs() {
+  static const std::vector<CoefficientInput> inputs{{input_name::adhesive_coefficient, "adhesive_coefficient"},
+                                                    {input_name::shear_factor, "shear_factor"},
+                                                    {input_name::childs_exponent, "childs_exponent"}};
+  return inputs;
+}
+
 }  // namespace mufric::contact

@@ -4,6 +4,8 @@
 // reads; another law's key is recorded as read without effect), stick's tangential penalty and the
 // heat partition. The scene only composes these; a contact option is added here and nowhere else.
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "micro/contact/interface_laws.hpp"
 #include "micro/contact/mortar_contact.hpp"
@@ -19,5 +21,13 @@ struct ContactOptions {
   static ContactOptions read(OptionKeys& keys, const std::string& base_directory);
   bool operator==(const ContactOptions&) const = default;
 };
+
+// The law coefficients a campaign may vary as model inputs (common/units.hpp input_name), each by the
+// key that sets it in the contact section.
+struct CoefficientInput {
+  std::string_view input;
+  std::string_view key;
+};
+const std::vector<CoefficientInput>& coefficient_inputs();
 
 }  // namespace mufric::contact

@@ -17,22 +17,20 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     throw Error(scene.source + ": load.vertical_displacement: a dataset varies the contact pressure, so the scene must "
                                "give load.pressure");
   }
-  // Each input sets the scene key the one table of inputs gives it (KnownInput::scene_key).
-  std::vector<const KnownInput*> known;
+  // Each input sets the scene key the scene gives it (scene::settable_inputs).
+  std::vector<const SettableInput*> known;
   std::string settable;
-  for (const KnownInput& k : known_inputs()) {
-    if (!k.scene_key.empty()) settable += (settable.empty() ? "" : ", ") + std::string(k.name);
-  }
+  for (const SettableInput& k : settable_inputs()) settable += (settable.empty() ? "" : ", ") + std::string(k.input);
   for (const InputSpec& input : inputs) {
-    const KnownInput* k = find_known_input(input.name);
-    if (k == nullptr || k->scene_key.empty()) {
+    const SettableInput* k = find_settable_input(input.name);
+    if (k == nullptr) {
       throw Error("input '" + input.name + "' has no counterpart in a micro-model scene (the inputs a scene sets: " +
                   settable + ")");
     }
     known.push_back(k);
   }
   for (const std::string_view required : {input_name::contact_pressure, input_name::sliding_velocity, input_name::temperature}) {
-    if (std::none_of(known.begin(), known.end(), [&](const KnownInput* k) { return k->name == required; })) {
+    if (std::none_of(known.begin(), known.end(), [&](const SettableInput* k) { return k->input == required; })) {
       throw Error("a micro-model dataset needs the inputs contact_pressure, sliding_velocity and temperature");
     }
   }
@@ -43,10 +41,10 @@ SampleEvaluator micro_evaluator(const Scene& scene, const InputSpace& inputs, in
     std::vector<SceneValue> corner;
     for (size_t j = 0; j < known.size(); ++j) corner.push_back({known[j]->scene_key, upper ? inputs[j].hi : inputs[j].lo, known[j]->kind});
     const Scene read = scene_with_values(scene, corner);
-    for (const KnownInput* k : known) {
-      const auto unread = read.ineffective_keys.find(std::string(k->scene_key));
+    for (const SettableInput* k : known) {
+      const auto unread = read.ineffective_keys.find(k->scene_key);
       if (unread != read.ineffective_keys.end()) {
-        throw Error("input '" + std::string(k->name) + "' sets " + std::string(k->scene_key) + ", which has no effect: " +
+        throw Error("input '" + std::string(k->input) + "' sets " + k->scene_key + ", which has no effect: " +
                     unread->second + " (choose a law that reads it with --set contact.law=...)");
       }
     }

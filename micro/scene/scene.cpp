@@ -300,6 +300,26 @@ Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& 
   return parse_scene(json, source, base_directory);
 }
 
+const std::vector<SettableInput>& settable_inputs() {
+  static const std::vector<SettableInput> inputs = [] {
+    std::vector<SettableInput> list{{input_name::contact_pressure, "load.pressure", QuantityKind::pressure},
+                                    {input_name::sliding_velocity, "load.velocity", QuantityKind::velocity},
+                                    {input_name::temperature, "load.temperature", QuantityKind::temperature}};
+    for (const contact::CoefficientInput& c : contact::coefficient_inputs()) {
+      list.push_back({c.input, "contact." + std::string(c.key), kind_of_input(c.input)});
+    }
+    return list;
+  }();
+  return inputs;
+}
+
+const SettableInput* find_settable_input(std::string_view input) {
+  for (const SettableInput& s : settable_inputs()) {
+    if (s.input == input) return &s;
+  }
+  return nullptr;
+}
+
 Scene scene_with_values(const Scene& scene, const std::vector<SceneValue>& values) {
   nlohmann::json json = scene.effective;
   for (const auto& [key, value, kind] : values) {

@@ -171,9 +171,19 @@ nlohmann::json default_scene_json();
 // A scene's JSON with "key=value" overrides applied, parsed.
 Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& overrides, const std::string& source,
                            const std::string& base_directory = ".");
+// The model inputs a scene sets, each by its key: the load's conditions (load.pressure, ...) and the
+// contact's law coefficients (contact.shear_factor, ...: contact::coefficient_inputs).
+struct SettableInput {
+  std::string_view input;  // common/units.hpp input_name
+  std::string scene_key;
+  QuantityKind kind;
+};
+const std::vector<SettableInput>& settable_inputs();
+const SettableInput* find_settable_input(std::string_view input);
+
 // The scene read again from its own words with SI values set at scene keys ("load.pressure" to 8e8):
-// how a dataset sets a plan point's inputs, whatever scene key an input names (common/units.hpp's
-// KnownInput::scene_key). Every check of the scene applies to the new values.
+// how a dataset sets a plan point's inputs, whatever scene key an input names (settable_inputs).
+// Every check of the scene applies to the new values.
 struct SceneValue {
   std::string_view key;  // e.g. load.pressure, contact.shear_factor
   double si;             // the value in SI
