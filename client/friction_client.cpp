@@ -276,12 +276,8 @@ class GrpcClient final : public FrictionClient {
       calibration.discrepancy = c.discrepancy();
       for (const auto& p : c.parameters()) calibration.parameters.push_back({p.name(), p.mean(), p.sd(), p.lo95(), p.hi95()});
       const auto& parts = c.at_box_centre();
-      calibration.mu = parts.mu();
-      calibration.sd = parts.sd();
-      calibration.parameter_sd = parts.parameter_sd();
-      calibration.conditional_sd = parts.conditional_sd();
-      calibration.emulator_sd = parts.emulator_sd();
-      calibration.discrepancy_sd = parts.discrepancy_sd();
+      calibration.at_box_centre = {parts.mu(), parts.sd(), parts.parameter_sd(), parts.conditional_sd(), parts.emulator_sd(),
+                                   parts.discrepancy_sd()};
       info.calibration = std::move(calibration);
     }
     return info;

@@ -130,12 +130,12 @@ void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
       q->set_hi95(p.hi95);
     }
     auto* parts = c->mutable_at_box_centre();
-    parts->set_mu(calibration->mu);
-    parts->set_sd(calibration->sd);
-    parts->set_parameter_sd(calibration->parameter_sd);
-    parts->set_conditional_sd(calibration->conditional_sd);
-    parts->set_emulator_sd(calibration->emulator_sd);
-    parts->set_discrepancy_sd(calibration->discrepancy_sd);
+    parts->set_mu(calibration->at_box_centre.mu);
+    parts->set_sd(calibration->at_box_centre.sd);
+    parts->set_parameter_sd(calibration->at_box_centre.parameter_sd);
+    parts->set_conditional_sd(calibration->at_box_centre.conditional_sd);
+    parts->set_emulator_sd(calibration->at_box_centre.emulator_sd);
+    parts->set_discrepancy_sd(calibration->at_box_centre.discrepancy_sd);
   }
   out.set_has_patch_scatter(model.has_patch_scatter());
   out.set_summary(model.summary());

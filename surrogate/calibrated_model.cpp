@@ -180,13 +180,7 @@ KindDescription CalibratedModel::kind_description() const {
   d.posterior_samples = samples().rows();
   d.discrepancy = problem().discrepancy();
   for (const ParameterSummary& q : record_.posterior) d.parameters.push_back({q.name, q.mean, q.sd, q.lo95, q.hi95});
-  const IntervalParts& c = centre_parts_;
-  d.mu = c.mu;
-  d.sd = c.sd;
-  d.parameter_sd = c.parameter_sd;
-  d.conditional_sd = c.conditional_sd;
-  d.emulator_sd = c.emulator_sd;
-  d.discrepancy_sd = c.discrepancy_sd;
+  d.at_box_centre = centre_parts_;
   return out;
 }
 

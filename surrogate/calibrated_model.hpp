@@ -33,12 +33,6 @@ struct CalibrationRecord {
   double acceptance = 0.0;
 };
 
-// The interval's parts at one point (μ units): see CalibratedPrediction. sd² = parameter_sd² +
-// conditional_sd²; emulator_sd and discrepancy_sd are each η's and δ's alone given the data, which
-// need not add up (given the measurements η and δ are correlated: what one explains the other need not).
-struct IntervalParts {
-  double mu = 0.0, sd = 0.0, parameter_sd = 0.0, conditional_sd = 0.0, emulator_sd = 0.0, discrepancy_sd = 0.0;
-};
 
 class CalibratedModel final : public FrictionModel {
  public:

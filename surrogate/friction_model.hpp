@@ -88,6 +88,13 @@ struct TrainingDescription {
 
 // What a calibrated model was calibrated on and its interval's parts at the box centre (μ units), for
 // `describe` and DescribeModel; see surrogate/calibrated_model.hpp.
+// A calibrated model's interval at a point, in its parts (μ units): sd² = parameter_sd² +
+// conditional_sd²; emulator_sd and discrepancy_sd are η's and δ's alone given the data, which need
+// not add up (given the measurements η and δ are correlated: what one explains the other need not).
+struct IntervalParts {
+  double mu = 0.0, sd = 0.0, parameter_sd = 0.0, conditional_sd = 0.0, emulator_sd = 0.0, discrepancy_sd = 0.0;
+};
+
 struct CalibrationDescription {
   struct Parameter {
     std::string name;
@@ -97,7 +104,7 @@ struct CalibrationDescription {
   long long measurements = 0, posterior_samples = 0;
   bool discrepancy = false;
   std::vector<Parameter> parameters;
-  double mu = 0.0, sd = 0.0, parameter_sd = 0.0, conditional_sd = 0.0, emulator_sd = 0.0, discrepancy_sd = 0.0;
+  IntervalParts at_box_centre;
 };
 
 // The structured description of a kind: the parts it has.

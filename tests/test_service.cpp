@@ -1176,7 +1176,7 @@ TEST_F(Service, ACalibratedModelAnswersEveryInterfaceAndDescribesItsCalibration)
     ASSERT_EQ(info.calibration->parameters.size(), 5u) << uri;
     EXPECT_EQ(info.calibration->parameters[1].name, "bias[tribometer]") << uri;
     EXPECT_EQ(info.calibration->parameters[0].lo95, d.calibration().parameters(0).lo95()) << uri;
-    EXPECT_EQ(info.calibration->sd, parts.sd()) << uri;
+    EXPECT_EQ(info.calibration->at_box_centre.sd, parts.sd()) << uri;
     EXPECT_EQ(info.calibration->measurements, 6) << uri;
   }
   EXPECT_FALSE(client::connect("grpc://" + server.address() + "/gp")->describe().calibration.has_value());

@@ -98,39 +98,17 @@ LubricantOptions lubricant_options(const LubricantSettings& settings, const Lubr
 
 }  // namespace mufric::coupling
 
-namespace mufric {
-template <>
-struct OptionChoice<coupling::Compressibility> {
-  static constexpr std::array<NamedChoice<coupling::Compressibility>, 3> names{
-      {{"none", coupling::Compressibility::none},
-       {"linear", coupling::Compressibility::linear},
-       {"dowson-higginson", coupling::Compressibility::dowson_higginson}}};
-};
-template <>
-struct OptionChoice<coupling::FilmFill> {
-  static constexpr std::array<NamedChoice<coupling::FilmFill>, 2> names{
-      {{"gap", coupling::FilmFill::gap}, {"after-pressing", coupling::FilmFill::after_pressing}}};
-};
-template <>
-struct OptionChoice<coupling::CavitationModel> {
-  static constexpr std::array<NamedChoice<coupling::CavitationModel>, 2> names{
-      {{"none", coupling::CavitationModel::none}, {"mass-conserving", coupling::CavitationModel::mass_conserving}}};
-};
-template <>
-struct OptionChoice<coupling::LeakModel> {
-  static constexpr std::array<NamedChoice<coupling::LeakModel>, 3> names{
-      {{"none", coupling::LeakModel::none}, {"ambient", coupling::LeakModel::ambient}, {"cell-mean", coupling::LeakModel::cell_mean}}};
-};
-template <>
-struct OptionChoice<coupling::FilmMeshMotion> {
-  static constexpr std::array<NamedChoice<coupling::FilmMeshMotion>, 2> names{
-      {{"columns", coupling::FilmMeshMotion::columns}, {"elastic", coupling::FilmMeshMotion::elastic}}};
-};
-template <>
-struct OptionChoice<coupling::Acceleration> {
-  static constexpr std::array<NamedChoice<coupling::Acceleration>, 3> names{
-      {{"iqn-ils", coupling::Acceleration::iqn_ils},
-       {"aitken", coupling::Acceleration::aitken},
-       {"relaxation", coupling::Acceleration::constant_relaxation}}};
-};
-}  // namespace mufric
+MUFRIC_OPTION_WORDS(coupling::Compressibility, {"none", coupling::Compressibility::none},
+                    {"linear", coupling::Compressibility::linear},
+                    {"dowson-higginson", coupling::Compressibility::dowson_higginson})
+MUFRIC_OPTION_WORDS(coupling::FilmFill, {"gap", coupling::FilmFill::gap},
+                    {"after-pressing", coupling::FilmFill::after_pressing})
+MUFRIC_OPTION_WORDS(coupling::CavitationModel, {"none", coupling::CavitationModel::none},
+                    {"mass-conserving", coupling::CavitationModel::mass_conserving})
+MUFRIC_OPTION_WORDS(coupling::LeakModel, {"none", coupling::LeakModel::none},
+                    {"ambient", coupling::LeakModel::ambient}, {"cell-mean", coupling::LeakModel::cell_mean})
+MUFRIC_OPTION_WORDS(coupling::FilmMeshMotion, {"columns", coupling::FilmMeshMotion::columns},
+                    {"elastic", coupling::FilmMeshMotion::elastic})
+MUFRIC_OPTION_WORDS(coupling::Acceleration, {"iqn-ils", coupling::Acceleration::iqn_ils},
+                    {"aitken", coupling::Acceleration::aitken},
+                    {"relaxation", coupling::Acceleration::constant_relaxation})

@@ -66,10 +66,5 @@ class LinearSolver {
 
 }  // namespace mufric::numerics
 
-namespace mufric {
-template <>
-struct OptionChoice<numerics::LinearSolverKind> {
-  static constexpr std::array<NamedChoice<numerics::LinearSolverKind>, 2> names{
-      {{"lu", numerics::LinearSolverKind::lu}, {"cholesky", numerics::LinearSolverKind::cholesky}}};
-};
-}  // namespace mufric
+MUFRIC_OPTION_WORDS(numerics::LinearSolverKind, {"lu", numerics::LinearSolverKind::lu},
+                    {"cholesky", numerics::LinearSolverKind::cholesky})

@@ -124,23 +124,12 @@ struct Scene {
 
 }  // namespace mufric::scene
 
-namespace mufric {
 // The words of the scene file, in the order its error messages list them.
-template <>
-struct OptionChoice<scene::Physics> {
-  static constexpr std::array<NamedChoice<scene::Physics>, 2> names{{{"dry", scene::Physics::dry}, {"lubricated", scene::Physics::lubricated}}};
-};
-template <>
-struct OptionChoice<scene::Protocol> {
-  static constexpr std::array<NamedChoice<scene::Protocol>, 2> names{
-      {{"press-slide", scene::Protocol::press_slide}, {"seed-000", scene::Protocol::seed000}}};
-};
-template <>
-struct OptionChoice<scene::DrawnSurfaces> {
-  static constexpr std::array<NamedChoice<scene::DrawnSurfaces>, 2> names{
-      {{"tools", scene::DrawnSurfaces::tools}, {"tools-and-chip", scene::DrawnSurfaces::tools_and_chip}}};
-};
-}  // namespace mufric
+MUFRIC_OPTION_WORDS(scene::Physics, {"dry", scene::Physics::dry}, {"lubricated", scene::Physics::lubricated})
+MUFRIC_OPTION_WORDS(scene::Protocol, {"press-slide", scene::Protocol::press_slide},
+                    {"seed-000", scene::Protocol::seed000})
+MUFRIC_OPTION_WORDS(scene::DrawnSurfaces, {"tools", scene::DrawnSurfaces::tools},
+                    {"tools-and-chip", scene::DrawnSurfaces::tools_and_chip})
 
 namespace mufric::scene {
 

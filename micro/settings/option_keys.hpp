@@ -26,6 +26,15 @@ struct NamedChoice {
 };
 template <class E>
 struct OptionChoice;
+// Declares E's word table, at global scope: MUFRIC_OPTION_WORDS(solid::TimeScheme, {"generalized-alpha",
+// solid::TimeScheme::generalized_alpha}, {"quasi-static", solid::TimeScheme::quasi_static});
+#define MUFRIC_OPTION_WORDS(E, ...)                                   \
+  namespace mufric {                                                  \
+  template <>                                                         \
+  struct OptionChoice<E> {                                            \
+    static constexpr NamedChoice<E> names[] = {__VA_ARGS__};          \
+  };                                                                  \
+  }
 template <class E>
 const char* choice_name(E value) {
   for (const auto& c : OptionChoice<E>::names) {

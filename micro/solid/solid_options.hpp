@@ -81,20 +81,9 @@ HeatConductionOptions heat_conduction_options(const ThermalOptions& thermal, con
 
 }  // namespace mufric::solid
 
-namespace mufric {
-template <>
-struct OptionChoice<solid::TimeScheme> {
-  static constexpr std::array<NamedChoice<solid::TimeScheme>, 2> names{
-      {{"generalized-alpha", solid::TimeScheme::generalized_alpha}, {"quasi-static", solid::TimeScheme::quasi_static}}};
-};
-template <>
-struct OptionChoice<solid::VolumetricTreatment> {
-  static constexpr std::array<NamedChoice<solid::VolumetricTreatment>, 2> names{
-      {{"full", solid::VolumetricTreatment::full}, {"mean-dilatation", solid::VolumetricTreatment::mean_dilatation}}};
-};
-template <>
-struct OptionChoice<solid::ThermalModel> {
-  static constexpr std::array<NamedChoice<solid::ThermalModel>, 2> names{
-      {{"adiabatic", solid::ThermalModel::adiabatic}, {"conduction", solid::ThermalModel::conduction}}};
-};
-}  // namespace mufric
+MUFRIC_OPTION_WORDS(solid::TimeScheme, {"generalized-alpha", solid::TimeScheme::generalized_alpha},
+                    {"quasi-static", solid::TimeScheme::quasi_static})
+MUFRIC_OPTION_WORDS(solid::VolumetricTreatment, {"full", solid::VolumetricTreatment::full},
+                    {"mean-dilatation", solid::VolumetricTreatment::mean_dilatation})
+MUFRIC_OPTION_WORDS(solid::ThermalModel, {"adiabatic", solid::ThermalModel::adiabatic},
+                    {"conduction", solid::ThermalModel::conduction})
