@@ -42,16 +42,32 @@ SplineCurve flat_chip_surface(double y, double period, int spans) {
   return SplineCurve(SplineBasis::periodic_uniform(2, spans, 0, 1), p, {}, Eigen::Vector2d(period, 0));
 }
 
+// The patch tests' set-up: a linear elastic flat chip (7 spans along, `through` across) fixed at its
+// bottom and pressed there by `pressure` onto a flat rigid tool that starts 1e-6 inside it, so contact
+// is active from the first iteration; `law` at the interface (frictionless by default).
+struct FlatChipOnTool {
+  static constexpr double period = 1.0, height = 0.5, penalty = 1e3;
+  std::unique_ptr<solid::SolidProblem> chip;
+  std::shared_ptr<MortarContact> contact;
+};
+
+FlatChipOnTool flat_chip_on_tool(double pressure, ContactInterface law = {}, int through = 3) {
+  using C = FlatChipOnTool;
+  auto chip = std::make_unique<solid::SolidProblem>(
+      solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(C::height, C::period, 7), 0.0, 2, through)),
+      std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
+  const RigidTool tool{flat_tool(C::height - 1e-6, C::period, 11, 2)};
+  auto contact = std::make_shared<MortarContact>(chip->space(), tool, C::penalty, 0, std::move(law));
+  chip->add_interaction(contact);
+  chip->fix_side(numerics::Side::bottom, 0);
+  chip->add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  return {std::move(chip), std::move(contact)};
+}
+
 TEST(MortarContact, PatchTestTransmitsUniformPressureAndNoShear) {
-  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3;
-  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
-                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
-  // The tool starts 1e-6 inside the chip: contact is active from the first iteration.
-  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                 penalty);
-  problem.add_interaction(contact);
-  problem.fix_side(numerics::Side::bottom, 0);
-  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  const double pressure = 1e-3, period = FlatChipOnTool::period;
+  auto [chip, contact] = flat_chip_on_tool(pressure);
+  solid::SolidProblem& problem = *chip;
   const Eigen::VectorXd u = solid::test::solve_static(problem);
   const ContactState s = contact->state(u);
   for (size_t q = 0; q < s.point_pressure.size(); ++q) {
@@ -215,15 +231,10 @@ std::shared_ptr<SampledPointStates> uniform_point_states(MortarContact& contact,
 // rigidly along the tool by d: every point carries τ = −ε_t d while ε_t d ≤ μ_a p (stick) and
 // τ = −μ_a p beyond (slip), so the resultant's ratio is μ_a exactly (Coulomb's law, closed form).
 TEST(CoulombContact, AFlatChipSlidUnderUniformPressureCarriesTheLawsShear) {
-  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3;
-  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
-                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
-  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                 penalty, 0, coulomb(mu_a, tangential));
+  const double pressure = 1e-3, tangential = 400.0, mu_a = 0.3, period = FlatChipOnTool::period;
+  auto [chip, contact] = flat_chip_on_tool(pressure, coulomb(mu_a, tangential));
+  solid::SolidProblem& problem = *chip;
   EXPECT_FALSE(contact->symmetric_tangent());
-  problem.add_interaction(contact);
-  problem.fix_side(numerics::Side::bottom, 0);
-  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
   const Eigen::VectorXd pressed = solid::test::solve_static(problem);
   contact->commit(pressed);
   const double stick_limit = mu_a * pressure / tangential;  // the slide at which stick ends
@@ -264,18 +275,13 @@ TEST(CoulombContact, AFlatChipSlidUnderUniformPressureCarriesTheLawsShear) {
 // a little through the layer, decaying ~0.4× per span; with 3 spans 6 % of it would reach the held
 // face, with 28 under 1e-9.)
 TEST(CoulombContact, SlipDissipatesMuPTimesTheSlipAndTheChipReceivesItsShare) {
-  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3;
+  const double pressure = 1e-3, tangential = 400.0, mu_a = 0.3, period = FlatChipOnTool::period;
   const double step = 2e-6, partition = 0.7;
   const int steps = 7;
-  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 28)),
-                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
   ContactInterface law = coulomb(mu_a, tangential);
   law.heat_partition = partition;
-  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                 penalty, 0, law);
-  problem.add_interaction(contact);
-  problem.fix_side(numerics::Side::bottom, 0);
-  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  auto [chip, contact] = flat_chip_on_tool(pressure, law, 28);
+  solid::SolidProblem& problem = *chip;
   Eigen::VectorXd u = solid::test::solve_static(problem);
   contact->commit(u);
   EXPECT_EQ(contact->dissipated_energy(), 0.0);
@@ -322,7 +328,7 @@ ContactInterface zorev_law(double shear_factor, double adhesive_coefficient, dou
 // under Zorev's, τ = min(μ_a p, m k): the Coulomb branch below the switch, the shear branch above it
 // (closed forms).
 TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
-  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0, mu_a = 0.3, m = 0.5;
+  const double pressure = 1e-3, tangential = 400.0, mu_a = 0.3, m = 0.5;
   struct Case {
     ContactInterface law;
     double k;               // the chip's shear yield stress, uniform
@@ -334,21 +340,15 @@ TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
       {zorev_law(m, mu_a, tangential), 2e-3, mu_a * pressure},  // μ_a p = 3e-4 < m k = 1e-3: Coulomb branch
       {zorev_law(m, mu_a, tangential), 2e-4, m * 2e-4}};        // m k = 1e-4 < μ_a p: the shear branch
   for (const auto& c : cases) {
-    solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
-                             std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
-    chip.fix_side(numerics::Side::bottom, 0);
-    chip.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
-    auto contact = std::make_shared<MortarContact>(chip.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                   penalty, 0, c.law);
+    auto [chip, contact] = flat_chip_on_tool(pressure, c.law);
     const size_t points = contact->surface_positions().size();
-    Eigen::VectorXd probe = Eigen::VectorXd::Zero(chip.dof_count());
+    Eigen::VectorXd probe = Eigen::VectorXd::Zero(chip->dof_count());
     EXPECT_THROW(contact->state(probe), Error);  // no provider of k yet
     auto states = std::make_shared<SampledPointStates>(points, 1.0);
     contact->set_point_states(states);
     EXPECT_THROW(contact->state(probe), Error);  // a provider, but k not given yet
     states->set_shear_strength(std::vector<double>(points, c.k));
-    chip.add_interaction(contact);
-    const Eigen::VectorXd pressed = solid::test::solve_static(chip);
+    const Eigen::VectorXd pressed = solid::test::solve_static(*chip);
     contact->commit(pressed);
     for (const double fraction : {0.5, 3.0}) {
       const double d = fraction * c.expected_limit / tangential;
@@ -369,7 +369,7 @@ TEST(YieldLimitedContact, AFlatChipSlidCarriesMTimesKOrZorevsLowerBranch) {
 // higher), a dry one the dry coefficient (closed forms); the state reports which points are wetted and
 // their length in contact; unset, every point is dry again.
 TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
-  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0;
+  const double pressure = 1e-3, tangential = 400.0, period = FlatChipOnTool::period;
   const double mu_a = 0.3, m = 0.5, k = 2e-3, mu_wet = 0.05, m_wet = 0.1;
   const auto table_path = std::filesystem::temp_directory_path() / "mufric_wetted_table.csv";
   {
@@ -394,20 +394,14 @@ TEST(WettedContact, WettedPointsTakeTheWettedCoefficients) {
        -m_wet * k * std::expm1(-kShearFactorOnsetCoefficient * pressure / (m_wet * k))},
       {with_law(std::make_shared<TableLaw>(table, mu_wet), tangential), 0.4 * pressure, mu_wet * pressure}};
   for (const Case& c : cases) {
-    solid::SolidProblem chip(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
-                             std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
-    chip.fix_side(numerics::Side::bottom, 0);
-    chip.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
-    auto contact = std::make_shared<MortarContact>(chip.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                   penalty, 0, c.law);
+    auto [chip, contact] = flat_chip_on_tool(pressure, c.law);
     const std::vector<Eigen::Vector2d> at = contact->surface_positions();
     const auto states = uniform_point_states(*contact, k, 300.0);
     std::vector<char> wetted(at.size(), 0);
     for (size_t q = 0; q < at.size(); ++q) wetted[q] = at[q].x() < 0.5 * period ? 1 : 0;
     EXPECT_THROW(states->set_wetted(std::vector<char>(at.size() + 1, 1)), Error);
     states->set_wetted(wetted);
-    chip.add_interaction(contact);
-    const Eigen::VectorXd pressed = solid::test::solve_static(chip);
+    const Eigen::VectorXd pressed = solid::test::solve_static(*chip);
     contact->commit(pressed);
     const double d = 3.0 * std::max(c.dry_limit, c.wet_limit) / tangential;  // slip everywhere
     Eigen::VectorXd slid = pressed;
@@ -762,14 +756,9 @@ ContactInterface table_law(double tangential) { return with_law(std::make_shared
 // The flat chip slid beyond stick under the table law: τ = μ_a(p) p with μ_a at the point's pressure
 // (closed form); the law needs the chip's temperature at the contact before it can shear.
 TEST(TableContact, AFlatChipSlidCarriesTheTablesMuTimesP) {
-  const double period = 1.0, height = 0.5, pressure = 1e-3, penalty = 1e3, tangential = 400.0;
-  solid::SolidProblem problem(solid::IgaSpace(SplineSurface::extruded(flat_chip_surface(height, period, 7), 0.0, 2, 3)),
-                              std::make_shared<solid::LinearElastic>(1.0, 0.3, 1.0));
-  auto contact = std::make_shared<MortarContact>(problem.space(), RigidTool{flat_tool(height - 1e-6, period, 11, 2)},
-                                                 penalty, 0, table_law(tangential));
-  problem.add_interaction(contact);
-  problem.fix_side(numerics::Side::bottom, 0);
-  problem.add_load({numerics::Side::bottom, Eigen::Vector2d::Zero(), pressure, {}});
+  const double pressure = 1e-3, tangential = 400.0;
+  auto [chip, contact] = flat_chip_on_tool(pressure, table_law(tangential));
+  solid::SolidProblem& problem = *chip;
   const size_t points = contact->surface_positions().size();
   auto states = std::make_shared<SampledPointStates>(points, 1.0);
   contact->set_point_states(states);
