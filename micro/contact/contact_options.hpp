@@ -14,7 +14,7 @@
 namespace mufric::contact {
 
 struct ContactOptions {
-  double penalty = 2e18;  // Pa/m (seed 000)
+  double penalty = kDefaultPenalty;  // Pa/m (seed 000)
   // The interface law (frictionless unless contact.law says otherwise), stick's penalty, the heat partition.
   ContactInterface interface{.law = std::make_shared<FrictionlessLaw>()};
   // Reads the section; a law's file key (the table law's) resolves against `base_directory`.
