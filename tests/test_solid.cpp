@@ -319,12 +319,8 @@ double cylinder_outer_displacement(VolumetricTreatment volumetric, double pressu
   problem.fix_side(Side::left, 0);   // the y axis
   problem.fix_side(Side::right, 1);  // the x axis
   problem.add_load({Side::bottom, Eigen::Vector2d::Zero(), pressure_over_k * k, [](double t) { return t; }});
-  TimeIntegrationOptions options;
-  options.scheme = TimeScheme::quasi_static;
-  options.dt = 0.1;
-  options.end_time = 1.0;
-  options.relative_tolerance = 1e-10;
-  TimeIntegrator integrator(problem, options);
+  TimeIntegrator integrator(
+      problem, {.scheme = TimeScheme::quasi_static, .dt = 0.1, .end_time = 1.0, .relative_tolerance = 1e-10});
   const IntegrationReport report = integrator.run();
   EXPECT_TRUE(report.completed) << report.reason;
   return problem.space().displacement(integrator.u(), 0.5, 1.0).norm();  // u = ½: 45°; v = 1: r = b
@@ -680,12 +676,8 @@ TEST(UnsymmetricTangent, DynamicStepsAddTheFullMassAndConvergeInOneIteration) {
   EXPECT_TRUE(std::equal(full.innerIndexPtr(), full.innerIndexPtr() + full.nonZeros(), tangent.innerIndexPtr()));
   EXPECT_DOUBLE_EQ((Eigen::MatrixXd(full) - Eigen::MatrixXd(SparseMatrix(lower.selfadjointView<Eigen::Lower>()))).norm(), 0.0);
 
-  TimeIntegrationOptions options;
-  options.scheme = TimeScheme::generalized_alpha;
-  options.dt = 0.01;
-  options.end_time = 0.05;
-  options.relative_tolerance = 1e-12;
-  TimeIntegrator integrator(problem, options);
+  TimeIntegrator integrator(
+      problem, {.scheme = TimeScheme::generalized_alpha, .dt = 0.01, .end_time = 0.05, .relative_tolerance = 1e-12});
   const IntegrationReport report = integrator.run();
   ASSERT_TRUE(report.completed) << report.reason;
   ASSERT_EQ(report.steps.size(), 5u);

@@ -233,11 +233,7 @@ TEST(ProfileFit, ChordLengthFitOfASmoothProfileConvergesWithRefinement) {
 }
 
 TEST(RoughProfile, HasTheRequestedRoughnessAndIsReproducible) {
-  RoughnessSpec spec;
-  spec.length = 100e-6;
-  spec.correlation_length = 1e-6;
-  spec.ra = 0.25e-6;
-  spec.samples = 4096;
+  RoughnessSpec spec{.length = 100e-6, .ra = 0.25e-6, .correlation_length = 1e-6, .samples = 4096};
   const Profile a = synthetic_rough_profile(spec), b = synthetic_rough_profile(spec);
   EXPECT_EQ(a.height, b.height);
   spec.seed = 2;
@@ -384,12 +380,7 @@ TEST(ClosestPoint, DivergedPointsFailWithAReasonInsteadOfExhaustingMemory) {
 // contact cell): f = C′·(C − x) is known there only to eps × 20 µm × |C′|, above the relative
 // tolerance alone, and the projection never converged (15 of 16 draws of a 20 µm cell stopped).
 TEST(ClosestPoint, ConvergesOnTheCurveFarFromTheOrigin) {
-  RoughnessSpec spec;
-  spec.length = 20e-6;
-  spec.ra = 0.3e-6;
-  spec.correlation_length = 1e-6;
-  spec.samples = 1024;
-  spec.seed = 3;
+  const RoughnessSpec spec{.length = 20e-6, .ra = 0.3e-6, .correlation_length = 1e-6, .samples = 1024, .seed = 3};
   const SplineCurve c = fit_periodic_profile(synthetic_rough_profile(spec), 3, 128).curve;
   long long not_converged = 0;
   for (int i = 0; i <= 200; ++i) {
