@@ -15,6 +15,7 @@
 
 #include "common/error.hpp"
 #include "micro/coupling/partitioned.hpp"
+#include "micro/run/chip_model.hpp"
 #include "micro/run/dataset_sample.hpp"
 #include "micro/run/measurement.hpp"
 #include "scene_test_support.hpp"
@@ -318,6 +319,29 @@ TEST(Scene, ErrorsNameTheKey) {
   apply_override(kelvin, "load.temperature=500K");
   EXPECT_DOUBLE_EQ(parse_scene(kelvin, "s").temperature, 500.0);
   EXPECT_THROW(apply_override(kelvin, "novalue"), Error);
+}
+
+// The chip's hardening as it arrives (load.initial_plastic_strain): read with its range, and every
+// quadrature point of the loaded chip starts at it, so its first yield is Johnson–Cook's at ε̄0
+// (seed 000 eq. 5, the closed form) rather than at A.
+TEST(Scene, AChipsInitialPlasticStrainIsEveryPointsStartingHardening) {
+  nlohmann::json j = default_scene_json();
+  EXPECT_EQ(parse_scene(j, "s").initial_plastic_strain, 0.0);  // seed 000's virgin chip
+  apply_override(j, "load.initial_plastic_strain=-0.1");
+  EXPECT_NE(error_of(j).find("load.initial_plastic_strain"), std::string::npos) << error_of(j);
+  apply_override(j, "load.initial_plastic_strain=1.1");
+  const Scene scene = parse_scene(j, "s");
+  EXPECT_EQ(scene.initial_plastic_strain, 1.1);
+  const SceneGeometry geometry = build_geometry(scene);
+  const LoadedChip chip = load_chip(scene, geometry, BottomMotion(scene));
+  const auto& m = scene.material;
+  const double t_star = (scene.temperature - m.transition_temperature) / (m.melting_temperature - m.transition_temperature);
+  const double expected = (m.a + m.b * std::pow(1.1, m.n)) * (1.0 - std::pow(t_star, m.m));
+  for (const solid::MaterialState& state : chip.problem->states()) {
+    ASSERT_EQ(state.equivalent_plastic_strain, 1.1);
+    EXPECT_NEAR(solid::johnson_cook_yield_stress(m, state.equivalent_plastic_strain, 0.0, state.temperature), expected,
+                1e-9 * expected);
+  }
 }
 
 // Regression (fuzz_scene_json): a number JSON cannot hold (1e999...) threw nlohmann's out_of_range,

@@ -152,6 +152,7 @@ LoadedChip load_chip(const Scene& scene, const SceneGeometry& geometry, const Bo
       solid::chip_patch(geometry.chip_surface, scene.discretisation.mesh(scene.chip_height));
   solid::MaterialState initial;
   initial.temperature = scene.temperature;
+  initial.equivalent_plastic_strain = scene.initial_plastic_strain;
   LoadedChip chip;
   chip.problem = std::make_unique<solid::SolidProblem>(solid::IgaSpace(patch),
                                                        std::make_shared<solid::J2JohnsonCook>(scene.material), initial,

@@ -135,7 +135,8 @@ void read_material(Section m, Scene& s) {
   m.finish();
 }
 
-// load: what drives Γ_B: a pressure or a vertical displacement, the sliding velocity, the temperature, the ramp.
+// load: what drives Γ_B (a pressure or a vertical displacement, the sliding velocity, the ramp) and the
+// chip's state as it arrives (its temperature and equivalent plastic strain).
 void read_load(Section l, Scene& s) {
   if (l.has("pressure") == l.has("vertical_displacement")) {
     l.fail("", "give exactly one of pressure or vertical_displacement");
@@ -149,6 +150,7 @@ void read_load(Section l, Scene& s) {
   s.vertical_displacement = l.quantity("vertical_displacement", QuantityKind::length, s.vertical_displacement, -1e-3, 1e-3);
   s.velocity = l.quantity("velocity", QuantityKind::velocity, s.velocity, -speeds.hi, speeds.hi);  // signed: direction
   s.temperature = l.quantity("temperature", QuantityKind::temperature, s.temperature, temperatures.lo, temperatures.hi);
+  s.initial_plastic_strain = l.number("initial_plastic_strain", s.initial_plastic_strain, 0.0, 20.0);
   s.ramp = l.quantity("ramp", QuantityKind::time, s.ramp, 0.0, 1.0);
   l.finish();
 }

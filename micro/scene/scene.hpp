@@ -99,6 +99,11 @@ struct Scene {
   double vertical_displacement = 0.0; // m, instead of a pressure (for comparisons with other codes)
   double velocity = 100.0 / 60.0;     // m/s, horizontal, of Γ_B (chip moving in +x against a fixed tool)
   double temperature = 773.15;        // K, initial
+  // The chip's equivalent plastic strain as it arrives at the tool (its hardening state; stress-free,
+  // in its current shape): 0, seed 000's, a virgin chip; a chip from a cut has passed the primary
+  // shear zone, ε̄ = γ/√3 with γ = cos α / (sin φ cos(φ − α)) (Merchant 1945), about 1.1 for
+  // Ti6Al4V at 15° rake (data/cirp2022_ti6al4v_tin). The study that decided it: bench/RESULTS.md.
+  double initial_plastic_strain = 0.0;
   double ramp = nanoseconds(25);      // s, the vertical load rises linearly over this time
   solid::TimeOptions time;
   // seed 000's protocol: the run's length and its averaging window (time.duration, time.average_from)
