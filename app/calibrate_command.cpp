@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/fast_evaluator_options.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/units.hpp"
@@ -25,12 +26,7 @@ namespace {
 struct CalibrateOptions {
   std::string model, out, model_out;
   CalibrationRequest request;
-  // The tolerances a request asks by default (EvaluationRequest), so that the grid answers it.
-  double fast_mu_tolerance = EvaluationRequest{}.mu_tolerance, fast_std_tolerance = EvaluationRequest{}.std_relative_tolerance;
-  // The grid's work budget in the GP's multiply-adds (CalibratedModel::exact_point_work): about 5
-  // minutes of one core (1e10 per second).
-  double fast_max_gigawork = 3000.0;
-  bool no_fast_evaluator = false;
+  FastOptions fast;  // the calibrated model's grid
   EnsembleOptions sampler = [] {
     EnsembleOptions o;
     o.max_steps = 40000;
@@ -110,34 +106,8 @@ void write_posterior(const std::string& path, const CalibrationProblem& problem,
 // The calibrated model: served like any other, with a fast evaluator certified against it.
 void write_calibrated_model(const CalibrateOptions& o, const CalibrationSetup& setup, const CalibrationResult& result) {
   CalibratedModel model = calibrated_model(setup, result);
-  FastEvaluatorOptions fast;
-  fast.mu_tolerance = o.fast_mu_tolerance;
-  fast.std_relative_tolerance = o.fast_std_tolerance;
-  fast.max_work = o.fast_max_gigawork * 1e9;
-  fast.progress = [](const std::string& line) { std::fprintf(stderr, "calibrate: fast evaluator: %s\n", line.c_str()); };
-  if (o.no_fast_evaluator) {
-    std::printf("no fast evaluator (--no-fast-evaluator): the exact posterior predictive answers\n");
-  } else {
-    try {
-      std::fprintf(stderr, "calibrate: fast evaluator: building within %.3g G multiply-adds (--fast-max-work; %.3g M a point)\n",
-                   o.fast_max_gigawork, model.exact_point_work() / 1e6);
-      auto grid = std::make_shared<const FastEvaluator>(
-          build_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, fast));
-      if (const std::string refusal = short_grid_refusal(*grid, fast); !refusal.empty()) {
-        std::printf("fast evaluator not stored (%s; %s): the exact posterior predictive answers\n", grid->stop_reason().c_str(),
-                    refusal.c_str());
-      } else {
-        if (!grid->stop_reason().empty()) {
-          std::printf("fast evaluator stopped before the tolerances (%s) at mu within %.3g, std within %.3g relative: requests "
-                      "that ask no more use it, the others the exact model\n",
-                      grid->stop_reason().c_str(), grid->bounds().mu_absolute, grid->bounds().std_relative);
-        }
-        model.attach_fast_evaluator(std::move(grid));
-      }
-    } catch (const FastEvaluatorOverCap& e) {
-      std::printf("no fast evaluator (%s): the exact posterior predictive answers\n", e.what());
-    }
-  }
+  attach_fast_evaluator(model, o.fast);
+  if (o.fast.skip) std::printf("no fast evaluator (--no-fast-evaluator): the exact posterior predictive answers\n");
   save_model(o.model_out, model);
   const IntervalParts& c = model.centre_parts();
   std::printf("wrote %s (calibrated model of", o.model_out.c_str());
@@ -254,23 +224,7 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--model-out", o->model_out,
                   "Write the calibrated model here (HDF5): mu(conditions) as the posterior predictive, its interval the\n"
                   "roughness mean, the coefficients' posterior and delta; served, described and evaluated like any model");
-  cmd->add_option("--fast-mu-tolerance", o->fast_mu_tolerance,
-                  "The calibrated model's fast evaluator: mu within this (absolute)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--fast-std-tolerance", o->fast_std_tolerance,
-                  "The calibrated model's fast evaluator: std within this (relative)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--fast-max-work", o->fast_max_gigawork,
-                  "The grid's work budget, G multiply-adds of the exact GP (about 10 per second on one core); a grid\n"
-                  "that does not meet the tolerances within it is kept with its certified bound, and requests asking\n"
-                  "for more use the exact predictive")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_flag("--no-fast-evaluator", o->no_fast_evaluator,
-                "Write the calibrated model without its grid: the exact posterior predictive answers every request\n"
-                "(slower per point; the grid takes seconds to minutes to certify)");
+  add_fast_evaluator_options(cmd, o->fast);
   cmd->footer(
       "y_i = mu(x_i, theta) + delta(x_i) + b_set + eps_i: the GP's interval of the mean, the measurement's SD,\n"
       "(with --discrepancy) delta and (for a data set given one) its bias in the likelihood; a condition given\n"

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/fast_evaluator_options.hpp"
 #include "app/input_flags.hpp"
 #include "client/friction_client.hpp"
 #include "campaign/campaign_summary.hpp"
@@ -19,6 +20,7 @@
 #include "common/units.hpp"
 #include "common/wording.hpp"
 #include "surrogate/accuracy.hpp"
+#include "surrogate/calibrated_model.hpp"
 #include "surrogate/empirical_laws.hpp"
 #include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
@@ -118,98 +120,6 @@ void check_mu_within_range(const TrainingSet& data, const BoxOptions& o, const s
 void apply_box_options(FrictionModel& model, const BoxOptions& o) {
   if (!o.extrapolation.empty()) model.set_default_extrapolation(extrapolation_from_string(o.extrapolation));
   if (!o.mu_range.empty()) model.set_mu_range(o.mu_range[0], o.mu_range[1]);
-}
-
-// --fast-* options of train and upgrade.
-struct FastOptions {
-  FastEvaluatorOptions build;
-  double max_gigawork = 0.0;  // 10⁹ multiply-adds; 0: fast_evaluator_budget's default
-  bool skip = false;
-};
-
-double fast_evaluator_budget(const FastOptions& o, const GaussianProcess& gp) {
-  return o.max_gigawork > 0.0 ? o.max_gigawork * 1e9 : default_fast_evaluator_work(gp.state().x_train.rows());
-}
-
-void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
-  // Positive and finite (PositiveNumber let "inf" through): a tolerance below rounding cannot be
-  // met, and a budget of 0 builds nothing.
-  constexpr double kLeastTolerance = 1e-15, kLeastBudget = 1e-3;
-  cmd->add_option("--fast-mu-tolerance", o.build.mu_tolerance,
-                  "Fast evaluator: refine until its measured bound on mu is within this (absolute)")
-      ->capture_default_str()->check(FiniteRange(kLeastTolerance, 1.0));
-  cmd->add_option("--fast-std-tolerance", o.build.std_relative_tolerance,
-                  "Fast evaluator: ... and its bound on std within this fraction of max(std, F), where\n"
-                  "F = mu tolerance / std tolerance: the interval's bounds mu +- z std are then accurate to\n"
-                  "this fraction of the half-width, or to the mu tolerance where std is smaller than F")
-      ->capture_default_str()->check(FiniteRange(kLeastTolerance, 1.0));
-  cmd->add_option("--fast-max-mb", o.build.max_megabytes, "Fast evaluator: largest grid, MB")
-      ->capture_default_str()->check(FiniteRange(kLeastBudget, 1e6));
-  cmd->add_option("--fast-max-work", o.max_gigawork,
-                  "Fast evaluator: work budget in 10^9 multiply-adds of the exact model (about 0.1 s each on one\n"
-                  "core with AVX2); a finer grid that would take the build past it is not built. Counted, not timed:\n"
-                  "the same data and command give the same file on a busy machine and an idle one\n"
-                  "(default: 100 n^3 for a GP of n points, at least 3000)")
-      ->check(FiniteRange(kLeastBudget, 1e9));
-  cmd->add_flag("--no-fast-evaluator", o.skip, "Store no fast evaluator: the exact model answers every request");
-}
-
-// Builds and reports a fast evaluator of `gp` ("model" or "patch scatter" in the messages); null when
-// it does not come within short_grid_refusal's factor of the tolerances (the one policy of train,
-// upgrade and calibrate). The message says what stopped it and how to build it later.
-std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GaussianProcess& gp, FastEvaluatorOptions build,
-                                                          const std::string& label) {
-  build.progress = [label](const std::string& line) {
-    std::printf("  fast evaluator (%s): %s\n", label.c_str(), line.c_str());
-    std::fflush(stdout);
-  };
-  std::printf("fast evaluator (%s): building within %.3g G multiply-adds and %.0f MB (--fast-max-work, --fast-max-mb)\n",
-              label.c_str(), build.max_work / 1e9, build.max_megabytes);
-  const auto start = std::chrono::steady_clock::now();
-  std::shared_ptr<const FastEvaluator> fast;
-  try {
-    fast = std::make_shared<const FastEvaluator>(build_fast_evaluator(gp, build));
-  } catch (const FastEvaluatorOverCap& e) {
-    // Regression: train exited here with no model written at all.
-    std::printf("fast evaluator (%s): not stored: %s; the exact model answers every request (a larger "
-                "--fast-max-mb with `mufric upgrade --rebuild`)\n", label.c_str(), e.what());
-    return nullptr;
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (const std::string refusal = short_grid_refusal(*fast, build); !refusal.empty()) {
-    std::printf("fast evaluator (%s): not stored, built in %.1f s: %s, %s; the exact model answers every request "
-                "(a larger --fast-max-work / --fast-max-mb, or looser --fast-*-tolerance, with `mufric upgrade --rebuild`)\n",
-                label.c_str(), seconds, fast->stop_reason().c_str(), refusal.c_str());
-    return nullptr;
-  }
-  if (!fast->meets(build.mu_tolerance, build.std_relative_tolerance)) {
-    std::printf("fast evaluator (%s): %.1f MB, built in %.1f s; stopped short (%s) at mu within %.3g, std within %.3g "
-                "relative: requests that ask no more use it, the others the exact model\n",
-                label.c_str(), static_cast<double>(fast->grid().bytes()) / 1e6, seconds, fast->stop_reason().c_str(),
-                fast->bounds().mu_absolute, fast->bounds().std_relative);
-    return fast;
-  }
-  std::printf("fast evaluator (%s): %.1f MB, built in %.1f s; meets the tolerances: it answers default requests inside "
-              "the box\n",
-              label.c_str(), static_cast<double>(fast->grid().bytes()) / 1e6, seconds);
-  return fast;
-}
-
-// The model's fast evaluator and, for a model with a patch scatter, the scatter's: its log variance
-// tabulated to the tolerance that holds patch_std to --fast-std-tolerance (relative), its own σ unused.
-void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o) {
-  gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
-  if (gp.patch_scatter()) gp.attach_patch_scatter_fast_evaluator(nullptr);
-  if (o.skip) return;
-  FastEvaluatorOptions build = o.build;
-  build.max_work = fast_evaluator_budget(o, gp);
-  gp.attach_fast_evaluator(build_fast_evaluator(gp, build, "model"));
-  if (gp.patch_scatter()) {
-    FastEvaluatorOptions scatter = build;
-    scatter.mu_tolerance = patch_scatter_log_variance_tolerance(o.build.std_relative_tolerance);
-    scatter.std_relative_tolerance = 1.0;
-    gp.attach_patch_scatter_fast_evaluator(build_fast_evaluator(*gp.patch_scatter(), scatter, "patch scatter"));
-  }
 }
 
 void add_train(CLI::App& app) {
@@ -618,19 +528,26 @@ void add_upgrade(CLI::App& app) {
     BoxOptions box;
   };
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("upgrade", "Rewrite a model file in the current schema, adding a GP's fast evaluator");
+  auto* cmd = app.add_subcommand("upgrade", "Rewrite a model file in the current schema, adding a GP's or a calibrated model's fast evaluator");
   cmd->add_option("model", o->model, "Model file (any readable schema version)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "Where to write (default: replace the file, atomically)");
-  cmd->add_flag("--rebuild", o->rebuild, "Rebuild a GP's fast evaluator even if the file has one");
+  cmd->add_flag("--rebuild", o->rebuild, "Rebuild the fast evaluator even if the file has one");
   add_fast_evaluator_options(cmd, o->fast);
   add_box_options(cmd, o->box);
   cmd->callback([o] {
     auto model = load_model_isolated(o->model);
     const bool range_changed = !o->box.mu_range.empty();
     apply_box_options(*model, o->box);
+    const bool build = o->fast.skip || o->rebuild || range_changed;
     if (auto* gp = dynamic_cast<GaussianProcess*>(model.get())) {
-      if (gp->fast_evaluator() == nullptr || o->rebuild || range_changed) {
+      if (gp->fast_evaluator() == nullptr || build) {
         attach_fast_evaluator(*gp, o->fast);
+      } else {
+        std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
+      }
+    } else if (auto* calibrated = dynamic_cast<CalibratedModel*>(model.get())) {
+      if (calibrated->fast_evaluator() == nullptr || build) {
+        attach_fast_evaluator(*calibrated, o->fast);
       } else {
         std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
       }

@@ -206,8 +206,10 @@ FastEvaluatorBounds measure_errors(const FastEvaluator& fast, const FrictionMode
   return {worst.mu_absolute, worst.std_relative, fast.bounds().std_floor};
 }
 
+GridSource grid_source(const GaussianProcess& gp) { return {gp, gp.state().hyper.length_scales, exact_point_work(gp)}; }
+
 FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options) {
-  return build_fast_evaluator(GridSource{gp, gp.state().hyper.length_scales, exact_point_work(gp)}, options);
+  return build_fast_evaluator(grid_source(gp), options);
 }
 
 FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& o) {

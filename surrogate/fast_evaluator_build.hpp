@@ -55,7 +55,9 @@ struct GridSource {
 // Refines until the bounds are within the options' tolerances, or the next grid would exceed the
 // memory cap or the work budget (then the finest grid built, whose bounds say what it reached).
 FastEvaluator build_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& options);
-// The GP's own: its length scales and exact_point_work.
+// The GP as a grid's source: its length scales and exact_point_work.
+GridSource grid_source(const GaussianProcess& gp);
+// The GP's own grid (grid_source(gp)).
 FastEvaluator build_fast_evaluator(const GaussianProcess& gp, const FastEvaluatorOptions& options);
 
 // The default work budget of a GP's grid (FastEvaluatorOptions::max_work), counted in work, never in

@@ -176,7 +176,9 @@ class GaussianProcess final : public FrictionModel {
   Eigen::VectorXd latent_variance(const LatentPoints& x) const;
 
   // The model file's groups under `group` ("/gp"; the patch scatter's under "/gp/patch_scatter").
-  void write_group(h5::Writer& out, const std::string& group) const;
+  // Whether a model stored inside another's file (a calibrated model's campaign GP) keeps its grid.
+  enum class GridInFile { with, without };
+  void write_group(h5::Writer& out, const std::string& group, GridInFile grid = GridInFile::with) const;
   static GaussianProcess read_group(const h5::Reader& in, InputSpace inputs, const std::string& group);
 
   // Store the n × n factor in model files up to this size; larger models refactorise on load.

@@ -71,7 +71,7 @@ constexpr Eigen::Index kMostPointsForLooAtLoad = 1000;
 
 void GaussianProcess::write(h5::Writer& out) const { write_group(out, "/gp"); }
 
-void GaussianProcess::write_group(h5::Writer& out, const std::string& group) const {
+void GaussianProcess::write_group(h5::Writer& out, const std::string& group, GridInFile grid) const {
   const auto& s = state_;
   const std::string summary_group = group + "/training", fast_group = group + "/fast_evaluator";
   out.group(group);
@@ -97,7 +97,7 @@ void GaussianProcess::write_group(h5::Writer& out, const std::string& group) con
   for (const auto& [name, field] : kSummaryTexts) out.string_attribute(summary_group, name, s.summary.*field);
   out.string_attribute(summary_group, kSummaryDatasetDescription, s.summary.dataset_description);
   out.double_attribute(summary_group, kSummaryStandardisedRms, s.summary.loo_standardised_rms);
-  if (fast_) write_fast_evaluator(out, *fast_, fast_group);
+  if (fast_ && grid == GridInFile::with) write_fast_evaluator(out, *fast_, fast_group);
   if (patch_scatter_) patch_scatter_->write_group(out, group + "/patch_scatter");
 }
 

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "common/error.hpp"
+#include "common/h5_file.hpp"
 #include "common/sanitizers.hpp"
 #include "surrogate/calibrated_model.hpp"
 #include "surrogate/calibration.hpp"
@@ -546,11 +547,14 @@ struct SmallCalibration {
     samples.resize(3, result.samples.cols());
     samples << result.samples.row(0), result.samples.row(result.samples.rows() / 2), result.samples.row(result.samples.rows() - 1);
   }
-  CalibratedModel model() const {
+  static CalibrationPriors priors() {
     CalibrationPriors priors;
     priors.discrepancy = true;
+    return priors;
+  }
+  CalibratedModel model() const {
     return CalibratedModel(std::make_shared<const CalibratedPosterior>(
-                               std::make_shared<const CalibrationProblem>(emulator, data, std::vector<std::string>{"shear_factor"}, priors),
+                               std::make_shared<const CalibrationProblem>(emulator, data, std::vector<std::string>{"shear_factor"}, priors()),
                                samples),
                            {});
   }
@@ -674,6 +678,20 @@ TEST(CalibratedModel, ItsFileAndFastEvaluatorGiveBackWhatItServes) {
   const std::string path = (std::filesystem::temp_directory_path() / ("mufric-calibrated-" + std::to_string(::getpid()) + ".h5")).string();
   save_model(path, model);
   const std::unique_ptr<FrictionModel> loaded = load_model(path);
+  {
+    // The campaign's GP is kept without a grid of its own, which the posterior never uses; its patch
+    // scatter (served as patch_std) keeps its own.
+    auto gridded = std::make_shared<GaussianProcess>(*c.emulator);
+    gridded->attach_fast_evaluator(std::make_shared<const FastEvaluator>(build_fast_evaluator(*gridded, options)));
+    const CalibratedModel with_gridded_emulator(
+        std::make_shared<const CalibratedPosterior>(
+            std::make_shared<const CalibrationProblem>(gridded, c.data, std::vector<std::string>{"shear_factor"}, c.priors()),
+            c.samples),
+        {});
+    save_model(path, with_gridded_emulator);
+    EXPECT_FALSE(h5::Reader(path, "model").has("/calibrated/emulator/fast_evaluator"));
+    EXPECT_TRUE(h5::Reader(path, "model").has("/calibrated/emulator/cholesky_lower"));
+  }
   std::filesystem::remove(path);
   ASSERT_EQ(loaded->kind(), "calibrated");
   EXPECT_TRUE(same_input_space(loaded->inputs(), model.inputs()));

@@ -958,6 +958,14 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   EXPECT_NE(r.output.find("kind calibrated"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("interval at the box centre: mu "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("measurements: " + path("measured.csv") + "; synthetic"), std::string::npos) << r.output;
+  // `upgrade` grids a calibrated model as it grids a GP, and strips the grid again.
+  r = run("upgrade " + path("served/calibrated.h5") + " --out " + path("graded.h5") + " --fast-max-work 0.05");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fast evaluator (calibrated model): "), std::string::npos) << r.output;
+  EXPECT_NE(run("describe " + path("graded.h5")).output.find("fast evaluator: grid"), std::string::npos);
+  ASSERT_EQ(run("upgrade " + path("graded.h5") + " --no-fast-evaluator").exit_code, 0);
+  EXPECT_NE(run("describe " + path("graded.h5")).output.find("no fast evaluator (the exact posterior predictive answers)"),
+            std::string::npos);
   const CommandResult from_file = run("predict --model " + path("served/calibrated.h5") + " --p 700MPa --v 100m/min");
   ASSERT_EQ(from_file.exit_code, 0) << from_file.output;
   {
