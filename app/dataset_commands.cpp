@@ -21,6 +21,7 @@
 #include "campaign/refine.hpp"
 #include "common/environment.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/units.hpp"
 #include "common/version.hpp"
 #include "common/wording.hpp"

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/version.hpp"
 #include "common/work_pool.hpp"
 

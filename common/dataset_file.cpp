@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <limits>
 
-#include <openssl/sha.h>
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
@@ -272,24 +271,6 @@ TrainingSet training_set(const Dataset& d, const std::string& path) {
     t.mu_std(static_cast<Eigen::Index>(k)) = d.mu_std.size() == d.size() ? d.mu_std(rows[k]) : std::numeric_limits<double>::quiet_NaN();
   }
   return t;
-}
-
-std::string sha256_hex(const std::string& bytes) {
-  unsigned char digest[SHA256_DIGEST_LENGTH];
-  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
-  std::string hex;
-  for (unsigned char byte : digest) {
-    char part[3];
-    std::snprintf(part, sizeof part, "%02x", byte);
-    hex += part;
-  }
-  return hex;
-}
-
-std::string sha256_file(const std::string& path) {
-  const auto bytes = read_whole_file(path);
-  if (!bytes) throw Error(path + ": cannot open for hashing");
-  return sha256_hex(*bytes);
 }
 
 }  // namespace mufric

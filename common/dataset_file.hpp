@@ -95,8 +95,4 @@ Dataset read_dataset_isolated(const std::string& path, const IsolationLimits& li
 void write_dataset(const std::string& path, const Dataset& dataset);
 TrainingSet training_set(const Dataset& dataset, const std::string& path);
 
-// Hex SHA-256 (OpenSSL) of a file's bytes.
-std::string sha256_file(const std::string& path);
-std::string sha256_hex(const std::string& bytes);
-
 }  // namespace mufric

@@ -1,8 +1,11 @@
 #include "common/files.hpp"
 
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
+
+#include <openssl/sha.h>
 
 #include "common/error.hpp"
 
@@ -28,6 +31,24 @@ void write_file_atomically(const std::string& path, const std::string& text) {
   std::error_code error;
   std::filesystem::rename(temporary, path, error);
   if (error) throw Error(path + ": cannot write (" + error.message() + ")");
+}
+
+std::string sha256_hex(const std::string& bytes) {
+  unsigned char digest[SHA256_DIGEST_LENGTH];
+  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
+  std::string hex;
+  for (unsigned char byte : digest) {
+    char part[3];
+    std::snprintf(part, sizeof part, "%02x", byte);
+    hex += part;
+  }
+  return hex;
+}
+
+std::string sha256_file(const std::string& path) {
+  const auto bytes = read_whole_file(path);
+  if (!bytes) throw Error(path + ": cannot open for hashing");
+  return sha256_hex(*bytes);
 }
 
 }  // namespace mufric

@@ -7,6 +7,7 @@
 
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/isolation.hpp"
 #include "surrogate/model_file.hpp"
 

@@ -8,6 +8,7 @@
 
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "temp_path.hpp"
 #include "error_text.hpp"
 

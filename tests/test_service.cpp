@@ -28,6 +28,7 @@
 #include "common/csv_table.hpp"
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
 #include "proto/wire_codec.hpp"
