@@ -286,21 +286,34 @@ void estimate_constant_mean(GaussianProcess::State& state) {
 
 }  // namespace
 
-void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summary) {
+LeaveOneOut leave_one_out_points(const GaussianProcess::State& state) {
   const Eigen::Index n = state.x_train.rows();
   Eigen::MatrixXd inverse = state.cholesky;
-  if (n < 2 || !inverse_from_cholesky(inverse)) return;
+  if (n < 2 || !inverse_from_cholesky(inverse)) return {};
   if (state.mean_estimated) {  // needs whole rows of K⁻¹; simple kriging reads only its diagonal
     inverse.triangularView<Eigen::StrictlyUpper>() = inverse.transpose().eval();
     const Eigen::VectorXd k_inv_ones = inverse.rowwise().sum();
     inverse -= k_inv_ones * k_inv_ones.transpose() / k_inv_ones.sum();
   }
+  LeaveOneOut loo;
+  loo.error.resize(n);
+  loo.std.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double k_inv_ii = inverse(i, i);
+    loo.error(i) = state.y_scale * state.alpha(i) / k_inv_ii;
+    loo.std(i) = state.y_scale / std::sqrt(k_inv_ii);
+  }
+  return loo;
+}
+
+void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summary) {
+  const LeaveOneOut loo = leave_one_out_points(state);
+  const Eigen::Index n = loo.error.size();
+  if (n == 0) return;
   double sum_rel = 0.0, max_rel = 0.0, sum_sq = 0.0, sum_standardised_sq = 0.0;
   Eigen::Index covered = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double k_inv_ii = inverse(i, i);
-    const double error = state.y_scale * state.alpha(i) / k_inv_ii;
-    const double std = state.y_scale / std::sqrt(k_inv_ii);
+    const double error = loo.error(i), std = loo.std(i);
     const double rel = relative_error(error, state.y_train(i));
     sum_rel += rel;
     max_rel = std::max(max_rel, rel);

@@ -121,5 +121,11 @@ GaussianProcess train_gaussian_process(const TrainingSet& data, const GpTraining
 // with an estimated mean, re-estimated without the point: K⁻¹ becomes P = K⁻¹ − K⁻¹11ᵀK⁻¹/1ᵀK⁻¹1 and
 // α = Py (Dubrule 1983, Math. Geol. 15(6):687, for universal kriging).
 void leave_one_out(const GaussianProcess::State& state, GpTrainingSummary& summary);
+// The same per training point: each point's LOO error (μ − μ₋ᵢ, μ units) and LOO standard deviation,
+// in the order of state.x_train; empty when the factor cannot be inverted or there is one point.
+struct LeaveOneOut {
+  Eigen::VectorXd error, std;
+};
+LeaveOneOut leave_one_out_points(const GaussianProcess::State& state);
 
 }  // namespace mufric
