@@ -10,14 +10,6 @@
 
 namespace mufric::app {
 
-namespace {
-
-double fast_evaluator_budget(const FastOptions& o, const GaussianProcess& gp) {
-  return o.max_gigawork > 0.0 ? o.max_gigawork * 1e9 : default_fast_evaluator_work(gp.state().x_train.rows());
-}
-
-}  // namespace
-
 void add_fast_evaluator_options(CLI::App* cmd, FastOptions& o) {
   // Positive and finite (PositiveNumber let "inf" through): a tolerance below rounding cannot be
   // met, and a budget of 0 builds nothing.
@@ -80,18 +72,16 @@ std::shared_ptr<const FastEvaluator> build_fast_evaluator(const GridSource& sour
 }
 
 void attach_fast_evaluator(GaussianProcess& gp, const FastOptions& o) {
-  gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
-  if (gp.patch_scatter()) gp.attach_patch_scatter_fast_evaluator(nullptr);
-  if (o.skip) return;
-  FastEvaluatorOptions build = o.build;
-  build.max_work = fast_evaluator_budget(o, gp);
-  gp.attach_fast_evaluator(build_fast_evaluator(grid_source(gp), build, "model"));
-  if (gp.patch_scatter()) {
-    FastEvaluatorOptions scatter = build;
-    scatter.mu_tolerance = patch_scatter_log_variance_tolerance(o.build.std_relative_tolerance);
-    scatter.std_relative_tolerance = 1.0;
-    gp.attach_patch_scatter_fast_evaluator(build_fast_evaluator(grid_source(*gp.patch_scatter()), scatter, "patch scatter"));
+  if (o.skip) {
+    gp.attach_fast_evaluator(nullptr);  // never keep a grid of another fit or range
+    if (gp.patch_scatter()) gp.attach_patch_scatter_fast_evaluator(nullptr);
+    return;
   }
+  FastEvaluatorOptions build = o.build;
+  build.max_work = o.max_gigawork > 0.0 ? o.max_gigawork * 1e9 : 0.0;  // 0: the GP's default
+  attach_fast_evaluators(gp, build, [](const GridSource& source, const FastEvaluatorOptions& options, const std::string& label) {
+    return build_fast_evaluator(source, options, label);
+  });
 }
 
 void attach_fast_evaluator(CalibratedModel& model, const FastOptions& o) {

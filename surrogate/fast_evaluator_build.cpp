@@ -304,4 +304,28 @@ std::string short_grid_refusal(const FastEvaluator& fast, const FastEvaluatorOpt
   return text;
 }
 
+std::shared_ptr<const FastEvaluator> build_kept_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& options,
+                                                                const std::string& /*label*/) {
+  std::shared_ptr<const FastEvaluator> fast;
+  try {
+    fast = std::make_shared<const FastEvaluator>(build_fast_evaluator(source, options));
+  } catch (const FastEvaluatorOverCap&) {
+    return nullptr;
+  }
+  return short_grid_refusal(*fast, options).empty() ? fast : nullptr;
+}
+
+void attach_fast_evaluators(GaussianProcess& gp, FastEvaluatorOptions options, const GridBuilder& build) {
+  gp.attach_fast_evaluator(nullptr);
+  if (gp.patch_scatter()) gp.attach_patch_scatter_fast_evaluator(nullptr);
+  if (!(options.max_work > 0.0)) options.max_work = default_fast_evaluator_work(gp.state().x_train.rows());
+  gp.attach_fast_evaluator(build(grid_source(gp), options, "model"));
+  if (gp.patch_scatter()) {
+    FastEvaluatorOptions scatter = options;
+    scatter.mu_tolerance = patch_scatter_log_variance_tolerance(options.std_relative_tolerance);
+    scatter.std_relative_tolerance = 1.0;
+    gp.attach_patch_scatter_fast_evaluator(build(grid_source(*gp.patch_scatter()), scatter, "patch scatter"));
+  }
+}
+
 }  // namespace mufric

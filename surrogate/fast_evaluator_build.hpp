@@ -6,6 +6,7 @@
 // on the code that builds one from it.
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "common/error.hpp"
@@ -81,6 +82,20 @@ inline constexpr double kShortGridUsefulFactor = 10.0;
 // "" when `fast` is worth storing (it meets the options' tolerances, or comes within the factor);
 // else why not, with the bounds it reached.
 std::string short_grid_refusal(const FastEvaluator& fast, const FastEvaluatorOptions& options);
+
+// Builds one grid and says whether it is kept (null: over the memory cap, or refused by
+// short_grid_refusal); `label` names it ("model", "patch scatter"). The app's prints what it does.
+using GridBuilder = std::function<std::shared_ptr<const FastEvaluator>(const GridSource& source,
+                                                                       const FastEvaluatorOptions& options,
+                                                                       const std::string& label)>;
+// The same, quiet: for a library caller that reports the outcome itself (the learner).
+std::shared_ptr<const FastEvaluator> build_kept_fast_evaluator(const GridSource& source, const FastEvaluatorOptions& options,
+                                                                const std::string& label);
+// The grids a GP serves with: its own and, with a patch scatter, the scatter's log variance tabulated
+// to the tolerance that holds patch_std to options.std_relative_tolerance (its own σ unused). Any grid
+// the model had is dropped first, never a grid of another fit or range; options.max_work of 0 or
+// less means default_fast_evaluator_work of the GP's points.
+void attach_fast_evaluators(GaussianProcess& gp, FastEvaluatorOptions options, const GridBuilder& build);
 
 // The largest errors of `fast` against the exact `model` at the points x (SI, one row each): what
 // the bound is measured from, and what a test checks it with.
