@@ -36,12 +36,10 @@ bool row_inside(const InputSpace& box, const Eigen::MatrixXd& rows, Eigen::Index
   return true;
 }
 
-// Candidate points: a Sobol' set in the box (shifted per round), plus the CSV's rows inside the box
+// Candidate points: a Sobol' set in the box (shifted per round), plus the logged rows inside the box
 // (the plan box is what the micro-model is run on; `grow` moves it toward the others first).
-Eigen::MatrixXd refine_candidates(const RefineOptions& o, const InputSpace& box, int round) {
+Eigen::MatrixXd refine_candidates(const PickOptions& o, const Eigen::MatrixXd& logged, const InputSpace& box, int round) {
   Eigen::MatrixXd c = plan_in_box(PlanDesign::sobol, o.candidate_count, box, o.seed + static_cast<unsigned long long>(round));
-  if (o.candidates_csv.empty()) return c;
-  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, box);
   std::vector<Eigen::Index> inside;
   for (Eigen::Index i = 0; i < logged.rows(); ++i) {
     if (row_inside(box, logged, i)) inside.push_back(i);
@@ -60,27 +58,6 @@ std::string box_text(const InputSpace& box) {
     text += cell;
   }
   return text;
-}
-
-// The plan's box grows toward the candidates (where the meso code asks), and the change is recorded
-// in the database's /plan/box_history; samples already run stay valid (the old box is inside).
-BoxGrowth grow_plan_box(const RefineOptions& o, Dataset& db) {
-  const Eigen::MatrixXd logged = csv_candidates(o.candidates_csv, db.inputs);
-  const InputSpace grown = grow_box(db.inputs, logged, o.grow_coverage);
-  BoxGrowth growth;
-  growth.candidate_rows = static_cast<long long>(logged.rows());
-  long long outside = 0;
-  for (Eigen::Index i = 0; i < logged.rows(); ++i) outside += !row_inside(db.inputs, logged, i);
-  if (same_input_space(grown, db.inputs)) return growth;
-  char head[128];
-  std::snprintf(head, sizeof head, "%s: grown by dataset refine --grow-box (coverage %g) toward %lld of %lld rows of ",
-                utc_timestamp().c_str(), o.grow_coverage, outside, static_cast<long long>(logged.rows()));
-  growth.record = head + o.candidates_csv + " outside: " + box_text(db.inputs) + " -> " + box_text(grown);
-  growth.grown = true;
-  db.inputs = grown;
-  db.box_history.push_back(growth.record);
-  write_dataset(o.db, db);
-  return growth;
 }
 
 // The database's samples that did not converge (failed or outside the model), as points: picks keep
@@ -132,6 +109,78 @@ constexpr unsigned long long kReferenceSeedOffset = 0x5eedULL;
 
 }  // namespace
 
+Eigen::MatrixXd logged_candidates(const std::string& path, const InputSpace& box) { return csv_candidates(path, box); }
+
+BoxGrowth grow_plan_box(Dataset& db, const Eigen::MatrixXd& logged, double coverage, const std::string& logged_source,
+                        const std::string& grown_by) {
+  const InputSpace grown = grow_box(db.inputs, logged, coverage);
+  BoxGrowth growth;
+  growth.candidate_rows = static_cast<long long>(logged.rows());
+  long long outside = 0;
+  for (Eigen::Index i = 0; i < logged.rows(); ++i) outside += !row_inside(db.inputs, logged, i);
+  if (same_input_space(grown, db.inputs)) return growth;
+  char head[256];
+  std::snprintf(head, sizeof head, "%s: grown by %s (coverage %g) toward %lld of %lld rows of ", utc_timestamp().c_str(),
+                grown_by.c_str(), coverage, outside, static_cast<long long>(logged.rows()));
+  growth.record = head + logged_source + " outside: " + box_text(db.inputs) + " -> " + box_text(grown);
+  growth.grown = true;
+  db.inputs = grown;
+  db.box_history.push_back(growth.record);
+  return growth;
+}
+
+GaussianProcess fit_campaign_gp(const TrainingSet& data, const GpTrainingOptions& options) {
+  return suits_stochastic_kriging(data) ? train_stochastic_kriging(data, options) : train_gaussian_process(data, options);
+}
+
+std::vector<RefinePick> append_refinement_picks(Dataset& db, const GaussianProcess& gp, const TrainingSet& data,
+                                                const Eigen::MatrixXd& logged, const PickOptions& o, int round, int batch) {
+  const Eigen::MatrixXd sobol = refine_candidates(o, logged, db.inputs, round);
+  std::vector<RefinePick> chosen;
+  Eigen::MatrixXd candidates;
+  if (gp.has_patch_scatter()) {
+    const ReplicationCandidates replicates = converged_design_points(db);
+    candidates.resize(sobol.rows() + replicates.points.rows(), sobol.cols());
+    candidates << sobol, replicates.points;
+    // One sample's noise at a candidate: the patch scatter there over the draws a sample makes.
+    const Eigen::VectorXd noise = gp.patch_std(candidates).array().square() / draws_per_sample(data);
+    const Eigen::MatrixXd reference =
+        plan_in_box(PlanDesign::sobol, o.reference_count, db.inputs, o.seed + kReferenceSeedOffset + static_cast<unsigned long long>(round));
+    for (const auto& p : pick_by_imse_reduction(gp, candidates, noise, reference, batch, unconverged_points(db))) {
+      RefinePick pick;
+      pick.std_at_pick = p.std_at_pick;
+      pick.imse_reduction = p.imse_reduction;
+      pick.plan_row = p.candidate;  // the candidate's row until it becomes a plan row below
+      if (p.candidate >= sobol.rows()) pick.replicates_row = replicates.plan_rows[static_cast<size_t>(p.candidate - sobol.rows())];
+      chosen.push_back(pick);
+    }
+  } else {
+    candidates = sobol;
+    for (const auto& p : pick_by_posterior_variance(gp, candidates, batch, unconverged_points(db))) {
+      RefinePick pick;
+      pick.std_at_pick = p.std_at_pick;
+      pick.plan_row = p.candidate;
+      chosen.push_back(pick);
+    }
+  }
+  // The picks become plan rows, so the database accounts for them like any planned point; a
+  // replicate is a new row at an existing row's point, with its own draws.
+  const Eigen::Index first = db.plan.rows();
+  db.plan.conservativeResize(first + static_cast<Eigen::Index>(chosen.size()), Eigen::NoChange);
+  for (size_t k = 0; k < chosen.size(); ++k) {
+    db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(chosen[k].plan_row);
+    chosen[k].number = k + 1;
+    chosen[k].plan_row = static_cast<long long>(first) + static_cast<long long>(k);
+  }
+  if (db.plan_design.find("active") == std::string::npos) {
+    db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
+  }
+  return chosen;
+}
+
+namespace {
+}  // namespace
+
 long long drop_pending_plan_rows(Dataset& db, const std::string& source) {
   long long last_run = -1;
   for (const long long row : db.plan_index) last_run = std::max(last_run, row);
@@ -168,8 +217,11 @@ RefineReport refine_dataset(const RefineOptions& o) {
     if (dropped > 0) write_dataset(o.db, db);
     if (o.on_drop) o.on_drop(dropped);
   }
+  const Eigen::MatrixXd logged = o.candidates_csv.empty() ? Eigen::MatrixXd(0, static_cast<Eigen::Index>(db.inputs.size()))
+                                                            : csv_candidates(o.candidates_csv, db.inputs);
   if (o.grow) {
-    const BoxGrowth growth = grow_plan_box(o, db);
+    const BoxGrowth growth = grow_plan_box(db, logged, o.grow_coverage, o.candidates_csv, "dataset refine --grow-box");
+    if (growth.grown) write_dataset(o.db, db);
     if (o.on_box) o.on_box(growth);
   }
   const SampleEvaluator evaluate = o.make_evaluator(db);
@@ -178,11 +230,11 @@ RefineReport refine_dataset(const RefineOptions& o) {
   GpTrainingOptions training;
   training.restarts = o.restarts;
   training.seed = o.seed;
+  const PickOptions picking{o.candidate_count, o.reference_count, o.seed};
   RefineReport report;
   for (int round = 1;; ++round) {
     const TrainingSet data = training_set(db, o.db);
-    const bool kriging = suits_stochastic_kriging(data);
-    const GaussianProcess gp = kriging ? train_stochastic_kriging(data, training) : train_gaussian_process(data, training);
+    const GaussianProcess gp = fit_campaign_gp(data, training);
     if (o.on_round) {
       const auto& sum = gp.state().summary;
       RefineRound r;
@@ -201,46 +253,8 @@ RefineReport refine_dataset(const RefineOptions& o) {
     if (!o.model_out.empty()) save_model(o.model_out, gp);
     if (report.spent >= o.budget) break;
     const int batch = static_cast<int>(std::min<long long>(o.batch, o.budget - report.spent));
-    const Eigen::MatrixXd sobol = refine_candidates(o, db.inputs, round);
-    std::vector<RefinePick> chosen;
-    Eigen::MatrixXd candidates;
-    if (kriging && gp.has_patch_scatter()) {
-      const ReplicationCandidates replicates = converged_design_points(db);
-      candidates.resize(sobol.rows() + replicates.points.rows(), sobol.cols());
-      candidates << sobol, replicates.points;
-      // One sample's noise at a candidate: the patch scatter there over the draws a sample makes.
-      const Eigen::VectorXd noise = gp.patch_std(candidates).array().square() / draws_per_sample(data);
-      const Eigen::MatrixXd reference =
-          plan_in_box(PlanDesign::sobol, o.reference_count, db.inputs, o.seed + kReferenceSeedOffset + static_cast<unsigned long long>(round));
-      for (const auto& p : pick_by_imse_reduction(gp, candidates, noise, reference, batch, unconverged_points(db))) {
-        RefinePick pick;
-        pick.std_at_pick = p.std_at_pick;
-        pick.imse_reduction = p.imse_reduction;
-        pick.plan_row = p.candidate;  // the candidate's row until it becomes a plan row below
-        if (p.candidate >= sobol.rows()) pick.replicates_row = replicates.plan_rows[static_cast<size_t>(p.candidate - sobol.rows())];
-        chosen.push_back(pick);
-      }
-    } else {
-      candidates = sobol;
-      for (const auto& p : pick_by_posterior_variance(gp, candidates, batch, unconverged_points(db))) {
-        RefinePick pick;
-        pick.std_at_pick = p.std_at_pick;
-        pick.plan_row = p.candidate;
-        chosen.push_back(pick);
-      }
-    }
-    // The picks become plan rows, so the database accounts for them like any planned point; a
-    // replicate is a new row at an existing row's point, with its own draws.
-    const Eigen::Index first = db.plan.rows();
-    db.plan.conservativeResize(first + static_cast<Eigen::Index>(chosen.size()), Eigen::NoChange);
-    for (size_t k = 0; k < chosen.size(); ++k) {
-      db.plan.row(first + static_cast<Eigen::Index>(k)) = candidates.row(chosen[k].plan_row);
-      chosen[k].number = k + 1;
-      chosen[k].plan_row = static_cast<long long>(first) + static_cast<long long>(k);
-      if (o.on_pick) o.on_pick(chosen[k]);
-    }
-    if (db.plan_design.find("active") == std::string::npos) {
-      db.plan_design = db.plan_design.empty() ? "active" : db.plan_design + "+active";
+    for (const RefinePick& pick : append_refinement_picks(db, gp, data, logged, picking, round, batch)) {
+      if (o.on_pick) o.on_pick(pick);
     }
     write_dataset(o.db, db);
     GenerationOptions options;

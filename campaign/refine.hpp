@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -19,6 +20,8 @@
 #include "common/dataset_file.hpp"
 #include "common/sample_outcome.hpp"
 #include "surrogate/accuracy.hpp"
+#include "surrogate/gaussian_process.hpp"
+#include "surrogate/gp_training.hpp"
 
 namespace mufric {
 
@@ -86,6 +89,28 @@ struct RefineReport {
 // when a row not run lies before one that was (the rows' numbers, and with them the seeds of their
 // draws, would change).
 long long drop_pending_plan_rows(Dataset& db, const std::string& source);
+
+// The steps of a round, for a caller that runs them itself (the learner, campaign/learning.hpp).
+// The rows of a CSV with unit headers (the server's --log-uncertain file) in the box's input order, SI.
+Eigen::MatrixXd logged_candidates(const std::string& path, const InputSpace& box);
+// The plan's box grown toward the logged rows (sampling.hpp grow_box), the change recorded in the
+// database's /plan/box_history naming `logged_source` and `grown_by`; samples already run stay valid
+// (the old box is inside). Not written: the caller writes the database.
+BoxGrowth grow_plan_box(Dataset& db, const Eigen::MatrixXd& logged, double coverage, const std::string& logged_source,
+                        const std::string& grown_by);
+// A campaign's GP: stochastic kriging for a database of independent draws, else a GP on the means.
+GaussianProcess fit_campaign_gp(const TrainingSet& data, const GpTrainingOptions& options);
+struct PickOptions {
+  long long candidate_count = 4096;  // Sobol' candidates per round
+  long long reference_count = 512;   // Sobol' points over which the integrated variance is averaged
+  unsigned long long seed = 1;       // of the candidate sets
+};
+// One round's picks (of at most `batch`) by `gp`, trained on `data` from `db`, among a Sobol' set of
+// round `round` and the logged rows inside the box, appended to db's plan as rows (not run, not
+// written); each pick's plan_row is its new row.
+std::vector<RefinePick> append_refinement_picks(Dataset& db, const GaussianProcess& gp, const TrainingSet& data,
+                                                const Eigen::MatrixXd& logged, const PickOptions& options, int round,
+                                                int batch);
 
 // Throws Error for a database without plan rows, and whatever reading, training, running or
 // writing throws (the database then holds every sample finished so far).
