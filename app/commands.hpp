@@ -30,4 +30,6 @@ void add_micro_commands(CLI::App& app);
 // plan / run / refine / status / merge under the `dataset` subcommand that add_surrogate_commands
 // creates (which adds `dataset from-model` itself).
 void add_dataset_commands(CLI::App& app);
+// init / run / status / rollback of the on-line learner.
+void add_learn_command(CLI::App& app);
 }  // namespace mufric::app

@@ -16,6 +16,7 @@
 
 #include "app/commands.hpp"
 #include "app/input_flags.hpp"
+#include "app/sample_evaluators.hpp"
 #include "campaign/dataset_generation.hpp"
 #include "campaign/campaign_summary.hpp"
 #include "campaign/refine.hpp"
@@ -114,7 +115,7 @@ void plan_command(const PlanOptions& o) {
 }
 
 struct RunOptions {
-  std::string plan, db, scene_path, shard = "0/1";
+  std::string plan, db, scene_path, shard = "0/1", simulator;
   std::vector<std::string> overrides;
   int jobs = 1, threads = 0;
   long long limit = -1;
@@ -151,25 +152,20 @@ void print_progress(const GenerationProgress& p, const InputSpace& inputs, const
   std::fflush(stdout);
 }
 
-// The scene of a run: --scene (or the one stored with the plan, or the default), then --set.
-scene::Scene run_scene(const std::string& scene_path, const std::vector<std::string>& overrides, const Dataset& plan,
-                       const std::string& plan_path) {
-  if (!scene_path.empty() || plan.scene_json.empty()) return scene::load_scene(scene_path, overrides);
-  return scene::scene_with_overrides(nlohmann::json::parse(plan.scene_json), overrides, "the scene of " + plan_path);
-}
-
-int threads_per_job(int jobs, int threads) {
-  return threads > 0 ? threads : std::max(1, usable_cores() / jobs);
-}
-
 void run_command(const RunOptions& o) {
   Dataset plan = read_dataset_isolated(o.plan);
   if (plan.plan.rows() == 0) throw Error(o.plan + ": has no plan (/plan/inputs is empty); make one with mufric dataset plan");
-  const scene::Scene sc = run_scene(o.scene_path, o.overrides, plan, o.plan);
-  plan.scene_json = sc.effective.dump(2);
-
   const int threads = threads_per_job(o.jobs, o.threads);
-  const SampleEvaluator evaluate = run::micro_evaluator(sc, plan.inputs, threads, o.sample_timeout);
+  SampleEvaluator evaluate;
+  if (o.simulator.empty()) {
+    const scene::Scene sc = run_scene(o.scene_path, o.overrides, plan, o.plan);
+    plan.scene_json = sc.effective.dump(2);
+    evaluate = run::micro_evaluator(sc, plan.inputs, threads, o.sample_timeout);
+  } else {
+    if (!o.scene_path.empty() || !o.overrides.empty()) throw Error("--simulator runs no scene: leave out --scene and --set");
+    plan.scene_json = simulator_scene_json(o.simulator);
+    evaluate = simulator_evaluator(o.simulator, plan.inputs);
+  }
   GenerationOptions options;
   options.shard = parse_shard(o.shard);
   options.jobs = o.jobs;
@@ -191,6 +187,7 @@ void run_command(const RunOptions& o) {
 
 struct RefineCommandOptions {
   RefineOptions refine;  // db, budget, batch, candidates, growth, jobs, seed, ...
+  std::string simulator;  // a model file standing in for the micro-model ("": the micro-model)
   int threads = 0;
   double sample_timeout = 0.0;  // s, 0: none
 };
@@ -199,8 +196,7 @@ void refine_command(const RefineCommandOptions& c) {
   RefineOptions o = c.refine;
   // The samples: the micro-model with the database's scene, on the (possibly grown) box's inputs.
   o.make_evaluator = [&c](const Dataset& db) {
-    const scene::Scene sc = run_scene("", {}, db, c.refine.db);
-    return run::micro_evaluator(sc, db.inputs, threads_per_job(c.refine.jobs, c.threads), c.sample_timeout);
+    return database_evaluator(db, c.refine.db, c.simulator, threads_per_job(c.refine.jobs, c.threads), c.sample_timeout);
   };
   o.on_box = [&o](const BoxGrowth& g) {
     if (!g.grown) {
@@ -385,6 +381,11 @@ void add_dataset_commands(CLI::App& app) {
   run->add_option("--threads", r->threads, "Threads per sample (default: cores / jobs)")->check(CLI::Range(1, 1024));
   run->add_option("--limit", r->limit, "Run at most this many samples now")->check(CLI::Range(1LL, 10000000LL));
   run->add_flag("--retry-failed", r->retry_failed, "Run failed samples again (their old record is replaced)");
+  run->add_option("--simulator", r->simulator,
+                  "A model file whose mu stands in for the micro-model (a law from mufric law, say): the campaign's\n"
+                  "machinery (run, refine, train, learn) in seconds. The database's scene then names it, so its\n"
+                  "samples never mix with the micro-model's")
+      ->check(CLI::ExistingFile);
   run->add_option("--sample-timeout", r->sample_timeout,
                   "Stop a sample still running after this many seconds and record it as failed, with where it stopped "
                      "(0: no limit). A corner of the box where the solver crawls then costs a shard this long, not hours")
@@ -421,6 +422,8 @@ void add_dataset_commands(CLI::App& app) {
   refine->add_option("--jobs", f->refine.jobs, "Runs at once")->capture_default_str()->check(CLI::Range(1, 1024));
   refine->add_option("--threads", f->threads, "Threads per run (default: cores / jobs)")->check(CLI::Range(1, 1024));
   refine->add_option("--restarts", f->refine.restarts, "GP optimiser restarts per round")->capture_default_str();
+  refine->add_option("--simulator", f->simulator, "The model file a simulator's database was run with (dataset run --simulator)")
+      ->check(CLI::ExistingFile);
   refine->add_option("--sample-timeout", f->sample_timeout,
                      "Stop a run still going after this many seconds and record it as failed (0: no limit)")
       ->capture_default_str()->check(FiniteRange(0.0, 1e7));

@@ -112,6 +112,7 @@ int main(int argc, char** argv) {
   mufric::app::add_service_commands(app);
   mufric::app::add_micro_commands(app);
   mufric::app::add_dataset_commands(app);
+  mufric::app::add_learn_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -1175,6 +1175,76 @@ TEST_F(Cli, DatasetRunSurvivesKillNine) {
   EXPECT_NE(r.output.find("0 of 6 plan rows not yet run"), std::string::npos) << r.output;
 }
 
+// The on-line learner end to end on a simulator campaign (the shipped model standing in for the
+// micro-model): a server's log of queries below the box; `learn run` killed with -9 as it plans and
+// again as it trains, resumed each time, finishes its round with every plan row run once and a
+// published version; status says so; rollback serves the first version's bytes again; a quiet log
+// rests; another simulator's runs are refused before they start.
+TEST_F(Cli, LearnerSurvivesKillNineAndPublishesAGatedRound) {
+  const std::string simulator = MUFRIC_SOURCE_DIR "/models/dry_default.h5";
+  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 16 --p 500MPa:1100MPa --v 50m/min:150m/min --T 200C:700C").exit_code, 0);
+  ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --simulator " + simulator).exit_code, 0);
+  std::filesystem::create_directories(path("served"));
+  std::filesystem::create_directories(path("logs"));
+  ASSERT_EQ(run("train --data " + path("db.h5") + " --out " + path("served/gp.h5") + " --restarts 0").exit_code, 0);
+  {
+    std::ofstream log(path("logs/gp.csv"));
+    log << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width,outside_inputs\n";
+    for (int i = 0; i < 6; ++i) log << 300e6 + 20e6 * i << ",1.5,700,0.1,1\n";
+    std::ofstream(path("logs/gp.outside.json")) << "{\"queries\": 60}";
+  }
+  CommandResult r = run("learn init " + path("learner") + " --db " + path("db.h5") + " --model " + path("served/gp.h5") + " --log " +
+                        path("logs/gp.csv") + " --round-samples 4 --budget-core-hours 1 --restarts 0");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string first_version = r.output.substr(r.output.find("serving version ") + 16, 16);
+  for (const std::string& kill_after : {"planned 4 runs", "training on"}) {
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      freopen(path("learn.log").c_str(), "w", stdout);
+      execl(MUFRIC_EXE, MUFRIC_EXE, "learn", "run", path("learner").c_str(), "--simulator", simulator.c_str(),
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    bool seen = false;
+    for (int i = 0; i < 6000 && !seen; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      std::ifstream log(path("learn.log"));
+      for (std::string line; std::getline(log, line);) seen = seen || line.find(kill_after) != std::string::npos;
+    }
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(seen) << kill_after << ": " << read_text(path("learn.log"));
+  }
+  r = run("learn run " + path("learner") + " --simulator " + simulator);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run("learn status " + path("learner"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("round 1: done; 6 logged rows (10 % of queries), plan rows 16-19"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("published "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("round 2"), std::string::npos) << r.output;  // the resumed round was not planned twice
+  r = run("dataset merge --out " + path("check.h5") + " " + path("db.h5"));
+  EXPECT_NE(r.output.find("0 duplicates removed -> 20 samples"), std::string::npos) << r.output;
+  EXPECT_NE(run("describe " + path("served/gp.h5")).output.find("contact_pressure   [300MPa, 1100MPa]"), std::string::npos);
+  r = run("learn run " + path("learner") + " --simulator " + simulator);
+  EXPECT_NE(r.output.find("resting: no query logged"), std::string::npos) << r.output;
+  r = run("learn rollback " + path("learner") + " " + first_version);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(run("describe " + path("served/gp.h5")).output.find("contact_pressure   [500MPa, 1100MPa]"), std::string::npos);
+  r = run("learn rollback " + path("learner") + " 0123456789abcdef");
+  EXPECT_NE(r.output.find("version 0123456789abcdef: not kept by this learner"), std::string::npos) << r.output;
+  // Another simulator than the campaign's: refused before any run.
+  ASSERT_EQ(run("law coulomb --mu 0.3 --out " + path("other.h5")).exit_code, 0);
+  {
+    std::ofstream log(path("logs/gp.csv"), std::ios::app);
+    for (int i = 0; i < 6; ++i) log << 250e6 << ",1.5,700,0.1,1\n";
+  }
+  r = run("learn run " + path("learner") + " --simulator " + path("other.h5"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("its samples were made by another simulator"), std::string::npos) << r.output;
+}
+
 // Regression (issue 30): default thread counts came from std::thread::hardware_concurrency(), the
 // machine's CPUs: under `taskset -c 0` with OMP_NUM_THREADS=1 on 2 cores `dataset run` said "1 job(s)
 // x 2 thread(s)" and `serve` "2 evaluation threads". Both now follow the CPU affinity mask, and

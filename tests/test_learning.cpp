@@ -1,0 +1,214 @@
+// The on-line learner (campaign/learning.hpp, issue 62): its gate's decisions on small synthetic
+// models, and whole rounds on a closed-form "micro-model": the server's log read from where it
+// stopped, the box grown toward it, the round run and published atomically, a version rolled back,
+// the loop resting when the log is quiet and stopping at its budget, and a round resumed after a stop.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "campaign/dataset_generation.hpp"
+#include "campaign/learning.hpp"
+#include "campaign/refine.hpp"
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "surrogate/model_file.hpp"
+#include "surrogate/sampling.hpp"
+#include "temp_path.hpp"
+
+namespace mufric {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A smooth μ(p, v, T) standing in for the micro-model; `offset` makes a "damaged" one (runs made
+// with another scene).
+double smooth_mu(const Eigen::VectorXd& x, double offset = 0.0) {
+  return 0.2 + 0.05 * std::sin(3e-9 * x(0)) + 0.01 * x(1) + 1e-4 * (x(2) - 400.0) + offset;
+}
+SampleEvaluator smooth_evaluator(double offset = 0.0) {
+  return [offset](const SampleRequest& r) {
+    SampleOutcome o;
+    o.converged = true;
+    o.mu = smooth_mu(r.x, offset);
+    o.diagnostics["micro_wall_seconds"] = 10.0;
+    return o;
+  };
+}
+
+TrainingSet points_of(const InputSpace& box, const Eigen::MatrixXd& x, Eigen::Index offset_from_row, double offset) {
+  TrainingSet t;
+  t.inputs = box;
+  t.x = x;
+  t.mu.resize(x.rows());
+  t.mu_std = Eigen::VectorXd::Constant(x.rows(), std::nan(""));
+  for (Eigen::Index i = 0; i < x.rows(); ++i) t.mu(i) = smooth_mu(x.row(i).transpose(), i >= offset_from_row ? offset : 0.0);
+  return t;
+}
+
+GaussianProcess fit(const TrainingSet& t) {
+  GpTrainingOptions o;
+  o.restarts = 0;
+  return train_gaussian_process(t, o);
+}
+
+// The gate publishes a candidate that learned new points of the same μ, and keeps aside one whose new
+// points disagree with what the served version knew, or that lost its points.
+TEST(Learning, TheGatePassesMoreOfTheSameAndRefusesADamagedRound) {
+  const InputSpace box = default_friction_box();
+  const Eigen::MatrixXd old_x = plan_in_box(PlanDesign::sobol, 24, box, 3);
+  const Eigen::MatrixXd new_x = plan_in_box(PlanDesign::sobol, 12, box, 11);  // interleaved with the old points
+  Eigen::MatrixXd all_x(36, 3);
+  all_x << old_x, new_x;
+  const GaussianProcess served = fit(points_of(box, old_x, 0, 0.0));
+  const FastEvaluatorOptions tolerances;
+  const GateDecision good = gate_candidate(served, fit(points_of(box, all_x, 24, 0.0)), tolerances);
+  EXPECT_TRUE(good.publish) << good.reason;
+  EXPECT_EQ(good.old_points, 24);
+  EXPECT_EQ(good.new_points, 12);
+  EXPECT_LE(good.candidate_loo_rmse, good.allowed_loo_rmse);
+  const GateDecision damaged = gate_candidate(served, fit(points_of(box, all_x, 24, 0.03)), tolerances);
+  EXPECT_FALSE(damaged.publish) << damaged.reason;
+  EXPECT_GT(damaged.candidate_loo_rmse, damaged.allowed_loo_rmse) << damaged.reason;
+  const GateDecision other = gate_candidate(served, fit(points_of(box, new_x, 0, 0.0)), tolerances);
+  EXPECT_FALSE(other.publish);
+  EXPECT_NE(other.reason.find("another database"), std::string::npos) << other.reason;
+}
+
+// The coverage test's tail against the sum of its terms written out: P(X ≤ 5 | 8, 0.95).
+TEST(Learning, TheBinomialTailIsTheSumOfItsTerms) {
+  const double p = 0.95, q = 0.05;
+  const double by_hand = std::pow(q, 8) + 8 * p * std::pow(q, 7) + 28 * p * p * std::pow(q, 6) + 56 * std::pow(p, 3) * std::pow(q, 5) +
+                         70 * std::pow(p, 4) * std::pow(q, 4) + 56 * std::pow(p, 5) * std::pow(q, 3);
+  EXPECT_NEAR(binomial_lower_tail(5, 8, p), by_hand, 1e-15);
+  EXPECT_EQ(binomial_lower_tail(8, 8, p), 1.0);
+  EXPECT_EQ(binomial_lower_tail(-1, 8, p), 0.0);
+}
+
+// A campaign of 20 plan rows in the default box, its served GP, and a server log of queries below
+// the box's pressures, written as `serve --log-uncertain` writes it.
+struct LearnerFixture {
+  std::string dir = test::temp_path("learner"), folder = test::temp_path("served"), db = test::temp_path("learn-db.h5");
+  std::string log = test::temp_path("uncertain") + "/gp.csv";
+  LearnerFixture() {
+    for (const auto& d : {dir, folder, fs::path(log).parent_path().string()}) fs::remove_all(d);
+    fs::remove(db);
+    fs::create_directories(folder);
+    fs::create_directories(fs::path(log).parent_path());
+    Dataset plan;
+    plan.inputs = default_friction_box();
+    plan.plan = plan_in_box(PlanDesign::sobol, 20, plan.inputs, 5);
+    plan.plan_design = "sobol";
+    plan.scene_json = "{\"scene\": \"closed form\"}";
+    plan.source = "learner test";
+    generate_dataset(plan, db, smooth_evaluator(), {});
+    GpTrainingOptions o;
+    o.restarts = 0;
+    save_model(served(), fit_campaign_gp(training_set(read_dataset(db), db), o));
+    log_queries(6, 100);
+  }
+  std::string served() const { return folder + "/gp.h5"; }
+  // Appends `rows` queries at 150–250 MPa (below the box) and sets the query count to `queries`.
+  void log_queries(int rows, long long queries) const {
+    const bool fresh = !fs::exists(log);
+    std::ofstream out(log, std::ios::app);
+    if (fresh) out << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width,outside_inputs\n";
+    for (int i = 0; i < rows; ++i) out << 150e6 + 20e6 * i << "," << 1.0 + 0.1 * i << "," << 500.0 + 10 * i << ",0.2,1\n";
+    out.close();
+    write_file_atomically(fs::path(log).replace_extension(".outside.json").string(),
+                          "{\"model\": \"gp\", \"queries\": " + std::to_string(queries) + "}");
+  }
+  LearnRunOptions run(SampleEvaluator evaluate) const {
+    LearnRunOptions o;
+    o.make_evaluator = [evaluate](const Dataset&) { return evaluate; };
+    o.fast.max_work = 1e9;  // small grids: the test is about the loop
+    return o;
+  }
+  LearnSetup setup() const {
+    LearnSetup s;
+    s.db = db;
+    s.served_model = served();
+    s.log = log;
+    s.round_samples = 4;
+    s.budget_core_hours = 1.0;
+    s.restarts = 0;
+    return s;
+  }
+};
+
+// One round: the box grows toward the logged pressures, four runs are made there, the retrained GP
+// passes the gate and replaces the served file; rolled back, the served file is the first version's
+// bytes again. With no new row logged the learner rests; a spent budget stops it.
+TEST(Learning, ARoundGrowsTheBoxRunsPublishesAndRollsBack) {
+  const LearnerFixture f;
+  learn_init(f.dir, f.setup());
+  EXPECT_THROW(learn_init(f.dir, f.setup()), Error);  // one learner per directory
+  const std::string first_version = file_version(f.served());
+  const LearnReport report = learn_rounds(f.dir, f.run(smooth_evaluator()));
+  EXPECT_EQ(report.rounds_finished, 1);
+  const LearnState s = read_learn_state(f.dir);
+  ASSERT_EQ(s.rounds.size(), 1u);
+  const LearnRound& r = s.rounds[0];
+  EXPECT_EQ(r.step, "done");
+  EXPECT_EQ(r.logged_rows, 6);
+  EXPECT_DOUBLE_EQ(r.uncertain_share, 0.06);
+  EXPECT_EQ(r.end_plan_row - r.first_plan_row, 4);
+  EXPECT_NEAR(s.spent_core_seconds, r.run_core_seconds, 1e-12);
+  const Dataset db = read_dataset(f.db);
+  EXPECT_EQ(db.size(), 24);
+  EXPECT_LT(db.inputs[0].lo, 300e6);  // grown toward 150 MPa
+  EXPECT_EQ(db.box_history.size(), 1u);
+  ASSERT_TRUE(r.gate.publish) << r.gate.reason;
+  EXPECT_EQ(file_version(f.served()), r.version);
+  EXPECT_NE(r.version, first_version);
+  EXPECT_EQ(load_model(f.served())->inputs()[0].lo, db.inputs[0].lo);
+  ASSERT_EQ(s.served.size(), 2u);
+  EXPECT_EQ(s.served[0].version, first_version);
+
+  // Nothing new in the log: the learner rests and plans nothing.
+  EXPECT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).stop, LearnStop::resting);
+  // A few rows among many queries: still resting (1 in 1000 is below the 1 % threshold).
+  f.log_queries(1, 1100);
+  EXPECT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).stop, LearnStop::resting);
+  EXPECT_EQ(read_learn_state(f.dir).rounds.size(), 1u);
+
+  learn_rollback(f.dir, first_version);
+  EXPECT_EQ(file_version(f.served()), first_version);
+  EXPECT_THROW(learn_rollback(f.dir, "0123456789abcdef"), Error);
+}
+
+// A kill after a round's picks were written and before the state recorded them leaves plan rows no
+// sample answers: the next learner adopts them as its round and runs them. The budget, counted in
+// the runs' own core-seconds, bounds each round's batch and then stops the loop.
+TEST(Learning, AnUnfinishedRoundIsResumedAtItsStepAndTheBudgetStopsTheLoop) {
+  const LearnerFixture f;
+  LearnSetup setup = f.setup();
+  setup.budget_core_hours = 30.0 / 3600.0;  // three 10 s samples
+  learn_init(f.dir, setup);
+  // The database as such a kill leaves it: two picks in the plan, no round in the state.
+  Dataset db = read_dataset(f.db);
+  const Eigen::Index rows = db.plan.rows();
+  db.plan.conservativeResize(rows + 2, Eigen::NoChange);
+  db.plan.row(rows) = db.plan.row(0) * 1.01;
+  db.plan.row(rows + 1) = db.plan.row(1) * 1.01;
+  write_dataset(f.db, db);
+  // Without a round recorded: the learner adopts the pending rows as its round.
+  const LearnReport report = learn_rounds(f.dir, f.run(smooth_evaluator()));
+  EXPECT_EQ(report.rounds_finished, 1);
+  LearnState s = read_learn_state(f.dir);
+  ASSERT_EQ(s.rounds.size(), 1u);
+  EXPECT_EQ(s.rounds[0].first_plan_row, rows);
+  EXPECT_EQ(s.rounds[0].step, "done");
+  EXPECT_EQ(read_dataset(f.db).size(), rows + 2);
+  // 20 s spent of 30: the next round may still plan one run (10 s each), then the budget stops it.
+  f.log_queries(6, 200);
+  EXPECT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).rounds_finished, 1);
+  s = read_learn_state(f.dir);
+  EXPECT_EQ(s.rounds.back().end_plan_row - s.rounds.back().first_plan_row, 1);
+  f.log_queries(6, 300);
+  EXPECT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).stop, LearnStop::budget_spent);
+}
+
+}  // namespace
+}  // namespace mufric
