@@ -1,6 +1,10 @@
 // `mufric learn init / run / status / rollback`: the on-line learner (campaign/learning.hpp). Here
 // flags are parsed, the sample evaluator wired in and progress printed.
+#include <sys/wait.h>
+
 #include <chrono>
+#include <filesystem>
+#include <utility>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -10,16 +14,100 @@
 #include "app/sample_evaluators.hpp"
 #include "campaign/learning.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 
 namespace mufric::app {
 namespace {
 
 struct LearnRunCommand {
-  std::string directory, simulator;
+  std::string directory, simulator, slurm_submit = MUFRIC_SLURM_SUBMIT, sbatch_args;
+  int slurm_tasks = 0;
+  double slurm_poll_seconds = 5.0;
   int rounds = 1, jobs = 1, threads = 0;
   double follow_seconds = 0.0, sample_timeout = 0.0;
   double fast_max_gigawork = 0.0;
 };
+
+// The output of a shell command, and its exit status.
+std::pair<std::string, int> shell(const std::string& command) {
+  std::string output;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) throw Error("cannot run: " + command);
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+  const int status = ::pclose(pipe);
+  return {output, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+std::string quoted(const std::string& word) {
+  std::string q = "'";
+  for (const char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// The round's runs as a Slurm array with the project's own scripts (deploy/slurm/submit-dataset.sh:
+// one shard per task, then a merge job after all of them). Each shard starts as a copy of the
+// campaign database, so that only the round's rows are pending in it; the merge keeps each plan row
+// once. The job ids are kept in the round's directory: a learner killed while the jobs run waits for
+// them again instead of submitting twice; jobs that ended without a merged database are submitted
+// again, and their shards resume from the rows they finished.
+void run_rows_on_slurm(const RoundRuns& r, const LearnRunCommand& c, const std::string& mufric) {
+  namespace fs = std::filesystem;
+  const std::string jobs_file = r.work_dir + "/jobs", merged = r.work_dir + "/db.h5";
+  const auto queued = [](const std::string& job) { return !shell("squeue -h -j " + job + " 2>/dev/null").first.empty(); };
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    std::string merge_job;
+    if (const auto text = read_whole_file(jobs_file)) merge_job = *text;
+    if (merge_job.empty() || (!queued(merge_job) && !fs::exists(merged))) {
+      fs::remove(merged);
+      for (int i = 0; i < c.slurm_tasks; ++i) {
+        const std::string shard = r.work_dir + "/shard-" + std::to_string(i) + ".h5";
+        if (!fs::exists(shard)) {
+          const auto bytes = read_whole_file(r.db_path);
+          if (!bytes) throw Error(r.db_path + ": cannot read it to start shard " + std::to_string(i));
+          write_file_atomically(shard, *bytes);
+        }
+      }
+      // dataset-array.sbatch splits MUFRIC_RUN_ARGS on spaces (no quotes): a path with a space cannot pass.
+      const std::string simulator = c.simulator.empty() ? "" : fs::absolute(c.simulator).string();
+      if (simulator.find_first_of(" \t'\"") != std::string::npos) throw Error("--simulator " + simulator + ": a path with spaces or quotes cannot pass to the Slurm tasks");
+      const std::string run_args = simulator.empty() ? "" : "--simulator " + simulator;
+      const auto [out, status] = shell("MUFRIC=" + quoted(mufric) + " MUFRIC_RUN_ARGS=" + quoted(run_args) + " bash " +
+                                       quoted(c.slurm_submit) + " " + quoted(r.db_path) + " " + quoted(r.work_dir) + " " +
+                                       std::to_string(c.slurm_tasks) + " " + c.sbatch_args + " 2>&1");
+      const auto at = out.find("merge job ");
+      if (status != 0 || at == std::string::npos) throw Error("Slurm submission failed: " + out);
+      merge_job = out.substr(at + 10, out.find_first_not_of("0123456789", at + 10) - (at + 10));
+      write_file_atomically(jobs_file, merge_job);
+      std::printf("submitted: %s", out.c_str());
+      std::fflush(stdout);
+    }
+    while (queued(merge_job)) {
+      // A shard that failed leaves the merge waiting for ever (afterok): cancel it and say why.
+      const std::string reason = shell("squeue -h -j " + merge_job + " -o %r 2>/dev/null").first;
+      if (reason.find("DependencyNeverSatisfied") != std::string::npos) {
+        shell("scancel " + merge_job + " 2>/dev/null");
+        fs::remove(jobs_file);  // the next `learn run` submits the round's shards again; they resume
+        std::string tails;
+        for (const auto& entry : fs::directory_iterator(r.work_dir)) {
+          if (entry.path().extension() != ".out") continue;
+          const auto text = read_whole_file(entry.path().string());
+          if (text && !text->empty()) tails += "\n  " + entry.path().filename().string() + ": " + text->substr(text->rfind('\n', text->size() - 2) + 1);
+        }
+        throw Error("a Slurm shard of " + r.work_dir + " failed, so its merge job " + merge_job + " was cancelled; its output:" + tails);
+      }
+      std::this_thread::sleep_for(std::chrono::duration<double>(c.slurm_poll_seconds));
+    }
+    if (fs::exists(merged)) {
+      const auto bytes = read_whole_file(merged);
+      if (!bytes) throw Error(merged + ": cannot read the merged database");
+      write_file_atomically(r.db_path, *bytes);
+      return;
+    }
+    std::printf("Slurm merge job %s ended without %s; submitting the round's shards again\n", merge_job.c_str(), merged.c_str());
+  }
+  throw Error("the Slurm jobs of " + r.work_dir + " ended twice without a merged database; see the *.out files there");
+}
 
 void print_line(const std::string& line) {
   std::printf("%s\n", line.c_str());
@@ -39,6 +127,11 @@ void run_learner(const LearnRunCommand& c) {
   o.make_evaluator = [simulator, threads, timeout](const Dataset& db) {
     return database_evaluator(db, "the learner's database", simulator, threads, timeout);
   };
+  if (c.slurm_tasks > 0) {
+    o.threads_per_job = 1;  // dataset-array.sbatch asks one CPU per task
+    const std::string mufric = std::filesystem::read_symlink("/proc/self/exe").string();
+    o.run_rows = [&c, mufric](const RoundRuns& r) { run_rows_on_slurm(r, c, mufric); };
+  }
   for (;;) {
     const LearnReport r = learn_rounds(c.directory, o);
     if (r.stop == LearnStop::budget_spent || c.follow_seconds <= 0.0) return;
@@ -121,7 +214,19 @@ void add_learn_command(CLI::App& app) {
   run_cmd->add_option("--fast-max-work", run->fast_max_gigawork,
                       "Work budget of each candidate's fast evaluator, 10^9 multiply-adds (default: train's)")
       ->check(FiniteRange(1e-3, 1e9));
-  run_cmd->callback([run] { run_learner(*run); });
+  run_cmd->add_option("--slurm-tasks", run->slurm_tasks,
+                      "Run each round as a Slurm array of this many tasks (deploy/slurm/submit-dataset.sh) instead of the local pool")
+      ->check(CLI::Range(1, 100000));
+  run_cmd->add_option("--slurm-submit", run->slurm_submit, "The submission script")->capture_default_str();
+  run_cmd->add_option("--sbatch-args", run->sbatch_args, "Extra sbatch options, e.g. \"--partition=compute --time=2:00:00\"");
+  run_cmd->add_option("--slurm-poll", run->slurm_poll_seconds, "Seconds between looks at the queue")
+      ->capture_default_str()->check(FiniteRange(0.1, 3600.0));
+  run_cmd->callback([run] {
+    if (run->slurm_tasks > 0 && !std::filesystem::exists(run->slurm_submit)) {
+      throw Error("--slurm-submit " + run->slurm_submit + ": not found (deploy/slurm/submit-dataset.sh of the source tree)");
+    }
+    run_learner(*run);
+  });
 
   auto status_dir = std::make_shared<std::string>();
   auto* status = learn->add_subcommand("status", "The learner's rounds, spend, gate decisions and kept versions");

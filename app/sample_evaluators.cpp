@@ -1,6 +1,7 @@
 #include "app/sample_evaluators.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <memory>
 
@@ -24,7 +25,9 @@ scene::Scene run_scene(const std::string& scene_path, const std::vector<std::str
 int threads_per_job(int jobs, int threads) { return threads > 0 ? threads : std::max(1, usable_cores() / jobs); }
 
 std::string simulator_scene_json(const std::string& model_path) {
-  return nlohmann::json{{"simulator", model_path}, {"sha256", sha256_file(model_path)}}.dump(2);
+  // The file's name and content, not its path: the same simulator from another directory (a Slurm
+  // task's) is the same scene.
+  return nlohmann::json{{"simulator", std::filesystem::path(model_path).filename().string()}, {"sha256", sha256_file(model_path)}}.dump(2);
 }
 
 SampleEvaluator simulator_evaluator(const std::string& model_path, const InputSpace& inputs) {

@@ -18,7 +18,7 @@ scene::Scene run_scene(const std::string& scene_path, const std::vector<std::str
 // Threads per sample: `threads`, or the usable cores shared among the jobs.
 int threads_per_job(int jobs, int threads);
 
-// The scene text a simulator's database stores: {"simulator": path, "sha256": the file's}.
+// The scene text a simulator's database stores: {"simulator": the file's name, "sha256": its content's}.
 std::string simulator_scene_json(const std::string& model_path);
 // The model's μ at each sample's point (converged; its σ as the sample's standard error when it has one).
 SampleEvaluator simulator_evaluator(const std::string& model_path, const InputSpace& inputs);

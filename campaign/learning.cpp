@@ -312,7 +312,9 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
   const long long queries = logged_query_count(setup.log);
   const long long new_queries = queries < 0 ? -1 : (s.queries_seen >= 0 && queries >= s.queries_seen ? queries - s.queries_seen : queries);
   round.logged_rows = logged.rows;
-  round.uncertain_share = new_queries > 0 ? static_cast<double>(logged.rows) / static_cast<double>(new_queries) : -1.0;
+  // At most 1: the counts restart with a reloaded model's box while its log goes on.
+  round.uncertain_share =
+      new_queries > 0 ? std::min(1.0, static_cast<double>(logged.rows) / static_cast<double>(new_queries)) : -1.0;
   s.log_offset = logged.end_offset;
   s.queries_seen = queries;
   const bool quiet = logged.rows == 0 || (round.uncertain_share >= 0.0 && round.uncertain_share < setup.rest_below);
@@ -339,7 +341,8 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
   training.restarts = setup.restarts;
   training.seed = setup.seed + static_cast<unsigned long long>(round.number);
   const GaussianProcess gp = fit_campaign_gp(data, training);
-  const PickOptions picking{4096, 512, setup.seed};
+  // The learner serves where the queries are: a pick's worth is the variance it removes there.
+  const PickOptions picking{4096, 512, setup.seed, true};
   const std::vector<RefinePick> picks = append_refinement_picks(db, gp, data, rows, picking, round.number, static_cast<int>(batch));
   round.first_plan_row = db.plan.rows() - static_cast<long long>(picks.size());
   round.end_plan_row = db.plan.rows();
@@ -353,29 +356,63 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
   return PlanOutcome::planned;
 }
 
-// Step 3: the round's rows run (resumes: generate_dataset skips rows already answered).
+// The core-seconds of the runs of plan rows [first, end) as the database records them (the
+// micro-model's micro_wall_seconds), for runs made by another engine; 0 where not recorded.
+double recorded_core_seconds(const Dataset& db, long long first, long long end, int threads_per_job) {
+  const auto it = db.diagnostics.find("micro_wall_seconds");
+  if (it == db.diagnostics.end()) return 0.0;
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    const long long row = db.plan_index[static_cast<size_t>(i)];
+    if (row >= first && row < end && std::isfinite(it->second(i))) sum += it->second(i);
+  }
+  return sum * threads_per_job;
+}
+
+// Step 3: the round's rows run (resumes: generate_dataset skips rows already answered), then the
+// database's samples in plan-row order, whatever order the engine finished them in: the same runs
+// train the same model, from the local pool or a Slurm array.
 void run_round(const std::string& dir, LearnState& s, const LearnRunOptions& o) {
   LearnRound& round = s.rounds.back();
-  const Dataset db = read_dataset_isolated(s.setup.db);
-  const SampleEvaluator evaluate = o.make_evaluator(db);
-  GenerationOptions generation;
-  generation.jobs = o.jobs;
-  generation.on_sample = [&](const GenerationProgress& p) {
-    // The micro-model's own time where it reports it (the budget is what the runs cost), else the wall time.
-    double seconds = p.sample_seconds;
-    if (p.outcome != nullptr) {
-      if (const auto it = p.outcome->diagnostics.find("micro_wall_seconds"); it != p.outcome->diagnostics.end()) seconds = it->second;
-    }
-    const double core_seconds = seconds * o.threads_per_job;
-    round.run_core_seconds += core_seconds;
-    s.spent_core_seconds += core_seconds;
-    write_state(dir, s);
-    say(o, format("round %d: sample %lld/%lld (plan row %lld) %s in %.1f s; spent %.3g of %.3g core-hours", round.number,
-                  p.finished, p.to_run, p.plan_row,
-                  p.outcome && p.outcome->converged ? format("mu %.5f", p.outcome->mu).c_str() : "failed", p.sample_seconds,
-                  s.spent_core_seconds / kSecondsPerHour, s.setup.budget_core_hours));
-  };
-  generate_dataset(db, s.setup.db, evaluate, generation);
+  if (o.run_rows) {
+    const std::string work = (fs::path(dir) / ("round-" + std::to_string(round.number) + "-runs")).string();
+    fs::create_directories(work);
+    say(o, format("round %d: plan rows %lld-%lld handed to the engine (%s)", round.number, round.first_plan_row,
+                  round.end_plan_row - 1, work.c_str()));
+    o.run_rows({s.setup.db, work, round.first_plan_row, round.end_plan_row});
+    const double core_seconds =
+        recorded_core_seconds(read_dataset_isolated(s.setup.db), round.first_plan_row, round.end_plan_row, o.threads_per_job);
+    s.spent_core_seconds += core_seconds - round.run_core_seconds;
+    round.run_core_seconds = core_seconds;
+  } else {
+    const Dataset db = read_dataset_isolated(s.setup.db);
+    const SampleEvaluator evaluate = o.make_evaluator(db);
+    GenerationOptions generation;
+    generation.jobs = o.jobs;
+    generation.on_sample = [&](const GenerationProgress& p) {
+      // The micro-model's own time where it reports it (the budget is what the runs cost), else the wall time.
+      double seconds = p.sample_seconds;
+      if (p.outcome != nullptr) {
+        if (const auto it = p.outcome->diagnostics.find("micro_wall_seconds"); it != p.outcome->diagnostics.end()) seconds = it->second;
+      }
+      const double core_seconds = seconds * o.threads_per_job;
+      round.run_core_seconds += core_seconds;
+      s.spent_core_seconds += core_seconds;
+      write_state(dir, s);
+      say(o, format("round %d: sample %lld/%lld (plan row %lld) %s in %.1f s; spent %.3g of %.3g core-hours", round.number,
+                    p.finished, p.to_run, p.plan_row,
+                    p.outcome && p.outcome->converged ? format("mu %.5f", p.outcome->mu).c_str() : "failed", p.sample_seconds,
+                    s.spent_core_seconds / kSecondsPerHour, s.setup.budget_core_hours));
+    };
+    generate_dataset(db, s.setup.db, evaluate, generation);
+  }
+  MergeReport merged;
+  const Dataset ordered = merge_datasets({s.setup.db}, false, merged);
+  if (merged.plan_rows_missing > 0) {
+    throw Error(s.setup.db + ": " + std::to_string(merged.plan_rows_missing) + " plan rows of round " + std::to_string(round.number) +
+                " were not run; run `mufric learn run` again to resume them");
+  }
+  write_dataset(s.setup.db, ordered);
   round.step = "train";
   write_state(dir, s);
 }

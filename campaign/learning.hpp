@@ -100,7 +100,17 @@ struct LearnState {
 void learn_init(const std::string& directory, const LearnSetup& setup);
 LearnState read_learn_state(const std::string& directory);
 
+// A round's runs handed to an engine other than the local work pool (the mufric executable's Slurm
+// array, deploy/slurm): it must leave every plan row in [first, end) answered in the database at
+// db_path (converged or failed), resuming what an earlier call for the same round began (work_dir is
+// the round's own, kept across calls).
+struct RoundRuns {
+  std::string db_path, work_dir;
+  long long first_plan_row = 0, end_plan_row = 0;
+};
+
 struct LearnRunOptions {
+  std::function<void(const RoundRuns&)> run_rows;  // empty: the local work pool
   int jobs = 1;              // samples run at once
   int threads_per_job = 1;   // for the core-hour count
   int rounds = 1;            // rounds this call may finish (each ends published, kept aside, or resting)

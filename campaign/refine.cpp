@@ -106,6 +106,30 @@ double draws_per_sample(const TrainingSet& data) {
 
 // The reference set of a round is another Sobol' shift than its candidates'.
 constexpr unsigned long long kReferenceSeedOffset = 0x5eedULL;
+// Fewer logged rows than this in the box say too little of where the queries are: the box instead.
+constexpr long long kLeastLoggedReference = 32;
+
+// Where the variance a pick removes is averaged: the box (a Sobol' set), or with
+// reference_from_logged the logged rows inside the box — the mean squared prediction error where the
+// queries are (IMSPE weighted by the query density; Binois, Huang, Gramacy & Ludkovski 2019,
+// Technometrics 61:7, eq. 4 with the density the log samples) — evenly thinned to reference_count.
+Eigen::MatrixXd imse_reference(const PickOptions& o, const Eigen::MatrixXd& logged, const InputSpace& box, int round) {
+  if (o.reference_from_logged) {
+    std::vector<Eigen::Index> inside;
+    for (Eigen::Index i = 0; i < logged.rows(); ++i) {
+      if (row_inside(box, logged, i)) inside.push_back(i);
+    }
+    if (static_cast<long long>(inside.size()) >= kLeastLoggedReference) {
+      const auto n = std::min<long long>(o.reference_count, static_cast<long long>(inside.size()));
+      Eigen::MatrixXd reference(n, logged.cols());
+      for (long long k = 0; k < n; ++k) {
+        reference.row(k) = logged.row(inside[static_cast<size_t>(k * static_cast<long long>(inside.size()) / n)]);
+      }
+      return reference;
+    }
+  }
+  return plan_in_box(PlanDesign::sobol, o.reference_count, box, o.seed + kReferenceSeedOffset + static_cast<unsigned long long>(round));
+}
 
 }  // namespace
 
@@ -144,8 +168,7 @@ std::vector<RefinePick> append_refinement_picks(Dataset& db, const GaussianProce
     candidates << sobol, replicates.points;
     // One sample's noise at a candidate: the patch scatter there over the draws a sample makes.
     const Eigen::VectorXd noise = gp.patch_std(candidates).array().square() / draws_per_sample(data);
-    const Eigen::MatrixXd reference =
-        plan_in_box(PlanDesign::sobol, o.reference_count, db.inputs, o.seed + kReferenceSeedOffset + static_cast<unsigned long long>(round));
+    const Eigen::MatrixXd reference = imse_reference(o, logged, db.inputs, round);
     for (const auto& p : pick_by_imse_reduction(gp, candidates, noise, reference, batch, unconverged_points(db))) {
       RefinePick pick;
       pick.std_at_pick = p.std_at_pick;

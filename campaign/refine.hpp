@@ -104,6 +104,9 @@ struct PickOptions {
   long long candidate_count = 4096;  // Sobol' candidates per round
   long long reference_count = 512;   // Sobol' points over which the integrated variance is averaged
   unsigned long long seed = 1;       // of the candidate sets
+  // Average the variance a pick removes over the logged rows inside the box (where the meso code
+  // asks) rather than over the box; the box while fewer than 32 rows are logged there.
+  bool reference_from_logged = false;
 };
 // One round's picks (of at most `batch`) by `gp`, trained on `data` from `db`, among a Sobol' set of
 // round `round` and the logged rows inside the box, appended to db's plan as rows (not run, not

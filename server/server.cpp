@@ -280,6 +280,8 @@ void run_server(const ServerOptions& options) {
       lock.unlock();
       registry.refresh();
       give_back_idle_memory(service, trimmer);
+      // The query counts a learner reads (NAME.outside.json) lag the log by at most a poll.
+      if (uncertain_log) uncertain_log->flush();
       lock.lock();
     }
   });

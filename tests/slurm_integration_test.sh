@@ -92,3 +92,30 @@ grep -q "0 duplicates removed -> 7 samples" <<<"$check" || { echo "FAIL: not 7 s
 grep -q "0 of 7 plan rows not yet run" <<<"$check" || { echo "FAIL: plan rows missing"; exit 1; }
 ls "$S"/out/shard-{0,1,2}.h5 >/dev/null || { echo "FAIL: one shard per array task expected"; exit 1; }
 echo "PASS: 3 array tasks + afterok merge, all 7 planned samples present"
+
+# The learner (issue 62) through a Slurm array gives the same model, bit for bit, as through the
+# local pool: one round on a simulator campaign (the shipped model standing in for the micro-model),
+# run once each way from the same files. The model files differ only in their provenance: creation
+# times, and the path and hash of their database file (its own creation time differs).
+sim="$repo/models/dry_default.h5"
+for engine in local slurm; do
+  d=$S/learn-$engine
+  mkdir -p "$d/served" "$d/logs"
+  "$mufric" dataset plan --out "$d/plan.h5" --samples 12 --p 500MPa:1100MPa >/dev/null
+  "$mufric" dataset run --plan "$d/plan.h5" --db "$d/db.h5" --simulator "$sim" >/dev/null
+  "$mufric" train --data "$d/db.h5" --out "$d/served/gp.h5" --restarts 0 >/dev/null
+  { echo "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width,outside_inputs"
+    for i in 0 1 2 3 4 5; do echo "$((300 + 20 * i))e6,1.5,700,0.1,1"; done; } >"$d/logs/gp.csv"
+  echo '{"queries": 60}' >"$d/logs/gp.outside.json"
+  "$mufric" learn init "$d/learner" --db "$d/db.h5" --model "$d/served/gp.h5" --log "$d/logs/gp.csv" \
+    --round-samples 4 --restarts 0 >/dev/null
+done
+"$mufric" learn run "$S/learn-local/learner" --simulator "$sim" | grep -E "planned|published|kept aside"
+"$mufric" learn run "$S/learn-slurm/learner" --simulator "$sim" --slurm-tasks 2 --slurm-poll 0.5 |
+  grep -E "submitted|planned|published|kept aside"
+ls "$S"/learn-slurm/learner/round-1-runs/shard-{0,1}.h5 >/dev/null || { echo "FAIL: the round did not run as 2 shards"; exit 1; }
+differing=$(h5diff -r "$S/learn-local/served/gp.h5" "$S/learn-slurm/served/gp.h5" 2>&1 |
+  grep -E "^(attribute|dataset)|differences found" | grep -B1 -E "^[1-9][0-9]* differences" | grep -E "^(attribute|dataset)" |
+  grep -vE "<(created_utc|seconds|dataset_path|dataset_sha256) of" || true)
+[[ -z $differing ]] || { echo "FAIL: the Slurm round's model differs from the local one's: $differing"; exit 1; }
+echo "PASS: a learner round through a 2-task Slurm array gives the local pool's model bit for bit"

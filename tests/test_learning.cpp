@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "campaign/dataset_generation.hpp"
 #include "campaign/learning.hpp"
@@ -84,6 +85,49 @@ TEST(Learning, TheBinomialTailIsTheSumOfItsTerms) {
   EXPECT_NEAR(binomial_lower_tail(5, 8, p), by_hand, 1e-15);
   EXPECT_EQ(binomial_lower_tail(8, 8, p), 1.0);
   EXPECT_EQ(binomial_lower_tail(-1, 8, p), 0.0);
+}
+
+// Where the learner's picks go on a campaign of independent draws (stochastic kriging, picks by the
+// variance they remove): averaged over the logged rows, all at 300-330 MPa, the picks move toward
+// those pressures; averaged over the box, they spread over it.
+TEST(Learning, PicksRemoveVarianceWhereTheQueriesAre) {
+  Dataset db;
+  db.inputs = default_friction_box();
+  db.plan = plan_in_box(PlanDesign::sobol, 24, db.inputs, 7);
+  db.plan_design = "sobol";
+  db.draws = DrawDesign::independent;
+  db.plan_seed = 3;
+  db.scene_json = "{}";
+  const std::string path = test::temp_path("picks-db.h5");
+  fs::remove(path);
+  generate_dataset(db, path, [](const SampleRequest& r) {
+    SampleOutcome o;
+    o.converged = true;
+    std::mt19937_64 rng(r.seeds->tool);
+    std::normal_distribution<double> scatter(0.0, 0.01);
+    for (int k = 0; k < 4; ++k) o.draw_mu.push_back(smooth_mu(r.x) + scatter(rng));
+    o.mu = (o.draw_mu[0] + o.draw_mu[1] + o.draw_mu[2] + o.draw_mu[3]) / 4.0;
+    return o;
+  }, {});
+  const Dataset run = read_dataset(path);
+  const TrainingSet data = training_set(run, path);
+  GpTrainingOptions training;
+  training.restarts = 0;
+  const GaussianProcess gp = fit_campaign_gp(data, training);
+  ASSERT_TRUE(gp.has_patch_scatter());
+  Eigen::MatrixXd logged = plan_in_box(PlanDesign::sobol, 64, {{"contact_pressure", "Pa", 300e6, 330e6}, db.inputs[1], db.inputs[2]}, 9);
+  const auto mean_pressure_of_picks = [&](bool from_logged) {
+    Dataset copy = run;
+    PickOptions o;
+    o.reference_from_logged = from_logged;
+    double sum = 0.0;
+    const auto picks = append_refinement_picks(copy, gp, data, logged, o, 1, 4);
+    for (const RefinePick& p : picks) sum += copy.plan(p.plan_row, 0);
+    return sum / static_cast<double>(picks.size());
+  };
+  const double near = mean_pressure_of_picks(true), spread = mean_pressure_of_picks(false);
+  EXPECT_LT(near, 500e6) << near;
+  EXPECT_LT(near, spread - 100e6) << near << " " << spread;
 }
 
 // A campaign of 20 plan rows in the default box, its served GP, and a server log of queries below
