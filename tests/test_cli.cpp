@@ -1197,7 +1197,7 @@ TEST_F(Cli, LearnerSurvivesKillNineAndPublishesAGatedRound) {
                         path("logs/gp.csv") + " --round-samples 4 --budget-core-hours 1 --restarts 0");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string first_version = r.output.substr(r.output.find("serving version ") + 16, 16);
-  for (const std::string& kill_after : {"planned 4 runs", "training on"}) {
+  for (const char* kill_after : {"planned 4 runs", "training on"}) {
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {

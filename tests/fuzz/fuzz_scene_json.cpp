@@ -12,7 +12,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = mufric::fuzz::write_input(data, size, ".json");
   try {
     const mufric::scene::Scene scene = mufric::scene::load_scene(path, {});
-    if (!(scene.penalty > 0) || !std::isfinite(scene.penalty)) std::abort();
+    if (!(scene.contact.penalty > 0) || !std::isfinite(scene.contact.penalty)) std::abort();
   } catch (const mufric::Error&) {
   }
   // The same bytes as an override of the default scene, as `--set` passes them.
