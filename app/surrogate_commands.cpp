@@ -539,18 +539,18 @@ void add_upgrade(CLI::App& app) {
     const bool range_changed = !o->box.mu_range.empty();
     apply_box_options(*model, o->box);
     const bool build = o->fast.skip || o->rebuild || range_changed;
+    // A GP's grids and a calibrated model's alike: built when missing or asked, else kept.
+    const auto grid = [&](auto& gridded) {
+      if (gridded.fast_evaluator() == nullptr || build) {
+        attach_fast_evaluator(gridded, o->fast);
+      } else {
+        std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
+      }
+    };
     if (auto* gp = dynamic_cast<GaussianProcess*>(model.get())) {
-      if (gp->fast_evaluator() == nullptr || build) {
-        attach_fast_evaluator(*gp, o->fast);
-      } else {
-        std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
-      }
+      grid(*gp);
     } else if (auto* calibrated = dynamic_cast<CalibratedModel*>(model.get())) {
-      if (calibrated->fast_evaluator() == nullptr || build) {
-        attach_fast_evaluator(*calibrated, o->fast);
-      } else {
-        std::printf("keeps its fast evaluator (--rebuild to build it again)\n");
-      }
+      grid(*calibrated);
     }
     const std::string out = o->out.empty() ? o->model : o->out;
     save_model(out, *model);
