@@ -54,19 +54,16 @@ std::string quoted(const std::string& word) {
 void run_rows_on_slurm(const RoundRuns& r, const LearnRunCommand& c, const std::string& mufric) {
   namespace fs = std::filesystem;
   const std::string jobs_file = r.work_dir + "/jobs", merged = r.work_dir + "/db.h5";
-  const auto queued = [](const std::string& job) { return !shell("squeue -h -j " + job + " 2>/dev/null").first.empty(); };
+  // Why the job waits ("None" while it runs), or "" once it has left the queue.
+  const auto queue_reason = [](const std::string& job) { return shell("squeue -h -j " + job + " -o %r 2>/dev/null").first; };
   for (int attempt = 0; attempt < 2; ++attempt) {
     std::string merge_job;
     if (const auto text = read_whole_file(jobs_file)) merge_job = *text;
-    if (merge_job.empty() || (!queued(merge_job) && !fs::exists(merged))) {
+    if (merge_job.empty() || (queue_reason(merge_job).empty() && !fs::exists(merged))) {
       fs::remove(merged);
       for (int i = 0; i < c.slurm_tasks; ++i) {
         const std::string shard = r.work_dir + "/shard-" + std::to_string(i) + ".h5";
-        if (!fs::exists(shard)) {
-          const auto bytes = read_whole_file(r.db_path);
-          if (!bytes) throw Error(r.db_path + ": cannot read it to start shard " + std::to_string(i));
-          write_file_atomically(shard, *bytes);
-        }
+        if (!fs::exists(shard)) copy_file_atomically(r.db_path, shard);
       }
       // dataset-array.sbatch splits MUFRIC_RUN_ARGS on spaces (no quotes): a path with a space cannot pass.
       const std::string simulator = c.simulator.empty() ? "" : fs::absolute(c.simulator).string();
@@ -82,9 +79,8 @@ void run_rows_on_slurm(const RoundRuns& r, const LearnRunCommand& c, const std::
       std::printf("submitted: %s", out.c_str());
       std::fflush(stdout);
     }
-    while (queued(merge_job)) {
+    for (std::string reason; !(reason = queue_reason(merge_job)).empty();) {
       // A shard that failed leaves the merge waiting for ever (afterok): cancel it and say why.
-      const std::string reason = shell("squeue -h -j " + merge_job + " -o %r 2>/dev/null").first;
       if (reason.find("DependencyNeverSatisfied") != std::string::npos) {
         shell("scancel " + merge_job + " 2>/dev/null");
         fs::remove(jobs_file);  // the next `learn run` submits the round's shards again; they resume
@@ -99,9 +95,7 @@ void run_rows_on_slurm(const RoundRuns& r, const LearnRunCommand& c, const std::
       std::this_thread::sleep_for(std::chrono::duration<double>(c.slurm_poll_seconds));
     }
     if (fs::exists(merged)) {
-      const auto bytes = read_whole_file(merged);
-      if (!bytes) throw Error(merged + ": cannot read the merged database");
-      write_file_atomically(r.db_path, *bytes);
+      copy_file_atomically(merged, r.db_path);
       return;
     }
     std::printf("Slurm merge job %s ended without %s; submitting the round's shards again\n", merge_job.c_str(), merged.c_str());

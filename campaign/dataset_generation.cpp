@@ -58,6 +58,14 @@ DrawSeeds row_draw_seeds(long long plan_seed, long long row) {
   return {h & kRowSeedMask, (h >> 32) & kRowSeedMask};
 }
 
+std::vector<bool> answered_plan_rows(const Dataset& db) {
+  std::vector<bool> answered(static_cast<size_t>(db.plan.rows()), false);
+  for (const long long row : db.plan_index) {
+    if (row >= 0 && row < db.plan.rows()) answered[static_cast<size_t>(row)] = true;
+  }
+  return answered;
+}
+
 Dataset empty_dataset(const Dataset& plan) {
   Dataset d;
   d.inputs = plan.inputs;

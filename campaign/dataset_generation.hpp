@@ -55,6 +55,9 @@ struct GenerationReport {
 // reproduces the sample.
 DrawSeeds row_draw_seeds(long long plan_seed, long long row);
 
+// Which of the plan's rows some sample answers, converged or not.
+std::vector<bool> answered_plan_rows(const Dataset& db);
+
 // A dataset with no samples carrying `plan`'s inputs, plan (design, seed, box history), source and
 // scene, stamped with this code's version: a new plan file, a new database, a merge's start.
 Dataset empty_dataset(const Dataset& plan);

@@ -25,6 +25,17 @@
 #include "surrogate/model_file.hpp"
 
 namespace mufric {
+
+// The state file's records, each key its member's name (nlohmann/json's macros; at namespace scope,
+// where argument-dependent lookup finds them).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnSetup, db, served_model, log, round_samples, budget_core_hours, rest_below,
+                                   grow_coverage, seed, restarts)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(GateDecision, publish, reason, old_points, served_loo_rmse, candidate_loo_rmse,
+                                   allowed_loo_rmse, new_points, new_covered, grid_certified)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnRound, number, step, first_plan_row, end_plan_row, logged_rows, uncertain_share,
+                                   run_core_seconds, candidate, gate, version, finished_utc)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnState::Served, version, utc, how)
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -40,91 +51,16 @@ std::string version_path(const std::string& dir, const std::string& version) {
   return (fs::path(dir) / "versions" / (version + ".h5")).string();
 }
 
-// ---- the state file -------------------------------------------------------------------------
-
-json to_json(const LearnSetup& s) {
-  return {{"db", s.db},         {"served_model", s.served_model},     {"log", s.log},
-          {"round_samples", s.round_samples}, {"budget_core_hours", s.budget_core_hours},
-          {"rest_below", s.rest_below},       {"grow_coverage", s.grow_coverage},
-          {"seed", s.seed},                   {"restarts", s.restarts}};
-}
-LearnSetup setup_from_json(const json& j) {
-  LearnSetup s;
-  s.db = j.at("db");
-  s.served_model = j.at("served_model");
-  s.log = j.at("log");
-  s.round_samples = j.at("round_samples");
-  s.budget_core_hours = j.at("budget_core_hours");
-  s.rest_below = j.at("rest_below");
-  s.grow_coverage = j.at("grow_coverage");
-  s.seed = j.at("seed");
-  s.restarts = j.at("restarts");
-  return s;
-}
-json to_json(const GateDecision& g) {
-  return {{"publish", g.publish},
-          {"reason", g.reason},
-          {"old_points", g.old_points},
-          {"served_loo_rmse", g.served_loo_rmse},
-          {"candidate_loo_rmse", g.candidate_loo_rmse},
-          {"allowed_loo_rmse", g.allowed_loo_rmse},
-          {"new_points", g.new_points},
-          {"new_covered", g.new_covered},
-          {"grid_certified", g.grid_certified}};
-}
-GateDecision gate_from_json(const json& j) {
-  GateDecision g;
-  g.publish = j.at("publish");
-  g.reason = j.at("reason");
-  g.old_points = j.at("old_points");
-  g.served_loo_rmse = j.at("served_loo_rmse");
-  g.candidate_loo_rmse = j.at("candidate_loo_rmse");
-  g.allowed_loo_rmse = j.at("allowed_loo_rmse");
-  g.new_points = j.at("new_points");
-  g.new_covered = j.at("new_covered");
-  g.grid_certified = j.at("grid_certified");
-  return g;
-}
-json to_json(const LearnRound& r) {
-  return {{"number", r.number},
-          {"step", r.step},
-          {"first_plan_row", r.first_plan_row},
-          {"end_plan_row", r.end_plan_row},
-          {"logged_rows", r.logged_rows},
-          {"uncertain_share", r.uncertain_share},
-          {"run_core_seconds", r.run_core_seconds},
-          {"candidate", r.candidate},
-          {"gate", to_json(r.gate)},
-          {"version", r.version},
-          {"finished_utc", r.finished_utc}};
-}
-LearnRound round_from_json(const json& j) {
-  LearnRound r;
-  r.number = j.at("number");
-  r.step = j.at("step");
-  r.first_plan_row = j.at("first_plan_row");
-  r.end_plan_row = j.at("end_plan_row");
-  r.logged_rows = j.at("logged_rows");
-  r.uncertain_share = j.at("uncertain_share");
-  r.run_core_seconds = j.at("run_core_seconds");
-  r.candidate = j.at("candidate");
-  r.gate = gate_from_json(j.at("gate"));
-  r.version = j.at("version");
-  r.finished_utc = j.at("finished_utc");
-  return r;
-}
+// ---- the state file: DIR/learn.json (its types' (de)serialisers are at the namespace's top) ----
 
 void write_state(const std::string& dir, const LearnState& s) {
-  json rounds = json::array(), served = json::array();
-  for (const auto& r : s.rounds) rounds.push_back(to_json(r));
-  for (const auto& v : s.served) served.push_back({{"version", v.version}, {"utc", v.utc}, {"how", v.how}});
   const json j = {{"format", "mufric learn state 1"},
-                  {"setup", to_json(s.setup)},
+                  {"setup", s.setup},
                   {"log_offset", s.log_offset},
                   {"queries_seen", s.queries_seen},
                   {"spent_core_seconds", s.spent_core_seconds},
-                  {"rounds", rounds},
-                  {"served", served}};
+                  {"rounds", s.rounds},
+                  {"served", s.served}};
   write_file_atomically(state_path(dir), j.dump(2) + "\n");
 }
 
@@ -236,30 +172,15 @@ __attribute__((format(printf, 1, 2))) std::string format(const char* pattern, ..
 void keep_version(const std::string& dir, LearnState& s, const std::string& file, const std::string& how) {
   const std::string version = file_version(file);
   const std::string kept = version_path(dir, version);
-  if (!fs::exists(kept)) {
-    const auto bytes = read_whole_file(file);
-    if (!bytes) throw Error(file + ": cannot read it to keep its version");
-    write_file_atomically(kept, *bytes);
-  }
+  if (!fs::exists(kept)) copy_file_atomically(file, kept);
   if (!s.served.empty() && s.served.back().version == version) return;  // a resumed step, already recorded
   s.served.push_back({version, utc_timestamp(), how});
-}
-
-// Replaces the served file by `source`'s bytes in one rename: a reader (the server's reload) sees
-// the old file or the new one, never a part (the temporary's name does not end in .h5).
-void publish_file(const std::string& source, const std::string& served) {
-  const auto bytes = read_whole_file(source);
-  if (!bytes) throw Error(source + ": cannot read it to publish");
-  write_file_atomically(served, *bytes);
 }
 
 // Plan rows of the database no sample answers, as [first, end): a kill after the picks were written
 // and before the state recorded them leaves them there, and they are the round's.
 std::pair<long long, long long> pending_rows(const Dataset& db) {
-  std::vector<bool> answered(static_cast<size_t>(db.plan.rows()), false);
-  for (const long long row : db.plan_index) {
-    if (row >= 0 && row < db.plan.rows()) answered[static_cast<size_t>(row)] = true;
-  }
+  const std::vector<bool> answered = answered_plan_rows(db);
   long long first = db.plan.rows();
   for (long long row = 0; row < db.plan.rows(); ++row) {
     if (!answered[static_cast<size_t>(row)]) {
@@ -270,21 +191,32 @@ std::pair<long long, long long> pending_rows(const Dataset& db) {
   return {first, db.plan.rows()};
 }
 
-// The mean core-seconds of a sample so far (the database's micro_wall_seconds, else the learner's
-// own count), for how many runs the budget still allows; 0 when nothing is known.
-double mean_sample_core_seconds(const Dataset& db, const LearnState& s, int threads_per_job) {
+// The micro-model's own time (micro_wall_seconds) of the samples answering plan rows [first, end),
+// and how many recorded it: what a round's runs cost when another engine ran them, and the mean
+// cost a budget is planned with.
+struct RecordedSeconds {
+  double seconds = 0.0;
+  long long samples = 0;
+};
+RecordedSeconds recorded_micro_seconds(const Dataset& db, long long first, long long end) {
+  RecordedSeconds r;
   const auto it = db.diagnostics.find("micro_wall_seconds");
-  double sum = 0.0;
-  long long n = 0;
-  if (it != db.diagnostics.end()) {
-    for (Eigen::Index i = 0; i < it->second.size(); ++i) {
-      if (std::isfinite(it->second(i))) {
-        sum += it->second(i);
-        ++n;
-      }
+  if (it == db.diagnostics.end()) return r;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    const long long row = db.plan_index[static_cast<size_t>(i)];
+    if (row >= first && row < end && std::isfinite(it->second(i))) {
+      r.seconds += it->second(i);
+      ++r.samples;
     }
   }
-  if (n > 0) return threads_per_job * sum / static_cast<double>(n);
+  return r;
+}
+
+// The mean core-seconds of a sample so far (the database's record, else the learner's own count),
+// for how many runs the budget still allows; 0 when nothing is known.
+double mean_sample_core_seconds(const Dataset& db, const LearnState& s, int threads_per_job) {
+  const RecordedSeconds recorded = recorded_micro_seconds(db, -1, db.plan.rows());  // −1: a sample of no plan row
+  if (recorded.samples > 0) return threads_per_job * recorded.seconds / static_cast<double>(recorded.samples);
   long long runs = 0;
   for (const auto& r : s.rounds) runs += r.end_plan_row - r.first_plan_row;
   return runs > 0 ? s.spent_core_seconds / static_cast<double>(runs) : 0.0;
@@ -356,19 +288,6 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
   return PlanOutcome::planned;
 }
 
-// The core-seconds of the runs of plan rows [first, end) as the database records them (the
-// micro-model's micro_wall_seconds), for runs made by another engine; 0 where not recorded.
-double recorded_core_seconds(const Dataset& db, long long first, long long end, int threads_per_job) {
-  const auto it = db.diagnostics.find("micro_wall_seconds");
-  if (it == db.diagnostics.end()) return 0.0;
-  double sum = 0.0;
-  for (Eigen::Index i = 0; i < db.size(); ++i) {
-    const long long row = db.plan_index[static_cast<size_t>(i)];
-    if (row >= first && row < end && std::isfinite(it->second(i))) sum += it->second(i);
-  }
-  return sum * threads_per_job;
-}
-
 // Step 3: the round's rows run (resumes: generate_dataset skips rows already answered), then the
 // database's samples in plan-row order, whatever order the engine finished them in: the same runs
 // train the same model, from the local pool or a Slurm array.
@@ -381,7 +300,8 @@ void run_round(const std::string& dir, LearnState& s, const LearnRunOptions& o) 
                   round.end_plan_row - 1, work.c_str()));
     o.run_rows({s.setup.db, work, round.first_plan_row, round.end_plan_row});
     const double core_seconds =
-        recorded_core_seconds(read_dataset_isolated(s.setup.db), round.first_plan_row, round.end_plan_row, o.threads_per_job);
+        o.threads_per_job *
+        recorded_micro_seconds(read_dataset_isolated(s.setup.db), round.first_plan_row, round.end_plan_row).seconds;
     s.spent_core_seconds += core_seconds - round.run_core_seconds;
     round.run_core_seconds = core_seconds;
   } else {
@@ -439,7 +359,9 @@ void gate_round(const std::string& dir, LearnState& s, const LearnRunOptions& o)
   round.gate = gate_candidate(*served, *candidate, o.fast);
   if (round.gate.publish) {
     keep_version(dir, s, round.candidate, "published by round " + std::to_string(round.number));
-    publish_file(round.candidate, s.setup.served_model);
+    // One rename: the server's reload sees the old file or the new one (the temporary's name does
+    // not end in .h5, so the registry never opens it).
+    copy_file_atomically(round.candidate, s.setup.served_model);
   }
   round.step = "done";
   round.finished_utc = utc_timestamp();
@@ -535,8 +457,6 @@ GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess
   return g;
 }
 
-std::string file_version(const std::string& path) { return sha256_file(path).substr(0, 16); }
-
 void learn_init(const std::string& directory, const LearnSetup& setup) {
   if (fs::exists(state_path(directory))) throw Error(directory + ": already holds a learner (" + state_path(directory) + ")");
   if (setup.round_samples < 1) throw Error("round samples: must be at least 1");
@@ -564,12 +484,12 @@ LearnState read_learn_state(const std::string& directory) {
   try {
     const json j = json::parse(*text);
     LearnState s;
-    s.setup = setup_from_json(j.at("setup"));
-    s.log_offset = j.at("log_offset");
-    s.queries_seen = j.at("queries_seen");
-    s.spent_core_seconds = j.at("spent_core_seconds");
-    for (const auto& r : j.at("rounds")) s.rounds.push_back(round_from_json(r));
-    for (const auto& v : j.at("served")) s.served.push_back({v.at("version"), v.at("utc"), v.at("how")});
+    j.at("setup").get_to(s.setup);
+    j.at("log_offset").get_to(s.log_offset);
+    j.at("queries_seen").get_to(s.queries_seen);
+    j.at("spent_core_seconds").get_to(s.spent_core_seconds);
+    j.at("rounds").get_to(s.rounds);
+    j.at("served").get_to(s.served);
     return s;
   } catch (const json::exception& e) {
     throw Error(path + ": not a learner's state (" + e.what() + ")");
@@ -611,7 +531,7 @@ void learn_rollback(const std::string& directory, const std::string& version) {
     for (const auto& v : s.served) known += (known.empty() ? "" : ", ") + v.version;
     throw Error("version " + version + ": not kept by this learner (kept: " + known + ")");
   }
-  publish_file(kept, s.setup.served_model);
+  copy_file_atomically(kept, s.setup.served_model);
   s.served.push_back({version, utc_timestamp(), "rolled back"});
   write_state(directory, s);
 }

@@ -22,6 +22,7 @@
 #include <Eigen/Dense>
 
 #include "campaign/dataset_generation.hpp"
+#include "common/files.hpp"  // file_version, the versions a learner keeps
 #include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gaussian_process.hpp"
 
@@ -133,7 +134,5 @@ LearnReport learn_rounds(const std::string& directory, const LearnRunOptions& op
 // Puts a version the learner kept (any of LearnState::served) back as the served file, atomically.
 void learn_rollback(const std::string& directory, const std::string& version);
 
-// The first 16 hex digits of a file's SHA-256: the version the server names it by.
-std::string file_version(const std::string& path);
 
 }  // namespace mufric

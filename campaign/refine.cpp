@@ -207,10 +207,7 @@ namespace {
 long long drop_pending_plan_rows(Dataset& db, const std::string& source) {
   long long last_run = -1;
   for (const long long row : db.plan_index) last_run = std::max(last_run, row);
-  std::vector<bool> answered(static_cast<size_t>(db.plan.rows()), false);
-  for (const long long row : db.plan_index) {
-    if (row >= 0 && row < db.plan.rows()) answered[static_cast<size_t>(row)] = true;
-  }
+  const std::vector<bool> answered = answered_plan_rows(db);
   std::vector<long long> gaps;
   for (long long row = 0; row < last_run; ++row) {
     if (!answered[static_cast<size_t>(row)]) gaps.push_back(row);

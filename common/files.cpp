@@ -51,4 +51,12 @@ std::string sha256_file(const std::string& path) {
   return sha256_hex(*bytes);
 }
 
+void copy_file_atomically(const std::string& from, const std::string& to) {
+  const auto bytes = read_whole_file(from);
+  if (!bytes) throw Error(from + ": cannot read it to copy it to " + to);
+  write_file_atomically(to, *bytes);
+}
+
+std::string file_version(const std::string& path) { return sha256_file(path).substr(0, kFileVersionDigits); }
+
 }  // namespace mufric

@@ -13,7 +13,6 @@
 
 namespace mufric::server {
 namespace {
-constexpr size_t kVersionDigits = 16;
 constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
 
 std::optional<FileIdentity> identity_of(const std::filesystem::path& path) {
@@ -64,7 +63,7 @@ int ModelRegistry::refresh(Rescan rescan) {
     auto served = std::make_shared<ServedModel>();
     served->name = name;
     served->path = entry.path();
-    served->version = sha256.substr(0, kVersionDigits);
+    served->version = sha256.substr(0, kFileVersionDigits);  // file_version, from the hash in hand
     try {
       served->model = load_model_isolated(entry.path().string());
       if (const std::string why = servable_inputs_violation(input_names(served->model->inputs())); !why.empty()) {
