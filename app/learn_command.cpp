@@ -19,6 +19,9 @@
 namespace mufric::app {
 namespace {
 
+// How long squeue may fail to answer (controller down or restarting) before the learner stops waiting.
+constexpr double kSlurmSilenceLimitSeconds = 1800.0;
+
 struct LearnRunCommand {
   std::string directory, simulator, slurm_submit = MUFRIC_SLURM_SUBMIT, sbatch_args;
   int slurm_tasks = 0;
@@ -54,8 +57,34 @@ std::string quoted(const std::string& word) {
 void run_rows_on_slurm(const RoundRuns& r, const LearnRunCommand& c, const std::string& mufric) {
   namespace fs = std::filesystem;
   const std::string jobs_file = r.work_dir + "/jobs", merged = r.work_dir + "/db.h5";
-  // Why the job waits ("None" while it runs), or "" once it has left the queue.
-  const auto queue_reason = [](const std::string& job) { return shell("squeue -h -j " + job + " -o %r 2>/dev/null").first; };
+  // Why the job waits ("None" while it runs), or "" once it has left the queue (squeue names a job
+  // the controller has forgotten an invalid id). A controller that does not answer (down, restarting,
+  // timing out) says nothing about the job: polled again until it has been silent for
+  // kSlurmSilenceLimitSeconds, so that a restart of slurmctld does not make the learner resubmit a
+  // round that is still running.
+  auto silent_since = std::chrono::steady_clock::time_point{};
+  const auto queue_reason = [&silent_since, &c](const std::string& job) {
+    for (;;) {
+      const auto [out, status] = shell("squeue -h -j " + job + " -o %r 2>&1");
+      if (status == 0) {
+        silent_since = {};
+        return out;
+      }
+      if (out.find("Invalid job id") != std::string::npos) return std::string();
+      const auto now = std::chrono::steady_clock::now();
+      if (silent_since == std::chrono::steady_clock::time_point{}) {
+        silent_since = now;
+        std::printf("squeue does not answer about job %s (%s); asking again every %g s\n", job.c_str(),
+                    out.substr(0, out.find('\n')).c_str(), c.slurm_poll_seconds);
+        std::fflush(stdout);
+      }
+      if (std::chrono::duration<double>(now - silent_since).count() > kSlurmSilenceLimitSeconds) {
+        throw Error("squeue has not answered about job " + job + " for " + std::to_string(static_cast<int>(kSlurmSilenceLimitSeconds)) +
+                    " s (" + out.substr(0, out.find('\n')) + "); the job may still run: `mufric learn run` again waits for it");
+      }
+      std::this_thread::sleep_for(std::chrono::duration<double>(c.slurm_poll_seconds));
+    }
+  };
   for (int attempt = 0; attempt < 2; ++attempt) {
     std::string merge_job;
     if (const auto text = read_whole_file(jobs_file)) merge_job = *text;

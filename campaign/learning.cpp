@@ -356,6 +356,7 @@ void gate_round(const std::string& dir, LearnState& s, const LearnRunOptions& o)
   LearnRound& round = s.rounds.back();
   const std::unique_ptr<GaussianProcess> served = load_gp(s.setup.served_model, "served model");
   const std::unique_ptr<GaussianProcess> candidate = load_gp(round.candidate, "candidate");
+  say(o, format("round %d: gating %s against the served model", round.number, round.version.c_str()));
   round.gate = gate_candidate(*served, *candidate, o.fast);
   if (round.gate.publish) {
     keep_version(dir, s, round.candidate, "published by round " + std::to_string(round.number));

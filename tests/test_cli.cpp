@@ -1180,24 +1180,32 @@ TEST_F(Cli, DatasetRunSurvivesKillNine) {
 // again as it trains, resumed each time, finishes its round with every plan row run once and a
 // published version; status says so; rollback serves the first version's bytes again; a quiet log
 // rests; another simulator's runs are refused before they start.
-TEST_F(Cli, LearnerSurvivesKillNineAndPublishesAGatedRound) {
-  const std::string simulator = MUFRIC_SOURCE_DIR "/models/dry_default.h5";
-  ASSERT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 16 --p 500MPa:1100MPa --v 50m/min:150m/min --T 200C:700C").exit_code, 0);
-  ASSERT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --simulator " + simulator).exit_code, 0);
+// A learner over a 16-sample campaign of the shipped model as simulator, its log holding six queries
+// below the box (p 300-400 MPa); returns `learn init`'s output.
+std::string set_up_learner(const std::filesystem::path& dir, const std::string& simulator) {
+  const auto path = [&dir](const std::string& name) { return (dir / name).string(); };
+  EXPECT_EQ(run("dataset plan --out " + path("plan.h5") + " --samples 16 --p 500MPa:1100MPa --v 50m/min:150m/min --T 200C:700C").exit_code, 0);
+  EXPECT_EQ(run("dataset run --plan " + path("plan.h5") + " --db " + path("db.h5") + " --simulator " + simulator).exit_code, 0);
   std::filesystem::create_directories(path("served"));
   std::filesystem::create_directories(path("logs"));
-  ASSERT_EQ(run("train --data " + path("db.h5") + " --out " + path("served/gp.h5") + " --restarts 0").exit_code, 0);
+  EXPECT_EQ(run("train --data " + path("db.h5") + " --out " + path("served/gp.h5") + " --restarts 0").exit_code, 0);
   {
     std::ofstream log(path("logs/gp.csv"));
     log << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width,outside_inputs\n";
     for (int i = 0; i < 6; ++i) log << 300e6 + 20e6 * i << ",1.5,700,0.1,1\n";
     std::ofstream(path("logs/gp.outside.json")) << "{\"queries\": 60}";
   }
-  CommandResult r = run("learn init " + path("learner") + " --db " + path("db.h5") + " --model " + path("served/gp.h5") + " --log " +
-                        path("logs/gp.csv") + " --round-samples 4 --budget-core-hours 1 --restarts 0");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const CommandResult r = run("learn init " + path("learner") + " --db " + path("db.h5") + " --model " + path("served/gp.h5") +
+                              " --log " + path("logs/gp.csv") + " --round-samples 4 --budget-core-hours 1 --restarts 0");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return r.output;
+}
+
+TEST_F(Cli, LearnerSurvivesKillNineAndPublishesAGatedRound) {
+  const std::string simulator = MUFRIC_SOURCE_DIR "/models/dry_default.h5";
+  CommandResult r{0, set_up_learner(dir_, simulator)};
   const std::string first_version = r.output.substr(r.output.find("serving version ") + 16, 16);
-  for (const char* kill_after : {"planned 4 runs", "training on"}) {
+  for (const char* kill_after : {"planned 4 runs", "training on", "gating"}) {
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
@@ -1243,6 +1251,58 @@ TEST_F(Cli, LearnerSurvivesKillNineAndPublishesAGatedRound) {
   r = run("learn run " + path("learner") + " --simulator " + path("other.h5"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("its samples were made by another simulator"), std::string::npos) << r.output;
+}
+
+// A learner round through Slurm whose controller stops answering for a while (slurmctld restarting):
+// the learner waits for the submitted jobs instead of taking them for gone and submitting the round
+// again. Slurm is faked on PATH: sbatch runs the project's job scripts in the background
+// (deploy/slurm/submit-dataset.sh submits them unchanged) and squeue fails like an unreachable
+// controller for its first three calls, then answers from the jobs' state.
+TEST_F(Cli, LearnerWaitsForSlurmJobsWhileTheControllerDoesNotAnswer) {
+  const std::string simulator = MUFRIC_SOURCE_DIR "/models/dry_default.h5";
+  set_up_learner(dir_, simulator);
+  const std::string fake = path("fake-slurm");
+  std::filesystem::create_directories(fake);
+  std::ofstream(fake + "/sbatch") << R"SH(#!/bin/bash
+# fake sbatch: the job (array tasks one after another) in the background; --dependency waits for the array
+n=$(( $(cat "$FAKE_SLURM/submitted" 2>/dev/null || echo 0) + 1 )); echo $n > "$FAKE_SLURM/submitted"
+chdir=. array= after=
+for a; do case $a in --chdir=*) chdir=${a#*=};; --array=*) array=${a#*=};; --dependency=afterok:*) after=${a#*:};; esac; done
+script=${!#}
+id=$((100 + n))
+(
+  cd "$chdir"
+  while [[ -n $after && ! -e $FAKE_SLURM/$after.done ]]; do sleep 0.1; done
+  sleep 1  # still running when the learner first asks
+  if [[ -n $array ]]; then
+    for ((i = ${array%-*}; i <= ${array#*-}; i++)); do
+      SLURM_ARRAY_TASK_ID=$i SLURM_ARRAY_TASK_MIN=${array%-*} SLURM_ARRAY_TASK_COUNT=$((${array#*-} - ${array%-*} + 1)) \
+        bash "$script" > "task-$i.out" 2>&1
+    done
+  else
+    bash "$script" > "merge.out" 2>&1
+  fi
+  touch "$FAKE_SLURM/$id.done"
+) > /dev/null 2>&1 &
+echo $id
+)SH";
+  std::ofstream(fake + "/squeue") << R"SH(#!/bin/bash
+# fake squeue -h -j ID -o %r: three calls as an unreachable controller, then the job's state
+n=$(( $(cat "$FAKE_SLURM/asked" 2>/dev/null || echo 0) + 1 )); echo $n > "$FAKE_SLURM/asked"
+if ((n <= 3)); then echo "squeue: error: slurm_load_jobs error: Unable to contact slurm controller (connect failure)" >&2; exit 1; fi
+[[ -e $FAKE_SLURM/$3.done ]] && { echo "slurm_load_jobs error: Invalid job id specified" >&2; exit 1; }
+echo None
+)SH";
+  std::filesystem::permissions(fake + "/sbatch", std::filesystem::perms::owner_all, std::filesystem::perm_options::add);
+  std::filesystem::permissions(fake + "/squeue", std::filesystem::perms::owner_all, std::filesystem::perm_options::add);
+  const CommandResult r = run("learn run " + path("learner") + " --simulator " + simulator + " --slurm-tasks 2 --slurm-poll 0.2",
+                              "env FAKE_SLURM=" + fake + " PATH=" + fake + ":" + std::getenv("PATH"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("squeue does not answer about job 102 (squeue: error: slurm_load_jobs error: Unable to contact"),
+            std::string::npos) << r.output;
+  EXPECT_EQ(read_text(fake + "/submitted"), "2\n") << r.output;  // one array and one merge job: submitted once
+  EXPECT_TRUE(r.output.find("published ") != std::string::npos || r.output.find("kept aside ") != std::string::npos) << r.output;
+  EXPECT_NE(run("learn status " + path("learner")).output.find("round 1: done"), std::string::npos);
 }
 
 // Regression (issue 30): default thread counts came from std::thread::hardware_concurrency(), the
