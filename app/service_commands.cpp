@@ -86,7 +86,8 @@ void add_service_commands(CLI::App& app) {
                   "compute the std)");
   cmd->add_option("--uncertain-width", o->uncertain_width, "Interval width (in mu) above which a query is logged")
       ->capture_default_str()->check(FiniteRange(1e-9, 1e9));
-  cmd->add_option("--uncertain-max-rows", o->uncertain_max_rows, "Most logged queries per model")->capture_default_str()
+  cmd->add_option("--uncertain-max-rows", o->uncertain_max_rows, "Most logged queries in a model's file: a full DIR/<model>.csv is renamed <model>.csv.1 (replacing the one "
+                  "before) and a new one begun")->capture_default_str()
       ->check(CLI::Range(1LL, 1'000'000'000LL));
   cmd->footer("Plaintext unless --tls-cert/--tls-key; bind to loopback unless the network is trusted. SIGHUP rescans the models now, by\n"
               "content; a bad new file is refused, and a deleted file logged, while the loaded version keeps serving. grpc.health.v1 and\n"

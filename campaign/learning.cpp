@@ -1,6 +1,7 @@
 #include "campaign/learning.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -12,6 +13,8 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -57,6 +60,7 @@ void write_state(const std::string& dir, const LearnState& s) {
   const json j = {{"format", "mufric learn state 1"},
                   {"setup", s.setup},
                   {"log_offset", s.log_offset},
+                  {"log_file_id", s.log_file_id},
                   {"queries_seen", s.queries_seen},
                   {"spent_core_seconds", s.spent_core_seconds},
                   {"rounds", s.rounds},
@@ -88,28 +92,61 @@ class DirectoryLock {
 // ---- the server's log -----------------------------------------------------------------------
 
 // The rows the server appended since `offset` (whole lines only: a line being written is left for
-// the next round), as a CSV with the file's header; the new offset. A log shorter than the offset
-// was started afresh (renamed away by an operator): it is read from its start.
+// the next round), as a CSV with the file's header; the new offset and the file it is in. The server
+// renames a full log to NAME.csv.1 and begins a new one (server/uncertain_log.hpp): when the file read
+// last time (`file_id`, its inode; 0: not known) is now the renamed one, its rest is read first, then
+// the new file from its start. A log shorter than the offset in the same file was started afresh by
+// an operator: it is read from its start.
 struct NewLogRows {
   std::string csv;  // header + the new lines ("" when the log does not exist)
   long long rows = 0;
   long long end_offset = 0;
+  long long file_id = 0;
 };
-NewLogRows read_new_log_rows(const std::string& path, long long offset) {
+
+long long file_id_of(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<long long>(st.st_ino) : 0;
+}
+
+// The whole lines of `text` after `offset` (from the line after the header when offset is inside it or
+// past the end), and the offset after them.
+std::pair<std::string, long long> lines_after(const std::string& text, long long offset) {
+  const auto header_end = text.find('\n');
+  if (header_end == std::string::npos) return {"", offset};
+  const long long size = static_cast<long long>(text.size());
+  const long long start = offset > size || offset <= static_cast<long long>(header_end) ? static_cast<long long>(header_end) + 1 : offset;
+  const long long end = static_cast<long long>(text.rfind('\n')) + 1;
+  if (end <= start) return {"", start};
+  return {text.substr(static_cast<size_t>(start), static_cast<size_t>(end - start)), end};
+}
+
+NewLogRows read_new_log_rows(const std::string& path, long long offset, long long file_id) {
   NewLogRows out;
   out.end_offset = offset;
+  out.file_id = file_id;
+  std::string rows, header;
+  const long long current_id = file_id_of(path);
+  if (file_id != 0 && current_id != file_id) {  // renamed since the last look
+    const std::string rotated = path + ".1";
+    const auto old_text = file_id_of(rotated) == file_id ? read_whole_file(rotated) : std::nullopt;
+    if (old_text) {
+      rows = lines_after(*old_text, offset).first;
+      header = old_text->substr(0, old_text->find('\n') + 1);
+    }
+    offset = 0;  // the new file from its start
+  }
   const auto text = read_whole_file(path);
-  if (!text) return out;
-  const auto header_end = text->find('\n');
-  if (header_end == std::string::npos) return out;
-  const long long size = static_cast<long long>(text->size());
-  const long long start = offset > size || offset <= static_cast<long long>(header_end) ? static_cast<long long>(header_end) + 1 : offset;
-  const auto last_newline = text->rfind('\n');
-  const long long end = static_cast<long long>(last_newline) + 1;
-  out.end_offset = std::max(start, end);
-  if (end <= start) return out;
-  out.csv = text->substr(0, header_end + 1) + text->substr(static_cast<size_t>(start), static_cast<size_t>(end - start));
-  out.rows = static_cast<long long>(std::count(out.csv.begin(), out.csv.end(), '\n')) - 1;
+  if (text && text->find('\n') != std::string::npos) {
+    auto [more, end] = lines_after(*text, offset);
+    rows += more;
+    header = text->substr(0, text->find('\n') + 1);
+    out.end_offset = end;
+    out.file_id = current_id;
+  }
+  if (header.empty()) return out;
+  out.csv = header + rows;
+  out.rows = static_cast<long long>(std::count(rows.begin(), rows.end(), '\n'));
   return out;
 }
 
@@ -240,7 +277,7 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
     write_state(dir, s);
     return PlanOutcome::planned;
   }
-  const NewLogRows logged = read_new_log_rows(setup.log, s.log_offset);
+  const NewLogRows logged = read_new_log_rows(setup.log, s.log_offset, s.log_file_id);
   const long long queries = logged_query_count(setup.log);
   const long long new_queries = queries < 0 ? -1 : (s.queries_seen >= 0 && queries >= s.queries_seen ? queries - s.queries_seen : queries);
   round.logged_rows = logged.rows;
@@ -248,6 +285,7 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
   round.uncertain_share =
       new_queries > 0 ? std::min(1.0, static_cast<double>(logged.rows) / static_cast<double>(new_queries)) : -1.0;
   s.log_offset = logged.end_offset;
+  s.log_file_id = logged.file_id;
   s.queries_seen = queries;
   const bool quiet = logged.rows == 0 || (round.uncertain_share >= 0.0 && round.uncertain_share < setup.rest_below);
   if (quiet) {
@@ -487,6 +525,7 @@ LearnState read_learn_state(const std::string& directory) {
     LearnState s;
     j.at("setup").get_to(s.setup);
     j.at("log_offset").get_to(s.log_offset);
+    s.log_file_id = j.value("log_file_id", 0LL);  // absent in states written before the log was renamed when full
     j.at("queries_seen").get_to(s.queries_seen);
     j.at("spent_core_seconds").get_to(s.spent_core_seconds);
     j.at("rounds").get_to(s.rounds);

@@ -85,6 +85,7 @@ struct LearnRound {
 struct LearnState {
   LearnSetup setup;
   long long log_offset = 0;       // bytes of the log consumed (whole lines)
+  long long log_file_id = 0;      // the log file the offset is in (its inode; 0: not yet read)
   long long queries_seen = -1;    // the model's query count at the last look (NAME.outside.json; −1: none)
   double spent_core_seconds = 0.0;
   std::vector<LearnRound> rounds;

@@ -1,6 +1,8 @@
 #include "server/uncertain_log.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -31,6 +33,13 @@ void count_outside(double value, const InputSpec& box, OutsideInputCount& count,
     outside = true;
   }
 }
+// The data rows of a log file (its lines but the header; 0 when it does not exist).
+long long count_logged_rows(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return 0;
+  const auto lines = std::count(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>(), '\n');
+  return std::max<long long>(0, static_cast<long long>(lines) - 1);
+}
 }  // namespace
 
 UncertainQueryLog::UncertainQueryLog(std::string directory, double width_threshold, long long max_rows_per_model)
@@ -44,6 +53,7 @@ UncertainQueryLog::UncertainQueryLog(std::string directory, double width_thresho
 UncertainQueryLog::~UncertainQueryLog() { flush(); }
 
 std::string UncertainQueryLog::path(const std::string& model) const { return directory_ + "/" + model + ".csv"; }
+std::string UncertainQueryLog::rotated_path(const std::string& model) const { return path(model) + ".1"; }
 std::string UncertainQueryLog::outside_path(const std::string& model) const {
   return directory_ + "/" + model + ".outside.json";
 }
@@ -93,7 +103,7 @@ void UncertainQueryLog::record(const std::string& model, const InputSpace& input
     }
     log.outside.outside_queries += outside_inputs > 0;
     const double width = 2.0 * kZ95 * std(i);
-    if ((!(width > width_threshold_) && outside_inputs == 0) || log.rows + added >= max_rows_) continue;
+    if ((!(width > width_threshold_) && outside_inputs == 0) || added >= max_rows_) continue;
     char cell[40];
     for (Eigen::Index j = 0; j < x.cols(); ++j) {
       std::snprintf(cell, sizeof cell, "%s%.17g", j ? "," : "", x(i, j));
@@ -120,6 +130,25 @@ void UncertainQueryLog::append_rows(const std::string& model, ModelLog& log, con
                                     const std::string& rows_text, long long added) {
   std::string text = rows_text;
   const std::string file = path(model);
+  if (!log.rows_counted) {  // a file from an earlier server process counts toward its cap
+    log.rows = count_logged_rows(file);
+    log.rows_counted = true;
+  }
+  if (log.rows > 0 && log.rows + added > max_rows_) {
+    // Full: renamed to NAME.csv.1 (replacing the one before), so the log's disk use stays bounded
+    // while it keeps following the queries; a reader that remembers the file (the learner) finishes
+    // the renamed one before it starts on the new one.
+    std::error_code ec;
+    std::filesystem::rename(file, rotated_path(model), ec);
+    if (ec) {
+      std::fprintf(stderr, "mufric serve: cannot rename the full %s (%s); uncertain queries of %s are not logged\n",
+                   file.c_str(), ec.message().c_str(), model.c_str());
+      return;
+    }
+    std::fprintf(stderr, "mufric serve: %s reached %lld logged queries; renamed to %s, a new log begins\n", file.c_str(),
+                 log.rows, rotated_path(model).c_str());
+    log.rows = 0;
+  }
   const bool fresh = !std::filesystem::exists(file) || std::filesystem::file_size(file) == 0;
   if (fresh) {
     std::string header;
@@ -130,16 +159,11 @@ void UncertainQueryLog::append_rows(const std::string& model, ModelLog& log, con
   out.write(text.data(), static_cast<std::streamsize>(text.size()));  // one write per batch
   out.flush();
   if (!out) {
-    std::fprintf(stderr, "mufric serve: cannot append to %s; uncertain queries of %s are not logged\n", file.c_str(),
+    std::fprintf(stderr, "mufric serve: cannot append to %s; these uncertain queries of %s are not logged\n", file.c_str(),
                  model.c_str());
-    log.rows = max_rows_;
     return;
   }
   log.rows += added;
-  if (log.rows >= max_rows_) {
-    std::fprintf(stderr, "mufric serve: %s reached %lld logged queries; logging rows for %s stops (the outside counts go on)\n",
-                 file.c_str(), max_rows_, model.c_str());
-  }
 }
 
 // The summary as JSON: per input its box and, per side, the count and the farthest value (SI).

@@ -1,7 +1,8 @@
 #pragma once
 // Where the meso code goes and the surrogate is unsure: query points whose 95 % interval is wider
 // than a threshold, or that lie outside the model's box, appended per model to DIR/<model>.csv
-// (unit header, SI values), the file `mufric dataset refine --candidates [--grow-box]` reads; and
+// (unit header, SI values; renamed to <model>.csv.1 when full), the file `mufric dataset refine
+// --candidates [--grow-box]` and `mufric learn` read; and
 // per input and side, how many queries fell outside the box and how far, in DIR/<model>.outside.json.
 // Opt-in (`serve --log-uncertain DIR`): it makes every call compute the predictive std, which a GP
 // pays n²/2 multiply-adds per point for.
@@ -41,13 +42,14 @@ class UncertainQueryLog {
 
   // Appends the points (rows of x, SI, the model's input order) whose interval width
   // 2 · 1.96 · std exceeds the threshold or that lie outside `inputs`' box (angles are periodic and
-  // never outside); stops appending for a model after max_rows_per_model rows, while the outside
-  // counts go on.
+  // never outside). A model's file holds at most max_rows_per_model rows: the batch that would pass
+  // it first renames the full file to NAME.csv.1 (replacing the one before) and begins a new one.
   void record(const std::string& model, const InputSpace& inputs, const Eigen::Ref<const Eigen::MatrixXd>& x,
               const Eigen::Ref<const Eigen::VectorXd>& std);
-  long long rows(const std::string& model) const;
+  long long rows(const std::string& model) const;  // in the model's current file
   OutsideSummary outside(const std::string& model) const;
   std::string path(const std::string& model) const;
+  std::string rotated_path(const std::string& model) const;  // NAME.csv.1: the full log renamed
   std::string outside_path(const std::string& model) const;
   // Writes the summaries now (the destructor does; a summary is otherwise rewritten at most once a
   // second, so that a crash loses at most a second of counts and a busy server no file writes).
@@ -55,7 +57,8 @@ class UncertainQueryLog {
 
  private:
   struct ModelLog {
-    long long rows = 0;
+    long long rows = 0;          // in the model's current file
+    bool rows_counted = false;   // rows read from a file an earlier process left
     OutsideSummary outside;
     InputSpace box;
     bool summary_dirty = false;

@@ -222,6 +222,21 @@ TEST(Learning, ARoundGrowsTheBoxRunsPublishesAndRollsBack) {
   EXPECT_THROW(learn_rollback(f.dir, "0123456789abcdef"), Error);
 }
 
+// The server renames a full log to NAME.csv.1 and begins a new one (serve --uncertain-max-rows): the
+// learner reads the rest of the renamed file, then the new one from its start, and no row twice.
+TEST(Learning, ALogRenamedWhenFullIsFinishedBeforeTheNewOneIsRead) {
+  const LearnerFixture f;
+  learn_init(f.dir, f.setup());
+  ASSERT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).rounds_finished, 1);
+  EXPECT_EQ(read_learn_state(f.dir).rounds.back().logged_rows, 6);
+  f.log_queries(2, 150);  // two more rows in the file the learner was reading
+  fs::rename(f.log, f.log + ".1");
+  f.log_queries(3, 200);  // a new file, begun with its header
+  ASSERT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).rounds_finished, 1);
+  EXPECT_EQ(read_learn_state(f.dir).rounds.back().logged_rows, 5);
+  EXPECT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).stop, LearnStop::resting);  // all read
+}
+
 // A kill after a round's picks were written and before the state recorded them leaves plan rows no
 // sample answers: the next learner adopts them as its round and runs them. The budget, counted in
 // the runs' own core-seconds, bounds each round's batch and then stops the loop.

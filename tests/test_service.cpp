@@ -297,6 +297,36 @@ TEST_F(Service, OutOfBoxQueriesAreLoggedAndCountedPerInputAndSide) {
   EXPECT_EQ(json.at("inputs").at(1).at("lowest").get<double>(), lowest[1]);
 }
 
+// A full log is renamed NAME.csv.1 (replacing the one before) and a new one begun, so that logging
+// follows the queries with bounded disk use; a server started on a part-full file counts its rows.
+TEST(UncertainLog, AFullLogIsRenamedAndANewOneBegun) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "rotating-log";
+  fs::remove_all(dir);
+  const InputSpace box = default_friction_box();
+  const auto batch = [&box](double pressure) {  // six points below the box's pressures: all logged
+    Eigen::MatrixXd x(6, 3);
+    for (Eigen::Index i = 0; i < 6; ++i) x.row(i) << pressure + 1e6 * static_cast<double>(i), box[1].lo, box[2].lo;
+    return x;
+  };
+  const Eigen::VectorXd std = Eigen::VectorXd::Zero(6);
+  const auto pressures = [](const fs::path& file) { return read_csv_table(file.string()).si_column("contact_pressure"); };
+  {
+    server::UncertainQueryLog log(dir.string(), 1e6, 10);
+    log.record("gp", box, batch(10e6), std);
+    EXPECT_FALSE(fs::exists(dir / "gp.csv.1"));
+    log.record("gp", box, batch(20e6), std);  // 12 rows would pass 10: the first six are renamed away
+    EXPECT_EQ(pressures(dir / "gp.csv.1").front(), 10e6);
+    EXPECT_EQ(pressures(dir / "gp.csv").front(), 20e6);
+    EXPECT_EQ(log.rows("gp"), 6);
+  }
+  server::UncertainQueryLog restarted(dir.string(), 1e6, 10);
+  restarted.record("gp", box, batch(30e6), std);  // the file's six rows count: renamed again
+  EXPECT_EQ(pressures(dir / "gp.csv.1").front(), 20e6);
+  const auto current = pressures(dir / "gp.csv");
+  ASSERT_EQ(current.size(), 6u);
+  EXPECT_EQ(current.front(), 30e6);
+}
+
 // A model reloaded with a grown box: counts against the old box would mislead, so they restart
 // and the summary on disk is rewritten against the new box.
 TEST_F(Service, OutsideCountsRestartWhenTheModelsBoxChanges) {
