@@ -28,6 +28,8 @@ rake_face_mu_0deg.csv: one row per cutting speed, its conditions with their SDs)
 3. The speed trend: the calibrated mu at each speed's conditions, and along the speeds with one
    condition moving at a time (the others at the 5 m/min values), which says what lowers it.
 
+--write-measurements CSV writes the calibration's rows (all six speeds) and stops: the shipped model's
+script (campaigns/ti6al4v_tin/train.sh) calibrates on exactly what is validated here.
 Writes DIR/validation.md (tables), DIR/holdout.csv, DIR/oblique.csv, DIR/trend.csv and DIR/*.png.
   /usr/bin/python3 bench/ti6al4v_validation.py --gp ti_gp.h5 --out bench/out/ti6al4v \\
       --variant childs= --variant coulomb-like="--fix shear_factor=1" --variant shear-factor-like="--fix adhesive_coefficient=1"
@@ -114,7 +116,7 @@ def predict(mufric, model, points, workdir):
     with open(query, "w") as f:
         f.write("contact_pressure[MPa],sliding_velocity[m/min],temperature[C]\n")
         for p, v, T in points:
-            f.write(f"{p!r},{v!r},{T!r}\n")
+            f.write(f"{float(p)!r},{float(v)!r},{float(T)!r}\n")
     out = run([mufric, "predict", "--model", str(model), "--csv", str(query), "--extrapolation", "clamp"])
     rows = rows_of(out)
     return np.array([float(r["mu"]) for r in rows]), np.array([float(r["std"]) for r in rows])
@@ -267,8 +269,8 @@ def trend(args, m, model, workdir):
     rows = []
     for case, points in cases.items():
         mu, sd = predict(args.mufric, model, points, workdir)
-        for speed, (p, v, T), a, b in zip(m.speeds, points, mu, sd):
-            rows.append(dict(case=case, speed=speed, p=p, v=v, T=T, mu=float(a), std=float(b)))
+        rows += [dict(case=case, speed=speed, p=p, v=v, T=T, mu=float(a), std=float(b))
+                 for speed, (p, v, T), a, b in zip(m.speeds, points, mu, sd)]
     return rows
 
 
@@ -318,14 +320,22 @@ def main():
     ap.add_argument("--gp", help="the Ti6Al4V campaign's GP (mufric train); required unless --oblique-only")
     ap.add_argument("--mufric", default=str(ROOT / "build" / "app" / "mufric"))
     ap.add_argument("--data", default=str(DATA / "rake_face_mu_0deg.csv"))
-    ap.add_argument("--out", required=True, help="directory for the tables and plots")
+    ap.add_argument("--out", help="directory for the tables and plots (required unless --write-measurements)")
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=CALIBRATE-ARGS, a law variant (repeatable; default: childs=, both coefficients free)")
     ap.add_argument("--seed", type=int, default=2026)
     ap.add_argument("--edge", choices=("smoothed", "per-speed"), default="smoothed",
                     help="the oblique prediction's edge forces: the orthogonal cuts' smoothed in speed, or per speed")
     ap.add_argument("--oblique-only", metavar="MODEL", help="only the oblique prediction and the trend, from this calibrated model")
+    ap.add_argument("--write-measurements", metavar="CSV",
+                    help="only write the six speeds' rows as every calibration here reads them (campaigns/ti6al4v_tin/train.sh)")
     args = ap.parse_args()
+    if args.write_measurements:
+        m = Measurements(args.data)
+        m.write(args.write_measurements, list(range(len(m.speeds))))
+        return
+    if not args.out:
+        ap.error("--out is required")
     if not args.gp and not args.oblique_only:
         ap.error("--gp is required (or --oblique-only MODEL)")
     variants = [v.split("=", 1) for v in (args.variant or ["childs="])]

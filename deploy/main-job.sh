@@ -4,7 +4,9 @@
 #   2. the whole chain: a Sobol' plan over seed 000's box → the dry micro-model at every point (a
 #      coarse scene that fits a laptop: 32 × 6 elements, deploy/coarse_scene.sh) → a Gaussian-process surrogate →
 #      `mufric serve` on loopback → a meso-trace client (Python, gRPC) asking μ with its 95 % interval
-#      per contact Gauss point → a short table and a plot of μ over the box with its band.
+#      per contact Gauss point → a short table and a plot of μ over the box with its band;
+#   3. the shipped dry_default at a few states, drawn; 4. the shipped Ti6Al4V model against the
+#      measured cuts it was calibrated on: a table and a plot of μ and its band.
 # Files go to ${MUFRIC_OUT:-mufric-out}/. MUFRIC_SAMPLES sets the plan size (default 32).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -56,4 +58,26 @@ for state in "300MPa 22.5m/min 25C" "800MPa 100m/min 500C" "1300MPa 200m/min 900
   $mufric predict --model dry_default --p "$p" --v "$v" --T "$t" | sed -n -e '2s/ *status.*//p' -e '3s/:.*//p' | paste -sd ' ' 
 done
 /usr/bin/python3 bench/plot_model.py "$mufric" dry_default "$out/dry_default.png"
+
+echo; echo "== 4. The shipped Ti6Al4V model (ti6al4v_tin: calibrated on measured dry cuts by a TiN-coated carbide tool)"
+measured=data/cirp2022_ti6al4v_tin/rake_face_mu_0deg.csv
+/usr/bin/python3 - "$mufric" "$measured" "$out/ti6al4v_tin.csv" <<'PY'
+import csv, subprocess, sys
+mufric, measured, out = sys.argv[1:]
+with open(measured) as f:
+    rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+conditions = ("contact_pressure[MPa]", "sliding_velocity[m/min]", "temperature[C]")
+with open(out, "w") as f:  # each speed's rake-face state as mufric predict reads it
+    f.write(",".join(conditions) + "\n" + "".join(",".join(r[c] for c in conditions) + "\n" for r in rows))
+answer = subprocess.run([mufric, "predict", "--model", "ti6al4v_tin", "--csv", out], check=True,
+                        capture_output=True, text=True).stdout
+served = list(csv.DictReader(line for line in answer.splitlines() if not line.startswith("#")))
+print("cutting speed   rake-face mu measured (95 %)   ti6al4v_tin at its state (95 %)")
+for speed, m, c in zip((5, 7.5, 10, 20, 30, 40), rows, served):
+    print(f"{speed:5g} m/min      {float(m['mu']):.3f} +- {1.96 * float(m['mu_sd']):.3f}"
+          f"              {float(c['mu']):.3f} ({float(c['lo']):.3f} .. {float(c['hi']):.3f})")
+PY
+/usr/bin/python3 bench/plot_calibration.py --mufric "$mufric" --model ti6al4v_tin --data "$measured" \
+  --label "rake-face mu from measured forces" --x sliding_velocity --title "Ti6Al4V / TiN-coated carbide, dry" \
+  --out "$out/ti6al4v_tin.png"
 echo; echo "files: $(ls "$out" | tr '\n' ' ')in $out/"
