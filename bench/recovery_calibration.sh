@@ -10,13 +10,14 @@
 #   bash bench/recovery_calibration.sh                        # Childs' shear factor (issue 51): m* = 0.55
 #   bash bench/recovery_calibration.sh --campaign campaigns/ti6al4v_tin --truth adhesive_coefficient=0.45 \
 #        --truth shear_factor=0.7 --condition-sd temperature=60      # Ti6Al4V (issue 60)
-# Options: --mufric PATH, --out DIR, --campaign DIR (db.h5 and measure-db.h5), --truth NAME=VALUE.
+# Options: --mufric PATH, --out DIR, --campaign DIR (db.h5 and measure-db.h5), --truth NAME=VALUE,
+# --calibrate-args "ARGS" (added to each calibrate, e.g. "--max-steps 200000" for a ridge that mixes slowly).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 mufric=$here/build/app/mufric
 out=${TMPDIR:-/tmp}/mufric-recovery
 campaign_dir=$here/campaigns/recovery_childs
-truths=() condition_sds=()
+truths=() condition_sds=() calibrate_args=""
 while [[ $# -gt 0 ]]; do
   case $1 in
     --mufric) mufric=$2; shift 2 ;;
@@ -24,7 +25,8 @@ while [[ $# -gt 0 ]]; do
     --campaign) campaign_dir=$2; shift 2 ;;
     --truth) truths+=("$2"); shift 2 ;;
     --condition-sd) condition_sds+=("$2"); shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --calibrate-args) calibrate_args=$2; shift 2 ;;
+    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "recovery_calibration.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -78,7 +80,7 @@ echo "measurements: $(($(grep -vc '^#' "$out/measured.csv") - 1)) rows"
 for variant in "" "--discrepancy"; do
   echo "== calibrate ${variant:-(no discrepancy)}"
   # A refused posterior (exit 2: the chains fail the limits) is a result too: say so and go on.
-  if ! "$mufric" calibrate --model "$out/campaign-gp.h5" --data "$out/measured.csv" --seed 1 $variant \
+  if ! "$mufric" calibrate --model "$out/campaign-gp.h5" --data "$out/measured.csv" --seed 1 $variant $calibrate_args \
       --out "$out/posterior${variant}.csv" --model-out "$out/calibrated${variant}.h5" \
       > "$out/calibrate${variant}.txt" 2>&1; then
     grep -v "% of the steps" "$out/calibrate${variant}.txt"
