@@ -1304,7 +1304,8 @@ script=${!#}
 id=$((100 + n))
 (
   cd "$chdir"
-  while [[ -n $after && ! -e $FAKE_SLURM/$after.done ]]; do sleep 0.1; done
+  for ((tries = 0; tries < 1200; tries++)); do [[ -z $after || -e $FAKE_SLURM/$after.done ]] && break; sleep 0.1; done
+  [[ -z $after || -e $FAKE_SLURM/$after.done ]] || exit 1  # the array never ended (a failed test): no orphan
   sleep 1  # still running when the learner first asks
   if [[ -n $array ]]; then
     for ((i = ${array%-*}; i <= ${array#*-}; i++)); do
