@@ -128,7 +128,7 @@ NewLogRows read_new_log_rows(const std::string& path, long long offset, long lon
   std::string rows, header;
   const long long current_id = file_id_of(path);
   if (file_id != 0 && current_id != file_id) {  // renamed since the last look
-    const std::string rotated = path + ".1";
+    const std::string rotated = rotated_log_path(path);
     const auto old_text = file_id_of(rotated) == file_id ? read_whole_file(rotated) : std::nullopt;
     if (old_text) {
       rows = lines_after(*old_text, offset).first;

@@ -59,4 +59,6 @@ void copy_file_atomically(const std::string& from, const std::string& to) {
 
 std::string file_version(const std::string& path) { return sha256_file(path).substr(0, kFileVersionDigits); }
 
+std::string rotated_log_path(const std::string& log_path) { return log_path + ".1"; }
+
 }  // namespace mufric

@@ -19,4 +19,7 @@ void copy_file_atomically(const std::string& from, const std::string& to);
 // it: the first kFileVersionDigits hex digits of its SHA-256.
 inline constexpr std::size_t kFileVersionDigits = 16;
 std::string file_version(const std::string& path);
+// Where a full log is renamed when a new one begins at `log_path` (serve --log-uncertain writes it,
+// the learner reads it): one name for both.
+std::string rotated_log_path(const std::string& log_path);
 }  // namespace mufric

@@ -53,7 +53,7 @@ UncertainQueryLog::UncertainQueryLog(std::string directory, double width_thresho
 UncertainQueryLog::~UncertainQueryLog() { flush(); }
 
 std::string UncertainQueryLog::path(const std::string& model) const { return directory_ + "/" + model + ".csv"; }
-std::string UncertainQueryLog::rotated_path(const std::string& model) const { return path(model) + ".1"; }
+std::string UncertainQueryLog::rotated_path(const std::string& model) const { return rotated_log_path(path(model)); }
 std::string UncertainQueryLog::outside_path(const std::string& model) const {
   return directory_ + "/" + model + ".outside.json";
 }

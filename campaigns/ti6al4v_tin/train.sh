@@ -15,7 +15,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$here/../..
 mufric=${MUFRIC:-$root/build/app/mufric}
 out=${OUT:-$root/models/ti6al4v_tin.h5}
-law_arguments=(${LAW_ARGUMENTS:---discrepancy})  # the variant the held-out study chose
+law_arguments=(--discrepancy)  # the variant the held-out study chose
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$mufric" train --data "$here/db.h5" --out "$work/campaign-gp.h5" --no-fast-evaluator > "$work/train.log"
