@@ -191,7 +191,9 @@ std::string CalibratedModel::summary() const {
   s << "calibrated: the posterior predictive of a campaign's GP (" << emulator_->state().x_train.rows() << " samples over";
   for (const InputSpec& input : emulator_->inputs()) s << " " << input.name;
   s << ") given " << p.data().mu.size() << " measurements, " << samples().rows() << " posterior samples, discrepancy "
-    << (p.discrepancy() ? "on" : "off") << "\n";
+    << (p.discrepancy() ? "on" : "off");
+  if (p.priors().discrepancy_trend_sd > 0.0) s << " with a linear trend (coefficients' SD " << p.priors().discrepancy_trend_sd << ")";
+  s << "\n";
   s << "  measurements: " << record_.data_source << "\n";
   if (!record_.priors.empty()) s << "  priors: " << record_.priors << "\n";
   for (const auto& [name, value] : p.held()) s << "  held: " << name << " = " << format_human(value, kind_of_input(name)) << "\n";
@@ -289,6 +291,7 @@ void CalibratedModel::write(h5::Writer& out) const {
   out.strings(g + "/held_inputs", held_names);
   out.doubles(g + "/held_values", held_values);
   out.int_attribute(g, "discrepancy", p.discrepancy() ? 1 : 0);
+  out.double_attribute(g, "discrepancy_trend_sd", p.priors().discrepancy_trend_sd);
   // Each biased data set's name and its prior (kind, a, b): what the posterior's bias columns mean.
   std::vector<std::string> bias_sets;
   h5::RowMatrix bias_priors(static_cast<Eigen::Index>(p.priors().biases.size()), 3);
@@ -379,6 +382,8 @@ CalibratedModel CalibratedModel::read(const h5::Reader& in, InputSpace inputs) {
   }
   CalibrationPriors priors;
   priors.discrepancy = in.int_attribute(g, "discrepancy") != 0;
+  // Files before the trend have none.
+  if (in.has_attribute(g, "discrepancy_trend_sd")) priors.discrepancy_trend_sd = in.double_attribute(g, "discrepancy_trend_sd");
   if (in.has(g + "/bias_sets")) {
     const std::vector<std::string> sets = in.strings(g + "/bias_sets");
     const Eigen::MatrixXd bias_priors = in.matrix(g + "/bias_priors");

@@ -97,12 +97,18 @@ struct CalibrationPriors {
   // the box and does not fit each measurement on its own.
   Prior discrepancy_amplitude{PriorKind::half_normal, 0.05, 0.0};
   Prior discrepancy_length_scale{PriorKind::log_normal, 0.5, 0.7};
+  // δ's linear trend, marginalised: δ(x) = β₀ + βᵀ(u − ½) + GP with β₀, βⱼ ~ N(0, s²) independent
+  // (KOH 2001 §4.3's regression mean h(x)ᵀβ under a normal prior, which adds s²(1 + (u − ½)ᵀ(u' − ½))
+  // to δ's covariance; Rasmussen & Williams §2.7); u in widths of the emulator's box. s in μ units
+  // (an offset at the box centre, a change per box width); 0: no trend.
+  double discrepancy_trend_sd = 0.0;
   // Data sets (by name) that carry a bias b_k of their own, with its prior (μ units); the others none.
   std::vector<std::pair<std::string, Prior>> biases;
 };
 // A priors file (JSON), e.g.
 //   {"parameters": {"shear_factor": {"uniform": [0.2, 0.9]}, "adhesive_coefficient": {"normal": [0.4, 0.1]}},
-//    "discrepancy": {"enabled": true, "amplitude": {"half_normal": [0.05]}, "length_scale": {"log_normal": [0.5, 0.7]}},
+//    "discrepancy": {"enabled": true, "amplitude": {"half_normal": [0.05]}, "length_scale": {"log_normal": [0.5, 0.7]},
+//                    "trend_sd": 0.15},
 //    "data_sets": {"tribometer": {"bias": {"normal": [0, 0.1]}}}}
 // Errors name the source and the key.
 CalibrationPriors parse_calibration_priors(const std::string& json_text, const std::string& source);
@@ -175,9 +181,11 @@ class CalibrationProblem {
     Eigen::VectorXd residual;
   };
   Likelihood likelihood_at(const PosteriorPoint& point) const;
-  // σ_δ² exp(−½ |u − u'|²/ℓ_δ²) between two sets of unit-box conditions.
-  static Eigen::MatrixXd discrepancy_covariance(const Eigen::MatrixXd& ua, const Eigen::MatrixXd& ub,
-                                                double amplitude, double length_scale);
+  // σ_δ² exp(−½ |u − u'|²/ℓ_δ²) + s²(1 + (u − ½)ᵀ(u' − ½)) between two sets of unit-box conditions
+  // (s: the priors' discrepancy_trend_sd), and its diagonal at one set.
+  static Eigen::MatrixXd discrepancy_covariance(const Eigen::MatrixXd& ua, const Eigen::MatrixXd& ub, double amplitude,
+                                                double length_scale, double trend_sd);
+  static Eigen::VectorXd discrepancy_variance(const Eigen::MatrixXd& u, double amplitude, double trend_sd);
 
  private:
   std::shared_ptr<const GaussianProcess> emulator_;

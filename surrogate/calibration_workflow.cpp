@@ -217,6 +217,7 @@ CalibrationSetup prepare_calibration(std::shared_ptr<const GaussianProcess> emul
     priors = parse_calibration_priors(*text, request.priors_file);
   }
   if (request.discrepancy) priors.discrepancy = true;
+  if (request.discrepancy_trend_sd) priors.discrepancy_trend_sd = *request.discrepancy_trend_sd;
 
   CalibrationSetup setup;
   check_plausible(model, completed(data), setup.warnings);
@@ -251,6 +252,7 @@ CalibrationRecord calibration_record(const CalibrationSetup& setup, const Calibr
   if (p.discrepancy) {
     priors += "; discrepancy_amplitude " + p.discrepancy_amplitude.describe() + "; discrepancy_length_scale " +
               p.discrepancy_length_scale.describe();
+    if (p.discrepancy_trend_sd > 0.0) priors += "; discrepancy trend " + Prior{PriorKind::normal, 0.0, p.discrepancy_trend_sd}.describe() + " coefficients";
   }
   for (const auto& [set, prior] : p.biases) priors += "; bias[" + set + "] " + prior.describe();
   if (problem.latent_count() > 0) {

@@ -7,6 +7,7 @@
 // give, a value that cannot be friction, a prior mostly outside the box, a model with nothing to
 // calibrate.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@ struct CalibrationRequest {
   std::vector<std::string> calibrated;   // law coefficients to calibrate; empty: every one not fixed
   std::string priors_file;               // JSON (parse_calibration_priors); empty: the defaults
   bool discrepancy = false;              // δ on, whatever the priors file says
+  std::optional<double> discrepancy_trend_sd;  // δ's linear trend (CalibrationPriors), over the priors file's
 };
 
 struct CalibrationSetup {

@@ -195,25 +195,7 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
     if (count <= kRowByRowMaxQueries) {
       norms = norms_row_by_row(k_block, what.max_threads);
     } else {
-#if defined(__AVX2__)
-      // A build for a vector ISA (MUFRIC_NATIVE): Eigen's product, compiled for it, is the faster one
-      // (1.45× OpenBLAS's dtrmm on one AVX-512 core at n = 900; bench/RESULTS.md).
-      v_block.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * k_block;
-#else
-      // A portable build: OpenBLAS's dtrmm, whose kernels are chosen for the CPU at load time (2.6×
-      // Eigen's SSE2 product on an AVX-512 core). One BLAS thread: the team is the parallelism.
-      // L⁻¹ is stored row-major: read column-major it is its transpose, upper triangular. OpenBLAS
-      // rounds a column differently depending on how many columns it is given (its edge tiles), so
-      // every call gets a full block, zero-padded: a query's σ is then the same bits in any batch,
-      // as with Eigen's product (the service's transports agree to the bit; tested).
-      v_block.setZero(n, kQueryBlock);
-      v_block.leftCols(count) = k_block;
-      const char side = 'L', upper = 'U', transpose = 'T', non_unit = 'N';
-      const int rows = static_cast<int>(n), columns = static_cast<int>(kQueryBlock);
-      const double one = 1.0;
-      dtrmm_(&side, &upper, &transpose, &non_unit, &rows, &columns, &one, inverse_factor_.data(), &rows, v_block.data(),
-             &rows);
-#endif
+      whiten_block(k_block, v_block);
       norms.resize(2, count);
       norms.row(0) = v_block.leftCols(count).colwise().squaredNorm();
       if (state_.mean_estimated) {
@@ -231,6 +213,28 @@ void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Ei
       out.std(first + b) = state_.y_scale * std::sqrt(variance);
     }
   }
+}
+
+void GaussianProcess::whiten_block(const Eigen::Ref<const Eigen::MatrixXd>& k_block, Eigen::MatrixXd& v_block) const {
+#if defined(__AVX2__)
+  // A build for a vector ISA (MUFRIC_NATIVE): Eigen's product, compiled for it, is the faster one
+  // (1.45× OpenBLAS's dtrmm on one AVX-512 core at n = 900; bench/RESULTS.md).
+  v_block.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * k_block;
+#else
+  // A portable build: OpenBLAS's dtrmm, whose kernels are chosen for the CPU at load time (2.6×
+  // Eigen's SSE2 product on an AVX-512 core). One BLAS thread: the team is the parallelism.
+  // L⁻¹ is stored row-major: read column-major it is its transpose, upper triangular. OpenBLAS
+  // rounds a column differently depending on how many columns it is given (its edge tiles), so
+  // every call gets a full block, zero-padded: a query's σ is then the same bits in any batch,
+  // as with Eigen's product (the service's transports agree to the bit; tested).
+  const Eigen::Index n = k_block.rows();
+  v_block.setZero(n, kQueryBlock);
+  v_block.leftCols(k_block.cols()) = k_block;
+  const char side = 'L', upper = 'U', transpose = 'T', non_unit = 'N';
+  const int rows = static_cast<int>(n), columns = static_cast<int>(kQueryBlock);
+  const double one = 1.0;
+  dtrmm_(&side, &upper, &transpose, &non_unit, &rows, &columns, &one, inverse_factor_.data(), &rows, v_block.data(), &rows);
+#endif
 }
 
 Eigen::MatrixXd GaussianProcess::scaled_queries(const Eigen::MatrixXd& x) const {
@@ -266,7 +270,17 @@ GaussianProcess::LatentPoints GaussianProcess::latent_points(const Eigen::Matrix
   out.mean.resize(x.rows());
   Eigen::MatrixXd correlations;
   means_and_correlations(out.scaled, out.mean, &correlations);
-  out.whitened.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * correlations;
+  if (x.rows() <= kLatentSmallBatch) {
+    out.whitened.noalias() = inverse_factor_.triangularView<Eigen::Lower>() * correlations;
+    return out;
+  }
+  out.whitened.resize(correlations.rows(), x.rows());
+  Eigen::MatrixXd v_block;
+  for (Eigen::Index first = 0; first < x.rows(); first += kQueryBlock) {
+    const Eigen::Index count = std::min(kQueryBlock, x.rows() - first);
+    whiten_block(correlations.middleCols(first, count), v_block);
+    out.whitened.middleCols(first, count) = v_block.leftCols(count);
+  }
   return out;
 }
 

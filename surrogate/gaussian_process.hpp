@@ -170,8 +170,18 @@ class GaussianProcess final : public FrictionModel {
     Eigen::MatrixXd scaled;    // rows × d, in the training inputs' scaled space
     Eigen::VectorXd mean;      // the latent mean, μ units (latent_mean's bits)
     Eigen::MatrixXd whitened;  // L⁻¹ k̂, n × rows
+    // Rows [first, first + count) alone: the same bits as formed with the others.
+    LatentPoints rows(Eigen::Index first, Eigen::Index count) const {
+      return {scaled.middleRows(first, count), mean.segment(first, count), whitened.middleCols(first, count)};
+    }
   };
+  // Up to kLatentSmallBatch points are whitened by Eigen's product; more in blocks of kGpQueryBlock
+  // through the batch variance's product (OpenBLAS's dtrmm in a portable build, each block full and
+  // zero-padded). A caller that wants a point's bits independent of the batch keeps its row count
+  // on one side of the line (a calibration's likelihood: its measurements; its predictive: whole blocks).
   LatentPoints latent_points(const Eigen::MatrixXd& x) const;
+  // Below this a padded block costs more than the faster product saves (128/16 = 8 against 2.6×).
+  static constexpr Eigen::Index kLatentSmallBatch = 16;
   Eigen::MatrixXd latent_covariance(const LatentPoints& a, const LatentPoints& b) const;
   Eigen::VectorXd latent_variance(const LatentPoints& x) const;
 
@@ -194,6 +204,9 @@ class GaussianProcess final : public FrictionModel {
   void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
                       Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block, Evaluation& out, long long& clamped) const;
 
+  // v_block's first columns ← L⁻¹ k_block (k_block: n × at most kGpQueryBlock columns): Eigen's
+  // product in a build for a vector ISA, OpenBLAS's dtrmm on a full zero-padded block in a portable one.
+  void whiten_block(const Eigen::Ref<const Eigen::MatrixXd>& k_block, Eigen::MatrixXd& v_block) const;
   // ((x − lo)/width)/l per row: the space the training inputs are scaled to.
   Eigen::MatrixXd scaled_queries(const Eigen::MatrixXd& x) const;
   void require_query_columns(const Eigen::MatrixXd& x) const;

@@ -495,17 +495,24 @@ TEST(Calibration, AMeasurementOutsideTheBoxIsRefusedNamingItsRow) {
   EXPECT_NE(error_of([&] { CalibrationProblem(emulator, data, {"shear_factr"}, {}); }).find("shear_factr"), std::string::npos);
   data.condition_names = {"contact_pressure", "temperature"};
   EXPECT_NE(error_of([&] { CalibrationProblem(emulator, data, {"shear_factor"}, {}); }).find("temperature"), std::string::npos);
+  CalibrationPriors trend_alone;
+  trend_alone.discrepancy_trend_sd = 0.1;
+  EXPECT_NE(error_of([&] {
+              CalibrationProblem(emulator, synthetic_measurements(5, 0.4, 0.01, 41), {"shear_factor"}, trend_alone);
+            }).find("discrepancy off"),
+            std::string::npos);
 }
 
 TEST(CalibrationPriors, AFilesErrorsNameTheKey) {
   const CalibrationPriors priors = parse_calibration_priors(
       R"({"parameters": {"shear_factor": {"uniform": [0.3, 0.8]}},
-          "discrepancy": {"enabled": true, "amplitude": {"half_normal": [0.02]}}})",
+          "discrepancy": {"enabled": true, "amplitude": {"half_normal": [0.02]}, "trend_sd": 0.15}})",
       "p.json");
   ASSERT_EQ(priors.parameters.size(), 1u);
   EXPECT_EQ(priors.parameters[0].second.describe(), "uniform(0.3, 0.8)");
   EXPECT_TRUE(priors.discrepancy);
   EXPECT_EQ(priors.discrepancy_amplitude.a, 0.02);
+  EXPECT_EQ(priors.discrepancy_trend_sd, 0.15);
   const std::pair<std::string, std::string> cases[] = {
       {R"({"parameters": {"shear_factor": {"uniform": [0.8, 0.3]}}})", "p.json: parameters.shear_factor.uniform"},
       {R"({"parameters": {"m": {"gamma": [1, 2]}}})", "parameters.m.gamma: unknown prior"},
@@ -513,6 +520,7 @@ TEST(CalibrationPriors, AFilesErrorsNameTheKey) {
       {R"({"parameters": {"m": {"normal": [0.5, -1]}}})", "parameters.m.normal"},
       {R"({"discrepancy": {"enabled": "yes"}})", "discrepancy.enabled"},
       {R"({"discrepancy": {"scale": 1}})", "discrepancy.scale: unknown key"},
+      {R"({"discrepancy": {"trend_sd": -0.1}})", "discrepancy.trend_sd: a number >= 0"},
       {R"({"prior": {}})", "p.json: prior: unknown key"},
       {R"({"parameters": )", "p.json: not JSON"}};
   for (const auto& one : cases) {
@@ -531,25 +539,26 @@ TEST(CalibrationPriors, AFilesErrorsNameTheKey) {
 
 // --- the calibrated model ------------------------------------------------------------------------
 
-// A calibration with δ on and three posterior samples kept, so that the mixture can be computed
-// independently below.
+// A calibration with δ on (and, given a trend SD, δ's linear trend) and three posterior samples
+// kept, so that the mixture can be computed independently below.
 struct SmallCalibration {
   std::shared_ptr<const GaussianProcess> emulator = synthetic_emulator();
   Measurements data = synthetic_measurements(10, 0.6, 0.005, 17, smooth_discrepancy);
+  double trend_sd = 0.0;
   Eigen::MatrixXd samples;
-  SmallCalibration() {
-    CalibrationPriors priors;
-    priors.discrepancy = true;
-    priors.parameters.emplace_back("shear_factor", Prior{PriorKind::normal, 0.6, 0.05});
+  explicit SmallCalibration(double trend = 0.0) : trend_sd(trend) {
+    CalibrationPriors sampled = priors();
+    sampled.parameters.emplace_back("shear_factor", Prior{PriorKind::normal, 0.6, 0.05});
     EnsembleOptions options = quick_sampler(51);
     options.steps = 300;
-    const CalibrationResult result = calibrate(CalibrationProblem(emulator, data, {"shear_factor"}, priors), options);
+    const CalibrationResult result = calibrate(CalibrationProblem(emulator, data, {"shear_factor"}, sampled), options);
     samples.resize(3, result.samples.cols());
     samples << result.samples.row(0), result.samples.row(result.samples.rows() / 2), result.samples.row(result.samples.rows() - 1);
   }
-  static CalibrationPriors priors() {
+  CalibrationPriors priors() const {
     CalibrationPriors priors;
     priors.discrepancy = true;
+    priors.discrepancy_trend_sd = trend_sd;
     return priors;
   }
   CalibratedModel model() const {
@@ -574,8 +583,13 @@ void dense_component(const SmallCalibration& c, const Eigen::RowVectorXd& theta_
   auto unit = [&box](const Eigen::RowVectorXd& row) {
     return Eigen::RowVector2d((row(0) - box[0].lo) / (box[0].hi - box[0].lo), (row(1) - box[1].lo) / (box[1].hi - box[1].lo));
   };
+  // δ's covariance: the squared exponential, and a linear trend's s²(1 + (u − ½)ᵀ(u' − ½)) written out
+  // as the prior covariance of β₀ + β₁(u₁ − ½) + β₂(u₂ − ½) with each β ~ N(0, s²).
   auto delta = [&](const Eigen::RowVectorXd& a, const Eigen::RowVectorXd& b) {
-    return amplitude * amplitude * std::exp(-0.5 * (unit(a) - unit(b)).squaredNorm() / (length * length));
+    const Eigen::RowVector2d ua = unit(a), ub = unit(b);
+    const Eigen::Vector3d basis_a(1.0, ua(0) - 0.5, ua(1) - 0.5), basis_b(1.0, ub(0) - 0.5, ub(1) - 0.5);
+    return amplitude * amplitude * std::exp(-0.5 * (ua - ub).squaredNorm() / (length * length)) +
+           basis_a.dot((c.trend_sd * c.trend_sd * Eigen::Matrix3d::Identity()) * basis_b);
   };
   Eigen::MatrixXd covariance = dense_latent_covariance(gp, data_points, data_points);
   Eigen::RowVectorXd cross = dense_latent_covariance(gp, query, data_points);
@@ -589,7 +603,49 @@ void dense_component(const SmallCalibration& c, const Eigen::RowVectorXd& theta_
   const Eigen::VectorXd residual = c.data.mu - gp.evaluate(data_points, exact).mu;
   const Eigen::LDLT<Eigen::MatrixXd> solver(covariance);
   mean = gp.evaluate(query, exact).mu(0) + cross.dot(solver.solve(residual));
-  variance = dense_latent_covariance(gp, query, query)(0, 0) + amplitude * amplitude - cross.dot(solver.solve(cross.transpose()));
+  variance = dense_latent_covariance(gp, query, query)(0, 0) + delta(x, x) - cross.dot(solver.solve(cross.transpose()));
+}
+
+void expect_the_dense_mixture(const SmallCalibration& c, const CalibratedModel& model, const Eigen::MatrixXd& x) {
+  EvaluationRequest exact{.std = true};
+  exact.mu_tolerance = 0.0;
+  const Evaluation e = model.evaluate(x, exact);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    double mean_sum = 0.0, second_moment = 0.0;
+    for (Eigen::Index s = 0; s < 3; ++s) {
+      double mean = 0.0, variance = 0.0;
+      dense_component(c, c.samples.row(s), x.row(i), mean, variance);
+      mean_sum += mean;
+      second_moment += variance + mean * mean;
+    }
+    const double mean = mean_sum / 3.0, sd = std::sqrt(second_moment / 3.0 - mean * mean);
+    EXPECT_NEAR(e.mu(i), mean, 1e-9) << i;
+    EXPECT_NEAR(e.std(i), sd, 1e-7 * sd + 1e-9) << i;
+  }
+}
+
+// δ with a linear trend (--discrepancy-trend) against the dense predictive with the trend's basis
+// written out, through the model file too; far from the data the trend carries δ's mean on.
+TEST(CalibratedModel, ADiscrepancyTrendServesTheDensePredictiveWithTheRegressionBasis) {
+  const SmallCalibration c(0.2);
+  const CalibratedModel model = c.model();
+  Eigen::MatrixXd x(4, 2);
+  x << 400e6, 0.5, 800e6, 1.5, 1200e6, 3.0, 650e6, 2.2;
+  expect_the_dense_mixture(c, model, x);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("mufric-calibrated-trend-" + std::to_string(::getpid()) + ".h5")).string();
+  save_model(path, model);
+  const std::unique_ptr<FrictionModel> loaded = load_model(path);
+  std::filesystem::remove(path);
+  EvaluationRequest exact{.std = true};
+  exact.mu_tolerance = 0.0;
+  const Evaluation direct = model.evaluate(x, exact), from_file = loaded->evaluate(x, exact);
+  EXPECT_TRUE((direct.mu.array() == from_file.mu.array()).all());
+  EXPECT_TRUE((direct.std.array() == from_file.std.array()).all());
+  // Without the trend the same samples give other answers: the file kept it.
+  SmallCalibration without = c;
+  without.trend_sd = 0.0;
+  EXPECT_GT((without.model().evaluate(x, exact).std - direct.std).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 TEST(CalibratedModel, ServesTheMixtureOfTheKennedyOHaganPredictivesOverItsPosteriorSamples) {
