@@ -166,8 +166,9 @@ def main():
             for k, name in enumerate(c for c in samples[0] if c in LAW_COEFFICIENTS):
                 values = np.array([float(r[name]) for r in samples])
                 lo, hi = np.quantile(values, [0.025, 0.975])
-                right.hist(values, bins=60, density=True, histtype="step", lw=1.5,
-                           color=colours[(j + k) % len(colours)], label=f"{owner}: {name}, 95 % {lo:.3g}–{hi:.3g}")
+                # The model's colour (as on the left), one line style per coefficient.
+                right.hist(values, bins=60, density=True, histtype="step", lw=1.5, color=colours[j % len(colours)],
+                           ls=("-", ":", "-.", (0, (5, 1)))[k % 4], label=f"{owner}: {name}, 95 % {lo:.3g}–{hi:.3g}")
         for truth in args.truth:
             name, _, value = truth.partition("=")
             right.axvline(float(value), color="k", ls="--", label=f"{name}* = {value}")

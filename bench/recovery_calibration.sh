@@ -11,13 +11,14 @@
 #   bash bench/recovery_calibration.sh --campaign campaigns/ti6al4v_tin --truth adhesive_coefficient=0.45 \
 #        --truth shear_factor=0.7 --condition-sd temperature=60      # Ti6Al4V (issue 60)
 # Options: --mufric PATH, --out DIR, --campaign DIR (db.h5 and measure-db.h5), --truth NAME=VALUE,
-# --calibrate-args "ARGS" (added to each calibrate, e.g. "--max-steps 200000" for a ridge that mixes slowly).
+# --calibrate-args "ARGS" (added to each calibrate, e.g. "--max-steps 200000" for a ridge that mixes slowly),
+# --trend SD (a third calibration: δ with a linear trend, calibrate --discrepancy-trend SD).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 mufric=$here/build/app/mufric
 out=${TMPDIR:-/tmp}/mufric-recovery
 campaign_dir=$here/campaigns/recovery_childs
-truths=() condition_sds=() calibrate_args=""
+truths=() condition_sds=() calibrate_args="" trend_sd=""
 while [[ $# -gt 0 ]]; do
   case $1 in
     --mufric) mufric=$2; shift 2 ;;
@@ -26,7 +27,8 @@ while [[ $# -gt 0 ]]; do
     --truth) truths+=("$2"); shift 2 ;;
     --condition-sd) condition_sds+=("$2"); shift 2 ;;
     --calibrate-args) calibrate_args=$2; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --trend) trend_sd=$2; shift 2 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "recovery_calibration.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -77,30 +79,37 @@ with open(path, "w") as out:
 PY
 echo "measurements: $(($(grep -vc '^#' "$out/measured.csv") - 1)) rows"
 "$mufric" train --data "$campaign" --out "$out/campaign-gp.h5" | grep -E "stochastic kriging|length scale|leave-one-out" || true
-for variant in "" "--discrepancy"; do
+# Each variant's calibrate arguments, its files' tag and its label in the picture.
+variants=("" "--discrepancy") tags=("" "--discrepancy") labels=("δ off" "δ on")
+if [[ -n $trend_sd ]]; then
+  variants+=("--discrepancy --discrepancy-trend $trend_sd") tags+=("--discrepancy-trend") labels+=("δ with a trend")
+fi
+for k in "${!variants[@]}"; do
+  variant=${variants[$k]} tag=${tags[$k]}
   echo "== calibrate ${variant:-(no discrepancy)}"
   # A refused posterior (exit 2: the chains fail the limits) is a result too: say so and go on.
   if ! "$mufric" calibrate --model "$out/campaign-gp.h5" --data "$out/measured.csv" --seed 1 $variant $calibrate_args \
-      --out "$out/posterior${variant}.csv" --model-out "$out/calibrated${variant}.h5" \
-      > "$out/calibrate${variant}.txt" 2>&1; then
-    grep -v "% of the steps" "$out/calibrate${variant}.txt"
+      --out "$out/posterior${tag}.csv" --model-out "$out/calibrated${tag}.h5" \
+      > "$out/calibrate${tag}.txt" 2>&1; then
+    grep -v "% of the steps" "$out/calibrate${tag}.txt"
     echo "calibrate refused the posterior: no credible interval to judge the truth by"
     continue
   fi
-  grep -v "% of the steps" "$out/calibrate${variant}.txt"
+  grep -v "% of the steps" "$out/calibrate${tag}.txt"
   for truth in "${truths[@]}"; do
     awk -v name="${truth%%=*}" -v value="${truth#*=}" '$1 == name { lo = $4; hi = $6;
       printf "%s* = %s %s the 95 %% credible interval %s .. %s\n", name, value, (lo <= value && value <= hi) ? "inside" : "OUTSIDE", lo, hi }' \
-      "$out/calibrate${variant}.txt"
+      "$out/calibrate${tag}.txt"
   done
 done
 # The picture: the posteriors against the truth, and what each calibrated model serves at the measured conditions.
 models=() posteriors=() truth_flags=()
 for truth in "${truths[@]}"; do truth_flags+=(--truth "$truth"); done
-for variant in "" "--discrepancy"; do
-  if [[ -f $out/calibrated${variant}.h5 ]]; then
-    models+=(--model "$out/calibrated${variant}.h5" --model-label "calibrated, δ ${variant:+on}${variant:-off}")
-    posteriors+=(--posterior "$out/posterior${variant}.csv")
+for k in "${!variants[@]}"; do
+  tag=${tags[$k]}
+  if [[ -f $out/calibrated${tag}.h5 ]]; then
+    models+=(--model "$out/calibrated${tag}.h5" --model-label "calibrated, ${labels[$k]}")
+    posteriors+=(--posterior "$out/posterior${tag}.csv")
   fi
 done
 ((${#models[@]} > 0)) && /usr/bin/python3 "$here/bench/plot_calibration.py" --mufric "$mufric" "${models[@]}" "${posteriors[@]}" \
