@@ -214,7 +214,8 @@ void add_calibrate_command(CLI::App& app) {
                   "With --discrepancy: delta also carries a linear trend over the conditions, an offset and a slope per\n"
                   "input whose coefficients are normal(0, SD) in mu units per width of the model's box (KOH 2001 §4.3's\n"
                   "regression mean, integrated out). For a model that misses a trend the measurements show (the Ti6Al4V\n"
-                  "model ships with 0.15). Default: none")
+                  "model ships with 0.15): it sharpens the prediction and widens the coefficients' posterior (the trend\n"
+                  "can stand in for them); to read the coefficients themselves, calibrate without it. Default: none")
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--walkers", o->sampler.walkers,
                   "Ensemble walkers (Goodman & Weare 2010); default: 32, or four per posterior coordinate when more")

@@ -13,57 +13,13 @@ if [[ $(id -u) -ne 0 ]] || ! command -v slurmctld >/dev/null || ! command -v mun
   exit 77
 fi
 S=$(mktemp -d /tmp/mufric-slurm.XXXXXX)
-chmod 755 "$S"
-started_munge=""
+source "$repo/deploy/slurm/single-node-cluster.sh"
 cleanup() {
-  # The daemons were started with our config file: stop exactly those (SIGKILL if they linger).
-  pkill -TERM -f "$S/slurm.conf" 2>/dev/null || true
-  for _ in 1 2 3 4 5; do pgrep -f "$S/slurm.conf" >/dev/null || break; sleep 1; done
-  pkill -KILL -f "$S/slurm.conf" 2>/dev/null || true
-  [[ -n $started_munge && -s /run/munge/munged.pid ]] && kill "$(cat /run/munge/munged.pid)" 2>/dev/null || true
+  single_node_slurm_stop "$S"
   rm -rf "$S"
 }
 trap cleanup EXIT
-
-# munge: reuse a daemon that answers, else start one (--force: a dead daemon may have left its socket).
-if ! munge -n >/dev/null 2>&1; then
-  mkdir -p /run/munge && chown munge:munge /run/munge
-  su -s /bin/sh munge -c "munged --force"
-  started_munge=yes
-  munge -n >/dev/null || { echo "FAIL: munged does not answer"; exit 1; }
-fi
-
-host=$(hostname -s)
-export SLURM_CONF=$S/slurm.conf
-cat > "$SLURM_CONF" <<CONF
-ClusterName=mufrictest
-SlurmctldHost=$host
-SlurmUser=root
-SlurmdUser=root
-AuthType=auth/munge
-ProctrackType=proctrack/linuxproc
-TaskPlugin=task/none
-ReturnToService=2
-SlurmctldPidFile=$S/slurmctld.pid
-SlurmdPidFile=$S/slurmd.pid
-SlurmdSpoolDir=$S/slurmd
-StateSaveLocation=$S/state
-SchedulerType=sched/backfill
-SelectType=select/cons_tres
-SelectTypeParameters=CR_Core
-SlurmctldLogFile=$S/ctld.log
-SlurmdLogFile=$S/slurmd.log
-NodeName=$host CPUs=$(nproc) RealMemory=2000 State=UNKNOWN
-PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
-CONF
-mkdir -p "$S/slurmd" "$S/state"
-slurmctld -c -f "$SLURM_CONF"
-slurmd -c -f "$SLURM_CONF"
-for _ in $(seq 1 60); do
-  sinfo -h -o %T 2>/dev/null | grep -qE '^(idle|mixed)' && break
-  sleep 1
-done
-sinfo -h -o %T | grep -qE '^(idle|mixed)' || { echo "FAIL: the node did not come up"; cat "$S"/*.log; exit 1; }
+single_node_slurm_start "$S" || { echo "FAIL: the cluster did not start"; exit 1; }
 
 # A small plan of the real micro-model (a coarse, short scene: seconds per sample).
 tiny=(--set geometry.chip_surface.fit.control_points=16 --set geometry.tool_surface.fit.control_points=16
@@ -114,8 +70,6 @@ done
 "$mufric" learn run "$S/learn-slurm/learner" --simulator "$sim" --slurm-tasks 2 --slurm-poll 0.5 |
   grep -E "submitted|planned|published|kept aside"
 ls "$S"/learn-slurm/learner/round-1-runs/shard-{0,1}.h5 >/dev/null || { echo "FAIL: the round did not run as 2 shards"; exit 1; }
-differing=$(h5diff -r "$S/learn-local/served/gp.h5" "$S/learn-slurm/served/gp.h5" 2>&1 |
-  grep -E "^(attribute|dataset)|differences found" | grep -B1 -E "^[1-9][0-9]* differences" | grep -E "^(attribute|dataset)" |
-  grep -vE "<(created_utc|seconds|dataset_path|dataset_sha256) of" || true)
-[[ -z $differing ]] || { echo "FAIL: the Slurm round's model differs from the local one's: $differing"; exit 1; }
+differing=$(bash "$repo/tests/same_model_file.sh" "$S/learn-local/served/gp.h5" "$S/learn-slurm/served/gp.h5") ||
+  { echo "FAIL: the Slurm round's model differs from the local one's: $differing"; exit 1; }
 echo "PASS: a learner round through a 2-task Slurm array gives the local pool's model bit for bit"
