@@ -5,6 +5,7 @@
 #include <Eigen/UmfPackSupport>
 #include <omp.h>
 
+#include <mutex>
 #include <vector>
 
 #include "common/error.hpp"
@@ -34,6 +35,12 @@ class CholmodThreadsWithinOurs {
   int previous_levels_;
   bool limit_;
 };
+
+// METIS keeps its random state in a global (GKlib's generator) and reseeds it at the start of each
+// ordering: two draws ordering their patterns at once drew from one sequence in turns, so their
+// orderings, and μ's last digits with them, changed from run to run with draws side by side. One
+// ordering at a time; it runs once per pattern, against hundreds of factorisations.
+std::mutex ordering_mutex;
 
 using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using Cholesky = Eigen::CholmodSupernodalLLT<Sparse>;
@@ -142,6 +149,7 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double, Eigen::ColMajor, 
 bool LinearSolver::factorize_cholesky(const Sparse& a) const {
   const CholmodThreadsWithinOurs threads;
   if (!cholesky_analysed_) {
+    const std::lock_guard one_ordering_at_a_time(ordering_mutex);
     impl_->cholesky.analyzePattern(a);
     cholesky_analysed_ = true;
   }
