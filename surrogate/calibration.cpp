@@ -768,6 +768,7 @@ void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen
   const Eigen::MatrixXd unit_new = problem.discrepancy() ? problem.unit_conditions(conditions) : Eigen::MatrixXd();
   Eigen::MatrixXd means(q, used), variances(q, used), discrepancy_means(q, used), discrepancy_variances(q, used),
       emulator_variances(q, used);
+  const double trend_sd = problem.priors().discrepancy_trend_sd;
   auto predict_sample = [&](Eigen::Index s, const GaussianProcess::LatentPoints& at) {
     const Sample& sample = samples_[static_cast<size_t>(s)];
     const auto lower = sample.likelihood.factor.matrixL();
@@ -775,7 +776,6 @@ void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen
     // diag(A C⁻¹ Aᵀ) = |L⁻¹Aᵀ|² per column, with C = LLᵀ the likelihood's factor.
     const Eigen::MatrixXd emulator_cross = emulator.latent_covariance(at, sample.likelihood.measured);
     const Eigen::MatrixXd emulator_explained = lower.solve(emulator_cross.transpose());
-    const double trend_sd = problem.priors().discrepancy_trend_sd;
     const Eigen::VectorXd prior_emulator_variance = emulator.latent_variance(at);
     emulator_variances.col(s) = prior_emulator_variance - emulator_explained.colwise().squaredNorm().transpose();
     if (problem.discrepancy()) {
