@@ -29,7 +29,7 @@ struct CalibrateOptions {
   FastOptions fast;  // the calibrated model's grid
   EnsembleOptions sampler = [] {
     EnsembleOptions o;
-    o.max_steps = 40000;
+    o.max_steps = kDefaultCalibrationMaxSteps;
     return o;
   }();
   bool automatic_walkers = true;  // --walkers not given: at least four per coordinate

@@ -175,7 +175,11 @@ void print_status(const std::string& directory) {
     if (r.uncertain_share >= 0.0) std::snprintf(share, sizeof share, "%.3g %% of queries", 100.0 * r.uncertain_share);
     std::printf("  round %d: %s; %lld logged rows (%s), plan rows %lld-%lld, %.3g core-hours", r.number, r.step.c_str(),
                 r.logged_rows, share, r.first_plan_row, r.end_plan_row - 1, r.run_core_seconds / 3600.0);
-    if (r.step == "done") std::printf("; %s %s: %s", r.gate.publish ? "published" : "kept aside", r.version.c_str(), r.gate.reason.c_str());
+    if (r.step == "done") {
+      std::printf("; %s %s: %s", r.gate.publish ? "published" : "kept aside", r.version.empty() ? "(no candidate)" : r.version.c_str(),
+                  r.gate.reason.c_str());
+      if (r.quarantined > 0) std::printf("; its %lld samples quarantined (failed, with the reason)", r.quarantined);
+    }
     std::printf("\n");
   }
   std::printf("  versions kept (mufric learn rollback %s VERSION):\n", directory.c_str());
@@ -194,15 +198,19 @@ void add_learn_command(CLI::App& app) {
       "model is least certain (the rules of `dataset refine`), runs it, retrains, and publishes the new version into\n"
       "the served folder only if it passes the gate: no worse on the points the served version knew (leave-one-out),\n"
       "its new points inside their 95 % intervals, its fast evaluator certified as the served one was. Otherwise the\n"
-      "version is kept aside with the reason. Every step is recorded before the next: kill the learner at any moment\n"
-      "and `learn run` resumes it.");
+      "version is kept aside with the reason. A served calibrated model (mufric calibrate --model-out) is recalibrated\n"
+      "on its measurements with the retrained GP as its emulator, then gated on its emulator as above and on its\n"
+      "measurements (inside its 95 % predictive interval no less often than a 95 % interval may, or than the served\n"
+      "version). Every step is recorded before the next: kill the learner at any moment and `learn run` resumes it.");
 
   auto setup = std::make_shared<LearnSetup>();
   auto dir = std::make_shared<std::string>();
   auto* init = learn->add_subcommand("init", "Make a learner's directory for one served model and its campaign");
   init->add_option("directory", *dir, "The learner's directory (made; its state is DIR/learn.json)")->required();
   init->add_option("--db", setup->db, "The campaign database (dataset plan + run), extended in place")->required()->check(CLI::ExistingFile);
-  init->add_option("--model", setup->served_model, "The served model file (FOLDER/NAME.h5), replaced by published versions")
+  init->add_option("--model", setup->served_model,
+                   "The served model file (FOLDER/NAME.h5), replaced by published versions: the campaign's GP, or a model\n"
+                   "calibrated through it")
       ->required()->check(CLI::ExistingFile);
   init->add_option("--log", setup->log, "The server's log of that model (LOGDIR/NAME.csv of serve --log-uncertain LOGDIR)")->required();
   init->add_option("--round-samples", setup->round_samples, "Runs a round plans, at most")->capture_default_str()->check(CLI::Range(1LL, 100000LL));

@@ -33,10 +33,12 @@ namespace mufric {
 // where argument-dependent lookup finds them).
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnSetup, db, served_model, log, round_samples, budget_core_hours, rest_below,
                                    grow_coverage, seed, restarts)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(GateDecision, publish, reason, old_points, served_loo_rmse, candidate_loo_rmse,
-                                   allowed_loo_rmse, new_points, new_covered, grid_certified)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnRound, number, step, first_plan_row, end_plan_row, logged_rows, uncertain_share,
-                                   run_core_seconds, candidate, gate, version, finished_utc)
+// With defaults: a state written before the measurements' counts reads them as 0.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GateDecision, publish, reason, old_points, served_loo_rmse, candidate_loo_rmse,
+                                                allowed_loo_rmse, new_points, new_covered, grid_certified, measurements,
+                                                measurements_covered, values_refused)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(LearnRound, number, step, first_plan_row, end_plan_row, logged_rows, uncertain_share,
+                                                run_core_seconds, candidate, gate, quarantined, version, finished_utc)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnState::Served, version, utc, how)
 
 namespace {
@@ -166,9 +168,10 @@ long long logged_query_count(const std::string& log_path) {
 
 // ---- training as `train` does it ------------------------------------------------------------
 
-// The served model's policies (extrapolation, μ range) carry over; its grids are built to `fast`.
+// The served model's policies (extrapolation, μ range) carry over; its grids are built to `fast`
+// (none without: a calibrated model's emulator serves through the calibrated model's own grid).
 GaussianProcess train_candidate(const Dataset& db, const std::string& db_path, const FrictionModel& served,
-                                const LearnSetup& setup, const FastEvaluatorOptions& fast) {
+                                const LearnSetup& setup, const FastEvaluatorOptions* fast) {
   TrainingSet data = training_set(db, db_path);
   data.description = campaign_summary(db);
   GpTrainingOptions training;
@@ -177,19 +180,51 @@ GaussianProcess train_candidate(const Dataset& db, const std::string& db_path, c
   GaussianProcess gp = fit_campaign_gp(data, training);
   gp.set_default_extrapolation(served.default_extrapolation());
   gp.set_mu_range(served.mu_min(), served.mu_max());
-  attach_fast_evaluators(gp, fast, build_kept_fast_evaluator);
+  if (fast != nullptr) attach_fast_evaluators(gp, *fast, build_kept_fast_evaluator);
   return gp;
 }
 
-std::unique_ptr<GaussianProcess> load_gp(const std::string& path, const std::string& role) {
+const CalibratedModel* as_calibrated(const FrictionModel& model) { return dynamic_cast<const CalibratedModel*>(&model); }
+
+// What the learner serves: a campaign's GP, or a calibrated model whose emulator is one.
+std::unique_ptr<FrictionModel> load_served(const std::string& path, const std::string& role) {
   std::unique_ptr<FrictionModel> model = load_model_isolated(path);
-  auto* gp = dynamic_cast<GaussianProcess*>(model.get());
-  if (gp == nullptr) {
+  if (dynamic_cast<const GaussianProcess*>(model.get()) == nullptr && as_calibrated(*model) == nullptr) {
     throw Error(path + ": the " + role + " is a " + std::string(model->kind()) +
-                " model; the learner retrains a campaign's GP (a calibrated model is recalibrated by mufric calibrate)");
+                " model; the learner retrains a campaign's GP, or recalibrates a calibrated model with the retrained GP");
   }
-  model.release();
-  return std::unique_ptr<GaussianProcess>(gp);
+  return model;
+}
+
+// The campaign's GP a served model stands on: itself, or a calibrated model's emulator.
+const GaussianProcess& campaign_gp_of(const FrictionModel& model) {
+  if (const CalibratedModel* calibrated = as_calibrated(model)) return calibrated->emulator();
+  return dynamic_cast<const GaussianProcess&>(model);
+}
+
+// The logged rows, a calibrated model's served conditions, as rows of its emulator's inputs: each
+// at the coefficients of one posterior sample (the kept samples spread over the rows in order), held
+// inputs at their value. There the posterior predictive evaluates the emulator, so that is where
+// runs make the calibrated model sure.
+Eigen::MatrixXd at_posterior_samples(const CalibratedModel& model, const Eigen::MatrixXd& conditions) {
+  const CalibrationProblem& problem = model.problem();
+  const Eigen::MatrixXd& samples = model.samples();
+  const Eigen::Index n = conditions.rows(), kept = samples.rows();
+  Eigen::MatrixXd rows(n, static_cast<Eigen::Index>(model.emulator().inputs().size()));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::VectorXd theta = samples.row((i * kept) / n).head(problem.parameter_count()).transpose();
+    rows.row(i) = problem.emulator_points(conditions.row(i), theta).row(0);
+  }
+  return rows;
+}
+
+// A recalibrated model's grid, when the served one had one (a grid of the posterior predictive costs
+// minutes; a model served exact stays exact).
+void attach_calibrated_grid(CalibratedModel& model, const CalibratedModel& served, FastEvaluatorOptions options) {
+  if (served.fast_evaluator() == nullptr) return;
+  if (!(options.max_work > 0.0)) options.max_work = kLeastFastEvaluatorWork;
+  model.attach_fast_evaluator(
+      build_kept_fast_evaluator(GridSource{model, model.unit_length_scales(), model.exact_point_work()}, options, "calibrated model"));
 }
 
 void say(const LearnRunOptions& o, const std::string& line) {
@@ -303,7 +338,10 @@ PlanOutcome plan_round(const std::string& dir, LearnState& s, const LearnRunOpti
   }
   const std::string rows_path = (fs::path(dir) / ("round-" + std::to_string(round.number) + "-logged.csv")).string();
   write_file_atomically(rows_path, logged.csv);
-  const Eigen::MatrixXd rows = logged_candidates(rows_path, db.inputs);
+  const std::unique_ptr<FrictionModel> served = load_served(setup.served_model, "served model");
+  const CalibratedModel* calibrated = as_calibrated(*served);
+  const Eigen::MatrixXd rows = calibrated != nullptr ? at_posterior_samples(*calibrated, logged_candidates(rows_path, calibrated->inputs()))
+                                                     : logged_candidates(rows_path, db.inputs);
   const BoxGrowth growth = grow_plan_box(db, rows, setup.grow_coverage, rows_path, "mufric learn");
   if (growth.grown) say(o, "round " + std::to_string(round.number) + ": " + growth.record);
   const TrainingSet data = training_set(db, setup.db);
@@ -378,29 +416,87 @@ void run_round(const std::string& dir, LearnState& s, const LearnRunOptions& o) 
 // Step 4: the candidate trained and saved.
 void train_round(const std::string& dir, LearnState& s, const LearnRunOptions& o) {
   LearnRound& round = s.rounds.back();
-  const std::unique_ptr<GaussianProcess> served = load_gp(s.setup.served_model, "served model");
+  const std::unique_ptr<FrictionModel> served = load_served(s.setup.served_model, "served model");
+  const CalibratedModel* calibrated = as_calibrated(*served);
   const Dataset db = read_dataset_isolated(s.setup.db);
   say(o, format("round %d: training on %lld samples", round.number, static_cast<long long>(db.size())));
-  const GaussianProcess candidate = train_candidate(db, s.setup.db, *served, s.setup, o.fast);
+  GaussianProcess emulator = train_candidate(db, s.setup.db, campaign_gp_of(*served), s.setup, calibrated ? nullptr : &o.fast);
   round.candidate = (fs::path(dir) / "candidates" / ("round-" + std::to_string(round.number) + ".h5")).string();
-  save_model(round.candidate, candidate);
+  if (calibrated == nullptr) {
+    save_model(round.candidate, emulator);
+  } else {
+    say(o, format("round %d: recalibrating on the served model's %lld measurements", round.number,
+                  static_cast<long long>(calibrated->problem().data().rows())));
+    const Recalibration r = recalibrate(*calibrated, std::make_shared<const GaussianProcess>(std::move(emulator)), o.recalibration_max_steps);
+    if (!r.result.convergence_failure.empty()) {  // no candidate: kept aside at once, with the reason
+      round.candidate.clear();
+      round.gate = GateDecision{};
+      round.gate.reason = "the recalibration's chains are not usable: " + r.result.convergence_failure;
+      round.step = "done";
+      round.finished_utc = utc_timestamp();
+      write_state(dir, s);
+      say(o, format("round %d: kept aside: %s", round.number, round.gate.reason.c_str()));
+      return;
+    }
+    CalibratedModel model = calibrated_model(r.setup, r.result);
+    attach_calibrated_grid(model, *calibrated, o.fast);
+    save_model(round.candidate, model);
+  }
   round.version = file_version(round.candidate);
   round.step = "gate";
   write_state(dir, s);
 }
 
+// The samples of a round whose values the gate refused, marked failed with the reason (μ kept, for
+// whoever looks into it): later rounds train without them and do not run their plan rows again.
+// Idempotent (a resumed gate step finds them marked); returns how many are marked.
+long long quarantine_round(const std::string& db_path, const LearnRound& round) {
+  Dataset db = read_dataset_isolated(db_path);
+  const std::string reason = "quarantined by mufric learn: round " + std::to_string(round.number) +
+                             "'s gate refused its values (" + round.gate.reason.substr(0, round.gate.reason.find(':')) + ")";
+  long long marked = 0, newly = 0;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    const long long row = db.plan_index[static_cast<size_t>(i)];
+    if (row < round.first_plan_row || row >= round.end_plan_row) continue;
+    std::string& why = db.failure_reason[static_cast<size_t>(i)];
+    if (why == reason) {
+      ++marked;
+    } else if (!db.failed(i)) {
+      db.status[static_cast<size_t>(i)] = static_cast<long long>(SampleStatus::failed);
+      why = reason;
+      ++marked;
+      ++newly;
+    }
+  }
+  if (newly > 0) write_dataset(db_path, db);
+  return marked;
+}
+
 // Step 5: gated, and published or kept aside.
 void gate_round(const std::string& dir, LearnState& s, const LearnRunOptions& o) {
   LearnRound& round = s.rounds.back();
-  const std::unique_ptr<GaussianProcess> served = load_gp(s.setup.served_model, "served model");
-  const std::unique_ptr<GaussianProcess> candidate = load_gp(round.candidate, "candidate");
+  const std::unique_ptr<FrictionModel> served = load_served(s.setup.served_model, "served model");
+  const std::unique_ptr<FrictionModel> candidate = load_served(round.candidate, "candidate");
   say(o, format("round %d: gating %s against the served model", round.number, round.version.c_str()));
-  round.gate = gate_candidate(*served, *candidate, o.fast);
+  const CalibratedModel *served_calibrated = as_calibrated(*served), *candidate_calibrated = as_calibrated(*candidate);
+  if ((served_calibrated == nullptr) != (candidate_calibrated == nullptr)) {  // the served file was replaced meanwhile
+    round.gate = GateDecision{};
+    round.gate.reason = "the candidate is a " + std::string(candidate->kind()) + " model and the served one now a " +
+                        std::string(served->kind()) + " model";
+  } else if (served_calibrated != nullptr) {
+    round.gate = gate_calibrated_candidate(*served_calibrated, *candidate_calibrated, o.fast);
+  } else {
+    round.gate = gate_candidate(campaign_gp_of(*served), campaign_gp_of(*candidate), o.fast);
+  }
   if (round.gate.publish) {
     keep_version(dir, s, round.candidate, "published by round " + std::to_string(round.number));
     // One rename: the server's reload sees the old file or the new one (the temporary's name does
     // not end in .h5, so the registry never opens it).
     copy_file_atomically(round.candidate, s.setup.served_model);
+  } else if (round.gate.values_refused) {
+    round.quarantined = quarantine_round(s.setup.db, round);
+    say(o, format("round %d: its %lld samples quarantined in %s (marked failed with the reason; later rounds train without them)",
+                  round.number, round.quarantined, s.setup.db.c_str()));
   }
   round.step = "done";
   round.finished_utc = utc_timestamp();
@@ -484,14 +580,66 @@ GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess
     g.reason = "the round added no converged point; " + figures;
   } else if (g.candidate_loo_rmse > g.allowed_loo_rmse) {
     g.reason = "worse on what the served version knew: " + figures;
+    g.values_refused = true;
   } else if (binomial_lower_tail(g.new_covered, g.new_points, kCoverageLevel) < kGateCoverageSignificance) {
     g.reason = format("its interval misses its new points more often than a 95 %% interval may (binomial p < %g): ",
                       kGateCoverageSignificance) + figures;
+    g.values_refused = true;
   } else if (!g.grid_certified) {
     g.reason = "its fast evaluator does not meet the tolerances the served one met; " + figures;
   } else {
     g.publish = true;
     g.reason = "no worse: " + figures;
+  }
+  return g;
+}
+
+namespace {
+// Of a calibrated model's measurements, those inside its 95 % posterior predictive interval widened
+// by the measurement's own SD (the predictive is of the true μ; a measurement scatters about it).
+long long measurements_covered(const CalibratedModel& model) {
+  const Measurements& data = model.problem().data();
+  EvaluationRequest exact;
+  exact.std = true;
+  exact.mu_tolerance = 0.0;  // the exact predictive, not a grid of it
+  const Evaluation e = model.evaluate(data.conditions, exact);
+  long long covered = 0;
+  for (Eigen::Index i = 0; i < data.rows(); ++i) {
+    covered += std::abs(data.mu(i) - e.mu(i)) <= kZ95 * std::hypot(e.std(i), data.mu_sd(i));
+  }
+  return covered;
+}
+}  // namespace
+
+GateDecision gate_calibrated_candidate(const CalibratedModel& served, const CalibratedModel& candidate,
+                                       const FastEvaluatorOptions& tolerances) {
+  GateDecision g = gate_candidate(served.emulator(), candidate.emulator(), tolerances);  // emulators: no grid in the file
+  g.measurements = candidate.problem().data().rows();
+  g.measurements_covered = measurements_covered(candidate);
+  const long long served_covered = measurements_covered(served);
+  const FastEvaluator* served_grid = served.fast_evaluator();
+  const FastEvaluator* candidate_grid = candidate.fast_evaluator();
+  g.grid_certified = served_grid == nullptr || !served_grid->meets(tolerances.mu_tolerance, tolerances.std_relative_tolerance) ||
+                     (candidate_grid != nullptr && candidate_grid->meets(tolerances.mu_tolerance, tolerances.std_relative_tolerance));
+  const std::string measured = format("; recalibrated: %lld of %lld measurements inside the 95 %% predictive interval (served %lld)",
+                                      g.measurements_covered, g.measurements, served_covered);
+  if (!g.publish) {
+    g.reason += measured;
+    return g;
+  }
+  // A data set with a bias of its own may leave the served version's coverage short of 95 %: the
+  // candidate is refused only for a shortfall it adds.
+  if (g.measurements_covered < served_covered &&
+      binomial_lower_tail(g.measurements_covered, g.measurements, kCoverageLevel) < kGateCoverageSignificance) {
+    g.publish = false;
+    g.values_refused = true;
+    g.reason = format("its posterior predictive misses the measurements more often than a 95 %% interval may (binomial p < %g) "
+                      "and more often than the served version's: ", kGateCoverageSignificance) + g.reason.substr(g.reason.find(':') + 2) + measured;
+  } else if (!g.grid_certified) {
+    g.publish = false;
+    g.reason = "its fast evaluator does not meet the tolerances the served one met; " + g.reason.substr(g.reason.find(':') + 2) + measured;
+  } else {
+    g.reason += measured;
   }
   return g;
 }
@@ -504,7 +652,19 @@ void learn_init(const std::string& directory, const LearnSetup& setup) {
   const Dataset db = read_dataset_isolated(setup.db);
   if (db.plan.rows() == 0) throw Error(setup.db + ": not a campaign database (no plan rows); start with mufric dataset plan and run");
   if (fs::path(setup.served_model).extension() != ".h5") throw Error(setup.served_model + ": a served model's file name ends in .h5");
-  load_gp(setup.served_model, "served model");
+  const std::unique_ptr<FrictionModel> served = load_served(setup.served_model, "served model");
+  if (const CalibratedModel* calibrated = as_calibrated(*served)) {
+    if (!calibrated->record().priors_kept) {
+      throw Error(setup.served_model + ": a calibrated model written before calibrated files kept their priors cannot be "
+                  "recalibrated by the learner: calibrate it again with mufric calibrate");
+    }
+    const InputSpace& emulator_inputs = calibrated->emulator().inputs();
+    bool same_names = emulator_inputs.size() == db.inputs.size();
+    for (size_t j = 0; same_names && j < db.inputs.size(); ++j) same_names = emulator_inputs[j].name == db.inputs[j].name;
+    if (!same_names) {
+      throw Error(setup.served_model + ": the calibrated model's emulator is not a GP of " + setup.db + " (its inputs differ)");
+    }
+  }
   fs::create_directories(fs::path(directory) / "versions");
   fs::create_directories(fs::path(directory) / "candidates");
   LearnState s;

@@ -9,9 +9,14 @@
 //      `dataset refine` (campaign/refine.hpp), within the round's samples and the core-hour budget;
 //   3. runs them (the local work pool; the database is rewritten after every sample);
 //   4. retrains the campaign's GP, with the served model's extrapolation policy, μ range and grids;
+//      a served calibrated model (surrogate/calibrated_model.hpp) is recalibrated on its measurements
+//      with the retrained GP as its emulator (the picks of step 2 then sit at the queried conditions
+//      and at the coefficients' posterior samples);
 //   5. gates it (gate_candidate): the new version replaces the served file only if it is no worse on
 //      what the served version knew, covers its new draws and keeps its grid certified; else it is
-//      kept aside with the reason. Publishing is a rename in the served folder, which the server's
+//      kept aside with the reason; a round refused for its values (not for its grid) has its samples
+//      quarantined: marked failed in the database with the reason, μ kept, so that later rounds train
+//      without them. Publishing is a rename in the served folder, which the server's
 //      reload picks up; every published version is kept for rollback (learn_rollback).
 // Every step writes its files atomically and records itself in DIR/learn.json before the next, so
 // kill -9 at any moment loses no finished run and the next `learn` resumes at the step it stopped.
@@ -23,6 +28,8 @@
 
 #include "campaign/dataset_generation.hpp"
 #include "common/files.hpp"  // file_version, the versions a learner keeps
+#include "surrogate/calibrated_model.hpp"
+#include "surrogate/calibration_workflow.hpp"  // kDefaultCalibrationMaxSteps
 #include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gaussian_process.hpp"
 
@@ -54,6 +61,13 @@ struct GateDecision {
   long long new_points = 0;         // the candidate's points the served version had not
   long long new_covered = 0;        // of them inside their leave-one-out 95 % interval
   bool grid_certified = true;       // the candidate's grid meets the tolerances the served one met
+  // A calibrated model's: its measurements, and of them inside the candidate's 95 % posterior
+  // predictive interval widened by the measurement's own SD.
+  long long measurements = 0;
+  long long measurements_covered = 0;
+  // Kept aside for the round's values (worse on the served version's points, its new points or the
+  // measurements not covered), not for its grid or its database: the round's samples are quarantined.
+  bool values_refused = false;
 };
 
 // Leave-one-out is the held-out error of each version on the served version's own points (R&W eq.
@@ -65,6 +79,10 @@ inline constexpr double kGateRmseSlack = 2.0;
 inline constexpr double kGateCoverageSignificance = 0.01;
 GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess& candidate,
                             const FastEvaluatorOptions& tolerances);
+// A recalibrated model: its emulator gated as a GP is (its grid aside), its measurements covered at a
+// rate the same binomial test does not reject, and its own grid certified where the served one was.
+GateDecision gate_calibrated_candidate(const CalibratedModel& served, const CalibratedModel& candidate,
+                                       const FastEvaluatorOptions& tolerances);
 // P(X ≤ k) for X ~ Binomial(n, p), the gate's coverage test.
 double binomial_lower_tail(long long k, long long n, double p);
 
@@ -78,6 +96,7 @@ struct LearnRound {
   double run_core_seconds = 0.0;  // micro-model time it spent
   std::string candidate;          // the retrained model's file (DIR/candidates/round-K.h5)
   GateDecision gate;
+  long long quarantined = 0;      // its samples marked failed because the gate refused their values
   std::string version;            // the candidate's version (its SHA-256, 16 hex digits, as the server names it)
   std::string finished_utc;
 };
@@ -120,6 +139,7 @@ struct LearnRunOptions {
   // executable: the micro-model with the database's scene). Required.
   std::function<SampleEvaluator(const Dataset& db)> make_evaluator;
   FastEvaluatorOptions fast;  // the candidate's grids; max_work 0: the GP's default budget
+  int recalibration_max_steps = kDefaultCalibrationMaxSteps;  // a calibrated model's sampler, at most
   std::function<void(const std::string& line)> progress;  // one line per step and per sample; may be empty
 };
 

@@ -302,6 +302,19 @@ void CalibratedModel::write(h5::Writer& out) const {
   }
   out.strings(g + "/bias_sets", bias_sets);
   out.matrix(g + "/bias_priors", bias_priors);
+  // The coefficients' priors as sampled (kind, a, b; a default uniform written out over its box) and
+  // δ's hyper-parameters' priors: what `mufric learn` recalibrates with (absent in files before it).
+  h5::RowMatrix parameter_priors(p.parameter_count(), 3);
+  for (Eigen::Index k = 0; k < p.parameter_count(); ++k) {
+    const Prior& prior = p.prior_of(k);
+    parameter_priors.row(k) << static_cast<double>(prior.kind), prior.a, prior.b;
+  }
+  out.matrix(g + "/parameter_priors", parameter_priors);
+  h5::RowMatrix discrepancy_priors(2, 3);
+  for (const auto& [row, prior] : {std::pair{0, p.priors().discrepancy_amplitude}, std::pair{1, p.priors().discrepancy_length_scale}}) {
+    discrepancy_priors.row(row) << static_cast<double>(prior.kind), prior.a, prior.b;
+  }
+  out.matrix(g + "/discrepancy_priors", discrepancy_priors);
   out.matrix(g + "/samples", samples());
   out.string_attribute(g, "data_source", record_.data_source);
   out.string_attribute(g, "priors", record_.priors);
@@ -323,6 +336,23 @@ void CalibratedModel::write(h5::Writer& out) const {
   out.matrix(g + "/posterior/summary", table);
   if (fast_) write_fast_evaluator(out, *fast_, g + "/fast_evaluator");
 }
+
+namespace {
+// A prior stored as a row (kind, a, b) of `matrix`, checked; the reader's error names the dataset.
+Prior prior_in_row(const h5::Reader& in, const std::string& dataset, const Eigen::MatrixXd& matrix, Eigen::Index row) {
+  const double kind = matrix(row, 0);
+  if (!(kind >= 0.0 && kind <= static_cast<double>(PriorKind::half_normal) && kind == std::floor(kind))) {
+    in.fail(dataset, "an unknown prior kind");
+  }
+  Prior prior{static_cast<PriorKind>(static_cast<int>(kind)), matrix(row, 1), matrix(row, 2)};
+  try {
+    prior.check(dataset);
+  } catch (const Error& e) {
+    in.fail(dataset, e.what());
+  }
+  return prior;
+}
+}  // namespace
 
 CalibratedModel CalibratedModel::read(const h5::Reader& in, InputSpace inputs) {
   const std::string g = kCalibratedGroup;
@@ -391,21 +421,25 @@ CalibratedModel CalibratedModel::read(const h5::Reader& in, InputSpace inputs) {
       in.fail(g + "/bias_priors", "one row (kind, a, b) per biased data set");
     }
     for (size_t b = 0; b < sets.size(); ++b) {
-      const double kind = bias_priors(static_cast<Eigen::Index>(b), 0);
-      if (!(kind >= 0.0 && kind <= static_cast<double>(PriorKind::half_normal) && kind == std::floor(kind))) {
-        in.fail(g + "/bias_priors", "an unknown prior kind");
-      }
-      Prior prior{static_cast<PriorKind>(static_cast<int>(kind)), bias_priors(static_cast<Eigen::Index>(b), 1),
-                  bias_priors(static_cast<Eigen::Index>(b), 2)};
-      try {
-        prior.check(g + "/bias_priors");
-      } catch (const Error& e) {
-        in.fail(g + "/bias_priors", e.what());
-      }
-      priors.biases.emplace_back(sets[b], prior);
+      priors.biases.emplace_back(sets[b], prior_in_row(in, g + "/bias_priors", bias_priors, static_cast<Eigen::Index>(b)));
     }
   }
   const std::vector<std::string> parameters = attribute_names(in.string_attribute(g, "parameters"));
+  // The priors a recalibration needs (files before them served without: their posterior is fixed).
+  const bool priors_kept = in.has(g + "/parameter_priors");
+  if (priors_kept) {
+    const Eigen::MatrixXd parameter_priors = in.matrix(g + "/parameter_priors");
+    const Eigen::MatrixXd discrepancy_priors = in.matrix(g + "/discrepancy_priors");
+    if (parameter_priors.rows() != static_cast<Eigen::Index>(parameters.size()) || parameter_priors.cols() != 3) {
+      in.fail(g + "/parameter_priors", "one row (kind, a, b) per calibrated coefficient");
+    }
+    if (discrepancy_priors.rows() != 2 || discrepancy_priors.cols() != 3) in.fail(g + "/discrepancy_priors", "two rows (kind, a, b)");
+    for (size_t k = 0; k < parameters.size(); ++k) {
+      priors.parameters.emplace_back(parameters[k], prior_in_row(in, g + "/parameter_priors", parameter_priors, static_cast<Eigen::Index>(k)));
+    }
+    priors.discrepancy_amplitude = prior_in_row(in, g + "/discrepancy_priors", discrepancy_priors, 0);
+    priors.discrepancy_length_scale = prior_in_row(in, g + "/discrepancy_priors", discrepancy_priors, 1);
+  }
   const Eigen::MatrixXd samples = in.matrix(g + "/samples");
   auto problem = std::make_shared<const CalibrationProblem>(emulator, std::move(data), parameters, priors, held);
   if (samples.cols() != problem->dimension() || samples.rows() < 1 || !samples.allFinite()) {
@@ -419,6 +453,7 @@ CalibratedModel CalibratedModel::read(const h5::Reader& in, InputSpace inputs) {
   record.burn_in_steps = static_cast<int>(in.int_attribute(g, "burn_in_steps"));
   record.seed = static_cast<unsigned long long>(in.int_attribute(g, "seed"));
   record.acceptance = in.double_attribute(g, "acceptance");
+  record.priors_kept = priors_kept;
   const std::vector<std::string> names = in.strings(g + "/posterior/names");
   const Eigen::MatrixXd table = in.matrix(g + "/posterior/summary");
   if (table.rows() != static_cast<Eigen::Index>(names.size()) || table.cols() != static_cast<Eigen::Index>(kPosteriorColumns.size())) {

@@ -31,6 +31,9 @@ struct CalibrationRecord {
   int walkers = 0, steps = 0, burn_in_steps = 0;
   unsigned long long seed = 0;
   double acceptance = 0.0;
+  // The file keeps every prior the sampler used, so the calibration can be run again with another
+  // emulator (false: a file written before it kept them).
+  bool priors_kept = true;
 };
 
 

@@ -12,6 +12,7 @@
 #include <random>
 #include <string>
 
+#include <hdf5.h>
 #include <unistd.h>
 
 #include "common/error.hpp"
@@ -19,6 +20,7 @@
 #include "common/sanitizers.hpp"
 #include "surrogate/calibrated_model.hpp"
 #include "surrogate/calibration.hpp"
+#include "surrogate/calibration_workflow.hpp"
 #include "surrogate/ensemble_sampler.hpp"
 #include "surrogate/fast_evaluator_build.hpp"
 #include "surrogate/gp_training.hpp"
@@ -774,6 +776,39 @@ TEST(CalibratedModel, ItsFileAndFastEvaluatorGiveBackWhatItServes) {
                 .find("both measured and held"),
             std::string::npos);
   EXPECT_EQ(error_of([&] { CalibrationProblem(c.emulator, pressure_only, {"shear_factor"}, {}, {{"sliding_velocity", box[1].lo}}); }), "");
+}
+
+// The file keeps the priors the sampler used (a default uniform written out over the box), so that
+// `mufric learn` can run the calibration again with a retrained emulator; a file from before them
+// reads, serves, and says why it cannot be recalibrated.
+TEST(CalibratedModel, ItsFileKeepsThePriorsARecalibrationNeedsAndAnOlderFileSaysItHasNone) {
+  const SmallCalibration c;
+  const std::string path = (std::filesystem::temp_directory_path() / ("mufric-calibrated-priors-" + std::to_string(::getpid()) + ".h5")).string();
+  save_model(path, c.model());
+  const auto expect_prior = [](const Prior& p, PriorKind kind, double a, double b) {
+    EXPECT_EQ(p.kind, kind);
+    EXPECT_EQ(p.a, a);
+    EXPECT_EQ(p.b, b);
+  };
+  {
+    const std::unique_ptr<FrictionModel> loaded = load_model(path);
+    const auto& model = dynamic_cast<const CalibratedModel&>(*loaded);
+    EXPECT_TRUE(model.record().priors_kept);
+    expect_prior(model.problem().prior_of(0), PriorKind::uniform, 0.2, 0.9);  // synthetic_box()'s shear factor
+    const CalibrationPriors defaults;
+    expect_prior(model.problem().priors().discrepancy_amplitude, defaults.discrepancy_amplitude.kind, 0.05, 0.0);
+    expect_prior(model.problem().priors().discrepancy_length_scale, defaults.discrepancy_length_scale.kind, 0.5, 0.7);
+  }
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_GE(H5Ldelete(file, "/calibrated/parameter_priors", H5P_DEFAULT), 0);
+  EXPECT_GE(H5Ldelete(file, "/calibrated/discrepancy_priors", H5P_DEFAULT), 0);
+  H5Fclose(file);
+  const std::unique_ptr<FrictionModel> older = load_model(path);
+  std::filesystem::remove(path);
+  const auto& model = dynamic_cast<const CalibratedModel&>(*older);
+  EXPECT_FALSE(model.record().priors_kept);
+  EXPECT_NE(error_of([&] { recalibrate(model, c.emulator); }).find("predates kept priors"), std::string::npos);
 }
 
 // A server loads a first calibrated model in its own process (an OpenMP team of two starts there),

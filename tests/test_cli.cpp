@@ -433,6 +433,13 @@ TEST_F(Cli, TheShippedTi6Al4VModelIsTheCalibration) {
   r = run("describe ti6al4v_tin");  // the build's copy, by its bare name
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("fast evaluator: grid"), std::string::npos) << r.output;  // stored only when it meets them
+  // The file keeps the priors a recalibration needs: an on-line learner takes it with its campaign.
+  std::filesystem::create_directories(path("served"));
+  std::filesystem::copy_file(MUFRIC_SOURCE_DIR "/models/ti6al4v_tin.h5", path("served/ti.h5"));
+  std::filesystem::copy_file(MUFRIC_SOURCE_DIR "/campaigns/ti6al4v_tin/db.h5", path("db.h5"));
+  r = run("learn init " + path("learner") + " --db " + path("db.h5") + " --model " + path("served/ti.h5") + " --log " + path("ti.csv"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("serving version"), std::string::npos) << r.output;
 }
 
 TEST_F(Cli, NumberWithoutUnitNamesTheFlag) {

@@ -14,6 +14,8 @@
 #include "campaign/refine.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "surrogate/calibration.hpp"
+#include "surrogate/calibration_workflow.hpp"
 #include "surrogate/model_file.hpp"
 #include "surrogate/sampling.hpp"
 #include "temp_path.hpp"
@@ -267,6 +269,186 @@ TEST(Learning, AnUnfinishedRoundIsResumedAtItsStepAndTheBudgetStopsTheLoop) {
   EXPECT_EQ(s.rounds.back().end_plan_row - s.rounds.back().first_plan_row, 1);
   f.log_queries(6, 300);
   EXPECT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).stop, LearnStop::budget_spent);
+}
+
+// A round whose runs were damaged (a closed form 0.03 above the campaign's, as runs made with another
+// scene but recorded as the campaign's would be) near the points the previous round ran: the gate
+// refuses it for its values, the served file stays, and its samples are quarantined (failed, with the
+// reason, μ kept), so that the next healthy round is judged without them and published.
+TEST(Learning, ARoundRefusedForItsValuesIsQuarantinedAndTheNextRoundIsPublishedWithoutIt) {
+  const LearnerFixture f;
+  learn_init(f.dir, f.setup());
+  ASSERT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).rounds_finished, 1);
+  ASSERT_TRUE(read_learn_state(f.dir).rounds.at(0).gate.publish);
+  const std::string published = file_version(f.served());
+  f.log_queries(6, 200);
+  ASSERT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator(0.03))).rounds_finished, 1);
+  const LearnRound damaged = read_learn_state(f.dir).rounds.at(1);
+  EXPECT_FALSE(damaged.gate.publish);
+  EXPECT_TRUE(damaged.gate.values_refused) << damaged.gate.reason;
+  EXPECT_EQ(damaged.quarantined, damaged.end_plan_row - damaged.first_plan_row);
+  EXPECT_EQ(file_version(f.served()), published);
+  const Dataset db = read_dataset(f.db);
+  long long quarantined = 0;
+  for (Eigen::Index i = 0; i < db.size(); ++i) {
+    const long long row = db.plan_index[static_cast<size_t>(i)];
+    if (row < damaged.first_plan_row || row >= damaged.end_plan_row) continue;
+    EXPECT_TRUE(db.failed(i));
+    EXPECT_NE(db.failure_reason[static_cast<size_t>(i)].find("quarantined by mufric learn: round 2"), std::string::npos);
+    EXPECT_NEAR(db.mu(i), smooth_mu(db.x.row(i).transpose(), 0.03), 1e-12);  // the values kept for whoever looks
+    ++quarantined;
+  }
+  EXPECT_EQ(quarantined, damaged.quarantined);
+  f.log_queries(6, 300);
+  ASSERT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).rounds_finished, 1);
+  const LearnRound healthy = read_learn_state(f.dir).rounds.at(2);
+  EXPECT_TRUE(healthy.gate.publish) << healthy.gate.reason;
+  EXPECT_EQ(healthy.gate.old_points, 24);
+  EXPECT_EQ(healthy.gate.new_points, healthy.end_plan_row - healthy.first_plan_row);  // the quarantined ones are not among them
+  EXPECT_EQ(file_version(f.served()), healthy.version);
+}
+
+// --- a calibrated served model -----------------------------------------------------------------
+
+// A campaign over (p, v) and a law's shear factor m, run on a closed form; the model served is its GP
+// calibrated on eight measurements made at m = 0.35; the server logged queries below the box's
+// pressures, in the calibrated model's served conditions (p, v).
+double law_mu(const Eigen::VectorXd& x) {
+  const double ps = (x(0) - 300e6) / 1000e6, vs = (x(1) - 0.375) / 2.958;
+  return 0.1 + 0.5 * x(2) * (1.0 - 0.3 * ps) - 0.05 * vs + 0.04 * ps * vs;
+}
+SampleEvaluator law_evaluator() {
+  return [](const SampleRequest& r) {
+    SampleOutcome o;
+    o.converged = true;
+    o.mu = law_mu(r.x);
+    o.diagnostics["micro_wall_seconds"] = 10.0;
+    return o;
+  };
+}
+
+struct CalibratedLearnerFixture {
+  std::string dir = test::temp_path("cal-learner"), folder = test::temp_path("cal-served"), db = test::temp_path("cal-learn-db.h5");
+  std::string log = test::temp_path("cal-uncertain") + "/calibrated.csv";
+  Measurements data;
+  EnsembleOptions sampler;
+  explicit CalibratedLearnerFixture(int sampler_steps = 1200) {
+    for (const auto& d : {dir, folder, fs::path(log).parent_path().string()}) fs::remove_all(d);
+    fs::remove(db);
+    fs::create_directories(folder);
+    fs::create_directories(fs::path(log).parent_path());
+    Dataset plan;
+    plan.inputs = {default_friction_box()[0], default_friction_box()[1], {"shear_factor", "1", 0.2, 0.9}};
+    plan.plan = plan_in_box(PlanDesign::sobol, 24, plan.inputs, 5);
+    plan.plan_design = "sobol";
+    plan.scene_json = "{\"scene\": \"closed form with a law\"}";
+    plan.source = "calibrated learner test";
+    generate_dataset(plan, db, law_evaluator(), {});
+    GpTrainingOptions o;
+    o.restarts = 0;
+    auto emulator = std::make_shared<const GaussianProcess>(fit_campaign_gp(training_set(read_dataset(db), db), o));
+    data.condition_names = {"contact_pressure", "sliding_velocity"};
+    const Eigen::MatrixXd at = plan_in_box(PlanDesign::sobol, 8, {plan.inputs[0], plan.inputs[1]}, 13);
+    data.conditions = at;
+    data.mu.resize(at.rows());
+    data.mu_sd = Eigen::VectorXd::Constant(at.rows(), 0.01);
+    for (Eigen::Index i = 0; i < at.rows(); ++i) {
+      data.mu(i) = law_mu(Eigen::Vector3d(at(i, 0), at(i, 1), 0.35)) + 0.005 * std::sin(7.0 * static_cast<double>(i));
+      data.row_names.push_back("measured line " + std::to_string(i + 2));
+    }
+    sampler.walkers = 12;
+    sampler.burn_in_steps = 300;
+    sampler.steps = sampler_steps;
+    sampler.seed = 23;
+    CalibrationSetup setup;
+    setup.problem = std::make_shared<const CalibrationProblem>(emulator, data, std::vector<std::string>{"shear_factor"}, CalibrationPriors{});
+    setup.data_source = "measured.csv";
+    save_model(served(), calibrated_model(setup, calibrate(*setup.problem, sampler)));
+    std::ofstream out(log);
+    out << "contact_pressure[Pa],sliding_velocity[m/s],ci95_width,outside_inputs\n";
+    for (int i = 0; i < 6; ++i) out << 150e6 + 20e6 * i << "," << 1.0 + 0.1 * i << ",0.2,1\n";
+    out.close();
+    write_file_atomically(fs::path(log).replace_extension(".outside.json").string(), "{\"model\": \"calibrated\", \"queries\": 100}");
+  }
+  std::string served() const { return folder + "/calibrated.h5"; }
+  LearnSetup setup() const {
+    LearnSetup s;
+    s.db = db;
+    s.served_model = served();
+    s.log = log;
+    s.round_samples = 4;
+    s.restarts = 0;
+    return s;
+  }
+  LearnRunOptions run() const {
+    LearnRunOptions o;
+    o.make_evaluator = [](const Dataset&) { return law_evaluator(); };
+    return o;
+  }
+};
+
+// A round on a served calibrated model: the picks go to the queried pressures, at shear factors on the
+// posterior's side of the box (the variance they remove is averaged over the queries at posterior
+// samples of m, about 0.35; the box's middle is 0.55), the retrained GP becomes the emulator of a calibration run
+// again on the served model's measurements with its priors and sampler (the same posterior, to the
+// bit, as that calibration run directly on the retrained GP), and the gate publishes it, counting the
+// measurements its predictive covers.
+TEST(Learning, ACalibratedModelIsRecalibratedOnItsMeasurementsBeforeTheGate) {
+  const CalibratedLearnerFixture f;
+  learn_init(f.dir, f.setup());
+  ASSERT_EQ(learn_rounds(f.dir, f.run()).rounds_finished, 1);
+  const LearnRound r = read_learn_state(f.dir).rounds.at(0);
+  ASSERT_TRUE(r.gate.publish) << r.gate.reason;
+  EXPECT_EQ(r.gate.old_points, 24);
+  EXPECT_EQ(r.gate.new_points, 4);
+  EXPECT_EQ(r.gate.measurements, 8);
+  EXPECT_GE(r.gate.measurements_covered, 7) << r.gate.reason;
+  EXPECT_NE(r.gate.reason.find("recalibrated: "), std::string::npos) << r.gate.reason;
+  const Dataset db = read_dataset(f.db);
+  EXPECT_LT(db.inputs[0].lo, 300e6);  // the box grew toward the queried pressures
+  int at_queried_pressures = 0, below_box_middle_m = 0;
+  for (long long row = r.first_plan_row; row < r.end_plan_row; ++row) {
+    at_queried_pressures += db.plan(row, 0) < 300e6;
+    below_box_middle_m += db.plan(row, 2) < 0.55;
+  }
+  EXPECT_GE(at_queried_pressures, 3);
+  EXPECT_GE(below_box_middle_m, 3) << "the picks' shear factors follow the posterior (m = 0.35), not the box";
+
+  const std::unique_ptr<FrictionModel> loaded = load_model(f.served());
+  ASSERT_EQ(loaded->kind(), "calibrated");
+  EXPECT_EQ(file_version(f.served()), r.version);
+  const auto& published = dynamic_cast<const CalibratedModel&>(*loaded);
+  EXPECT_EQ(published.emulator().state().x_train.rows(), 28);
+  EXPECT_TRUE((published.problem().data().mu.array() == f.data.mu.array()).all());
+  EXPECT_EQ(published.record().seed, f.sampler.seed);
+  EXPECT_EQ(published.record().data_source, "measured.csv");
+  // The independent path: the published emulator calibrated directly with the fixture's own data,
+  // default priors and sampler.
+  auto emulator = std::make_shared<const GaussianProcess>(published.emulator());
+  EnsembleOptions sampler = f.sampler;
+  sampler.max_steps = kDefaultCalibrationMaxSteps;
+  const CalibrationResult direct = calibrate(CalibrationProblem(emulator, f.data, {"shear_factor"}, CalibrationPriors{}), sampler);
+  ASSERT_EQ(published.record().posterior.size(), direct.summary.size());
+  EXPECT_EQ(published.record().posterior[0].mean, direct.summary[0].mean);
+  EXPECT_EQ(published.record().posterior[0].sd, direct.summary[0].sd);
+  EXPECT_NEAR(direct.summary[0].mean, 0.35, 3.0 * direct.summary[0].sd + 0.01);
+}
+
+// Chains that cannot meet the limits (the served calibration's 40 steps, not continued) leave no
+// candidate: the round is kept aside with the sampler's reason, and the served file stays.
+TEST(Learning, ARecalibrationWhoseChainsAreNotUsableIsKeptAsideWithItsReason) {
+  const CalibratedLearnerFixture f(40);
+  learn_init(f.dir, f.setup());
+  const std::string before = file_version(f.served());
+  LearnRunOptions o = f.run();
+  o.recalibration_max_steps = 0;
+  ASSERT_EQ(learn_rounds(f.dir, o).rounds_finished, 1);
+  const LearnRound r = read_learn_state(f.dir).rounds.at(0);
+  EXPECT_EQ(r.step, "done");
+  EXPECT_FALSE(r.gate.publish);
+  EXPECT_NE(r.gate.reason.find("the recalibration's chains are not usable: "), std::string::npos) << r.gate.reason;
+  EXPECT_TRUE(r.candidate.empty());
+  EXPECT_EQ(file_version(f.served()), before);
 }
 
 }  // namespace
