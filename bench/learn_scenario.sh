@@ -9,15 +9,17 @@
 # BUDGET core-hours.
 #   bash bench/learn_scenario.sh [--mufric build/app/mufric] [--out /tmp/learn-scenario] [--rounds 6]
 #        [--round-samples 8] [--budget 0.5] [--jobs 1] [--start-samples 16] [--uncertain-width 0.05]
-#        [--slurm-tasks N]
+#        [--slurm-tasks N] [--damage-round K]
 # (--uncertain-width: the server's, and the trace's definition of an uncertain answer: a 95 % interval
 # wider than this; the learner rests once the log no longer sees such answers. --slurm-tasks: the
 # learner's rounds run as a Slurm array of N tasks on the cluster SLURM_CONF names, instead of the
-# local pool; bench/learn_scenario_slurm.sh brings one up and compares the two.)
+# local pool; bench/learn_scenario_slurm.sh brings one up and compares the two. --damage-round K, with
+# --slurm-tasks: round K's runs go through bench/faulty_site/submit-dataset.sh, whose workers run
+# another scene and record the campaign's; bench/learn_damaged_round.sh checks what the gate makes of it.)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 mufric=$here/build/app/mufric out=/tmp/learn-scenario rounds=6 round_samples=8 budget=0.5 jobs=1 start=16 width=0.05
-engine=()
+engine=() damage_round=0
 while (($#)); do
   case $1 in
     --mufric) mufric=$2; shift 2 ;;
@@ -29,10 +31,12 @@ while (($#)); do
     --start-samples) start=$2; shift 2 ;;
     --uncertain-width) width=$2; shift 2 ;;
     --slurm-tasks) engine=(--slurm-tasks "$2" --slurm-poll 1); shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    --damage-round) damage_round=$2; shift 2 ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) echo "unknown argument $1 (--help)"; exit 2 ;;
   esac
 done
+if ((damage_round > 0 && ${#engine[@]} == 0)); then echo "--damage-round needs --slurm-tasks (the faulty site is a Slurm site)"; exit 2; fi
 source "$here/deploy/coarse_scene.sh"
 py=/usr/bin/python3
 export PYTHONPATH=$here/build/python:$here/examples/python
@@ -58,7 +62,9 @@ trace() { "$py" "$here/bench/learn_trace.py" "$address" gp --uncertain-width "$w
 trace 0 --header > "$out/passes.csv"
 for r in $(seq 1 "$rounds"); do
   echo "== round $r ($((SECONDS - started)) s)"
-  "$mufric" learn run "$out/learner" --jobs "$jobs" "${engine[@]}" | grep -E "submitted|planned|published|kept aside|resting|budget" || true
+  site=()
+  ((r == damage_round)) && site=(--slurm-submit "$here/bench/faulty_site/submit-dataset.sh") && echo "   (round $r through the faulty site)"
+  "$mufric" learn run "$out/learner" --jobs "$jobs" "${engine[@]}" "${site[@]}" | grep -E "submitted|planned|published|kept aside|quarantined|resting|budget" || true
   sleep 2  # the server's poll (0.5 s) reloads a published version
   trace "$r" >> "$out/passes.csv"
 done

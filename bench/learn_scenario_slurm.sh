@@ -17,14 +17,9 @@ while (($#)); do
     *) pass+=("$1"); shift ;;
   esac
 done
-if [[ $(id -u) -ne 0 ]] || ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
-  echo "needs root, slurm-wlm and munge (deploy/install-deps.sh)"; exit 2
-fi
-rm -rf "$out" && mkdir -p "$out"
-cluster=$(mktemp -d /tmp/mufric-slurm.XXXXXX)
 source "$here/deploy/slurm/single-node-cluster.sh"
-trap 'single_node_slurm_stop "$cluster"; rm -rf "$cluster"' EXIT
-single_node_slurm_start "$cluster"
+single_node_slurm_until_exit
+rm -rf "$out" && mkdir -p "$out"
 
 started=$SECONDS
 echo "== the scenario through the local pool"

@@ -42,6 +42,9 @@ struct SampleOutcome {
   std::vector<std::string> warnings;
   std::map<std::string, double> diagnostics;  // SI, named as in /samples/diagnostics
   std::vector<double> draw_mu;                // each draw's μ, in draw order (empty: not known)
+  // Failed with its μ and standard error kept readable (a sample the learner quarantined: its values
+  // were refused, not missing); a merge keeps what its files hold. Otherwise a failed sample's are NaN.
+  bool keep_values_when_failed = false;
 };
 // Evaluates one request. May throw: the sample is then recorded as failed with the exception's message.
 using SampleEvaluator = std::function<SampleOutcome(const SampleRequest& request)>;

@@ -288,17 +288,21 @@ TEST(Learning, ARoundRefusedForItsValuesIsQuarantinedAndTheNextRoundIsPublishedW
   EXPECT_TRUE(damaged.gate.values_refused) << damaged.gate.reason;
   EXPECT_EQ(damaged.quarantined, damaged.end_plan_row - damaged.first_plan_row);
   EXPECT_EQ(file_version(f.served()), published);
-  const Dataset db = read_dataset(f.db);
-  long long quarantined = 0;
-  for (Eigen::Index i = 0; i < db.size(); ++i) {
-    const long long row = db.plan_index[static_cast<size_t>(i)];
-    if (row < damaged.first_plan_row || row >= damaged.end_plan_row) continue;
-    EXPECT_TRUE(db.failed(i));
-    EXPECT_NE(db.failure_reason[static_cast<size_t>(i)].find("quarantined by mufric learn: round 2"), std::string::npos);
-    EXPECT_NEAR(db.mu(i), smooth_mu(db.x.row(i).transpose(), 0.03), 1e-12);  // the values kept for whoever looks
-    ++quarantined;
-  }
-  EXPECT_EQ(quarantined, damaged.quarantined);
+  // The round's samples in the database: failed, with the reason, their damaged values readable for
+  // whoever looks into the fault; returns how many.
+  const auto expect_quarantined = [&damaged](const Dataset& db) {
+    long long quarantined = 0;
+    for (Eigen::Index i = 0; i < db.size(); ++i) {
+      const long long row = db.plan_index[static_cast<size_t>(i)];
+      if (row < damaged.first_plan_row || row >= damaged.end_plan_row) continue;
+      EXPECT_TRUE(db.failed(i));
+      EXPECT_NE(db.failure_reason[static_cast<size_t>(i)].find("quarantined by mufric learn: round 2"), std::string::npos);
+      EXPECT_NEAR(db.mu(i), smooth_mu(db.x.row(i).transpose(), 0.03), 1e-12);
+      ++quarantined;
+    }
+    return quarantined;
+  };
+  EXPECT_EQ(expect_quarantined(read_dataset(f.db)), damaged.quarantined);
   f.log_queries(6, 300);
   ASSERT_EQ(learn_rounds(f.dir, f.run(smooth_evaluator())).rounds_finished, 1);
   const LearnRound healthy = read_learn_state(f.dir).rounds.at(2);
@@ -306,6 +310,7 @@ TEST(Learning, ARoundRefusedForItsValuesIsQuarantinedAndTheNextRoundIsPublishedW
   EXPECT_EQ(healthy.gate.old_points, 24);
   EXPECT_EQ(healthy.gate.new_points, healthy.end_plan_row - healthy.first_plan_row);  // the quarantined ones are not among them
   EXPECT_EQ(file_version(f.served()), healthy.version);
+  EXPECT_EQ(expect_quarantined(read_dataset(f.db)), damaged.quarantined);  // through the next round's rewrite too
 }
 
 // --- a calibrated served model -----------------------------------------------------------------

@@ -5,6 +5,8 @@
 # (../shared/notes/single-node-slurm.md is the recipe). Source it, then
 #   single_node_slurm_start DIR   # exports SLURM_CONF=DIR/slurm.conf; returns 1 (with the logs) if the node does not come up
 #   single_node_slurm_stop DIR    # stops exactly the daemons started with DIR's config, and a munged it started
+#   single_node_slurm_until_exit  # for a benchmark script: refuses (exit 2) without root, slurm-wlm or
+#                                 # munge, starts one in a fresh directory and stops it when the script exits
 # Tasks get the node's CPUs (nproc) and 2000 MB in all.
 
 single_node_slurm_started_munge=""
@@ -63,4 +65,14 @@ single_node_slurm_stop() {
   if [[ -n $single_node_slurm_started_munge && -s /run/munge/munged.pid ]]; then
     kill "$(cat /run/munge/munged.pid)" 2>/dev/null || true
   fi
+}
+
+single_node_slurm_until_exit() {
+  if [[ $(id -u) -ne 0 ]] || ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
+    echo "needs root, slurm-wlm and munge (deploy/install-deps.sh)"
+    exit 2
+  fi
+  single_node_slurm_dir=$(mktemp -d /tmp/mufric-slurm.XXXXXX)
+  trap 'single_node_slurm_stop "$single_node_slurm_dir"; rm -rf "$single_node_slurm_dir"' EXIT
+  single_node_slurm_start "$single_node_slurm_dir"
 }
