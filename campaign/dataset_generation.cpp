@@ -126,11 +126,11 @@ void append_sample(Dataset& d, const Eigen::VectorXd& x, long long plan_row, con
   d.x.conservativeResize(n + 1, Eigen::NoChange);
   d.x.row(n) = x.transpose();
   d.mu.conservativeResize(n + 1);
-  const bool values = outcome.converged || outcome.keep_values_when_failed;
-  d.mu(n) = values ? outcome.mu : std::numeric_limits<double>::quiet_NaN();
+  const bool has_values = outcome.converged || outcome.keep_values_when_failed;
+  d.mu(n) = has_values ? outcome.mu : std::numeric_limits<double>::quiet_NaN();
   if (d.mu_std.size() != n) d.mu_std = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
   d.mu_std.conservativeResize(n + 1);
-  d.mu_std(n) = values ? outcome.mu_std : std::numeric_limits<double>::quiet_NaN();
+  d.mu_std(n) = has_values ? outcome.mu_std : std::numeric_limits<double>::quiet_NaN();
   // A completed run with warnings (a molten chip) is kept, with its μ, but outside the model: the
   // warnings are its reason, and training leaves it out.
   const bool outside = outcome.converged && !outcome.warnings.empty();

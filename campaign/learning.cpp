@@ -520,23 +520,47 @@ double binomial_lower_tail(long long k, long long n, double p) {
   return std::min(sum, 1.0);
 }
 
-GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess& candidate, const FastEvaluatorOptions& tolerances) {
-  GateDecision g;
+namespace {
+
+// A gate's decision and its verdict's first words; the figures it rests on (gate_figures) follow
+// unless the verdict came before any (another input space, another database).
+struct Judged {
+  GateDecision decision;
+  std::string verdict;
+  bool figures_follow = false;
+};
+
+std::string gate_figures(const GateDecision& g) {
+  std::string figures = format("leave-one-out RMSE on the served version's %lld points %.3g (served %.3g, at most %.3g); "
+                               "%lld of %lld new points inside their 95 %% interval",
+                               g.old_points, g.candidate_loo_rmse, g.served_loo_rmse, g.allowed_loo_rmse, g.new_covered, g.new_points);
+  if (g.measurements > 0) {
+    figures += format("; recalibrated: %lld of %lld measurements inside the 95 %% predictive interval", g.measurements_covered,
+                      g.measurements);
+  }
+  return figures;
+}
+
+// gate_candidate's checks.
+Judged judge_candidate(const GaussianProcess& served, const GaussianProcess& candidate, const FastEvaluatorOptions& tolerances) {
+  Judged judged;
+  GateDecision& g = judged.decision;
+  std::string& why = judged.verdict;
   if (!same_input_space(served.inputs(), candidate.inputs())) {
     // The box grew: the inputs must still be the same names in the same order.
     bool same_names = served.inputs().size() == candidate.inputs().size();
     for (size_t j = 0; same_names && j < served.inputs().size(); ++j) same_names = served.inputs()[j].name == candidate.inputs()[j].name;
     if (!same_names) {
-      g.reason = "the candidate's inputs are not the served model's";
-      return g;
+      why = "the candidate's inputs are not the served model's";
+      return judged;
     }
   }
   const auto& old_state = served.state();
   const auto& new_state = candidate.state();
   const LeaveOneOut old_loo = leave_one_out_points(old_state), new_loo = leave_one_out_points(new_state);
   if (old_loo.error.size() == 0 || new_loo.error.size() == 0) {
-    g.reason = "leave-one-out could not be computed (a factor could not be inverted)";
-    return g;
+    why = "leave-one-out could not be computed (a factor could not be inverted)";
+    return judged;
   }
   // The candidate's rows at the served version's points (the same samples: same SI coordinates).
   std::map<std::vector<double>, Eigen::Index> candidate_row;
@@ -556,9 +580,9 @@ GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess
     new_sq += new_loo.error(it->second) * new_loo.error(it->second);
   }
   if (g.old_points < old_state.x_train.rows()) {
-    g.reason = format("the candidate was not trained on all the served version's points (%lld of %lld found): another database",
-                      g.old_points, static_cast<long long>(old_state.x_train.rows()));
-    return g;
+    why = format("the candidate was not trained on all the served version's points (%lld of %lld found): another database",
+                 g.old_points, static_cast<long long>(old_state.x_train.rows()));
+    return judged;
   }
   const double n = static_cast<double>(g.old_points);
   g.served_loo_rmse = std::sqrt(old_sq / n);
@@ -573,28 +597,24 @@ GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess
   const FastEvaluator* candidate_grid = candidate.fast_evaluator();
   const bool served_certified = served_grid != nullptr && served_grid->meets(tolerances.mu_tolerance, tolerances.std_relative_tolerance);
   g.grid_certified = !served_certified || (candidate_grid != nullptr && candidate_grid->meets(tolerances.mu_tolerance, tolerances.std_relative_tolerance));
-  const std::string figures = format("leave-one-out RMSE on the served version's %lld points %.3g (served %.3g, at most %.3g); "
-                                     "%lld of %lld new points inside their 95 %% interval",
-                                     g.old_points, g.candidate_loo_rmse, g.served_loo_rmse, g.allowed_loo_rmse, g.new_covered, g.new_points);
+  judged.figures_follow = true;
   if (g.new_points == 0) {
-    g.reason = "the round added no converged point; " + figures;
+    why = "the round added no converged point; ";
   } else if (g.candidate_loo_rmse > g.allowed_loo_rmse) {
-    g.reason = "worse on what the served version knew: " + figures;
+    why = "worse on what the served version knew: ";
     g.values_refused = true;
   } else if (binomial_lower_tail(g.new_covered, g.new_points, kCoverageLevel) < kGateCoverageSignificance) {
-    g.reason = format("its interval misses its new points more often than a 95 %% interval may (binomial p < %g): ",
-                      kGateCoverageSignificance) + figures;
+    why = format("its interval misses its new points more often than a 95 %% interval may (binomial p < %g): ", kGateCoverageSignificance);
     g.values_refused = true;
   } else if (!g.grid_certified) {
-    g.reason = "its fast evaluator does not meet the tolerances the served one met; " + figures;
+    why = "its fast evaluator does not meet the tolerances the served one met; ";
   } else {
     g.publish = true;
-    g.reason = "no worse: " + figures;
+    why = "no worse: ";
   }
-  return g;
+  return judged;
 }
 
-namespace {
 // Of a calibrated model's measurements, those inside its 95 % posterior predictive interval widened
 // by the measurement's own SD (the predictive is of the true μ; a measurement scatters about it).
 long long measurements_covered(const CalibratedModel& model) {
@@ -609,11 +629,19 @@ long long measurements_covered(const CalibratedModel& model) {
   }
   return covered;
 }
+
 }  // namespace
+
+GateDecision gate_candidate(const GaussianProcess& served, const GaussianProcess& candidate, const FastEvaluatorOptions& tolerances) {
+  Judged judged = judge_candidate(served, candidate, tolerances);
+  judged.decision.reason = judged.verdict + (judged.figures_follow ? gate_figures(judged.decision) : "");
+  return judged.decision;
+}
 
 GateDecision gate_calibrated_candidate(const CalibratedModel& served, const CalibratedModel& candidate,
                                        const FastEvaluatorOptions& tolerances) {
-  GateDecision g = gate_candidate(served.emulator(), candidate.emulator(), tolerances);  // emulators: no grid in the file
+  Judged judged = judge_candidate(served.emulator(), candidate.emulator(), tolerances);  // emulators: no grid in the file
+  GateDecision& g = judged.decision;
   g.measurements = candidate.problem().data().rows();
   g.measurements_covered = measurements_covered(candidate);
   const long long served_covered = measurements_covered(served);
@@ -621,26 +649,19 @@ GateDecision gate_calibrated_candidate(const CalibratedModel& served, const Cali
   const FastEvaluator* candidate_grid = candidate.fast_evaluator();
   g.grid_certified = served_grid == nullptr || !served_grid->meets(tolerances.mu_tolerance, tolerances.std_relative_tolerance) ||
                      (candidate_grid != nullptr && candidate_grid->meets(tolerances.mu_tolerance, tolerances.std_relative_tolerance));
-  const std::string measured = format("; recalibrated: %lld of %lld measurements inside the 95 %% predictive interval (served %lld)",
-                                      g.measurements_covered, g.measurements, served_covered);
-  if (!g.publish) {
-    g.reason += measured;
-    return g;
-  }
   // A data set with a bias of its own may leave the served version's coverage short of 95 %: the
   // candidate is refused only for a shortfall it adds.
-  if (g.measurements_covered < served_covered &&
+  if (g.publish && g.measurements_covered < served_covered &&
       binomial_lower_tail(g.measurements_covered, g.measurements, kCoverageLevel) < kGateCoverageSignificance) {
     g.publish = false;
     g.values_refused = true;
-    g.reason = format("its posterior predictive misses the measurements more often than a 95 %% interval may (binomial p < %g) "
-                      "and more often than the served version's: ", kGateCoverageSignificance) + g.reason.substr(g.reason.find(':') + 2) + measured;
-  } else if (!g.grid_certified) {
+    judged.verdict = format("its posterior predictive misses the measurements more often than a 95 %% interval may (binomial p < %g) "
+                            "and more often than the served version's: ", kGateCoverageSignificance);
+  } else if (g.publish && !g.grid_certified) {
     g.publish = false;
-    g.reason = "its fast evaluator does not meet the tolerances the served one met; " + g.reason.substr(g.reason.find(':') + 2) + measured;
-  } else {
-    g.reason += measured;
+    judged.verdict = "its fast evaluator does not meet the tolerances the served one met; ";
   }
+  g.reason = judged.verdict + (judged.figures_follow ? gate_figures(g) + format(" (served %lld)", served_covered) : "");
   return g;
 }
 
