@@ -169,7 +169,6 @@ double GaussianProcess::mean_from_correlations(const double* correlation) const 
 void GaussianProcess::evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count,
                                      const EvaluationRequest& what, Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block,
                                      Evaluation& out, long long& clamped) const {
-  const Eigen::Index n = scaled_train_.rows();
   const Eigen::Index d = scaled_train_.cols();
   const Eigen::MatrixXd q = scaled_queries(x.middleRows(first, count));
   const bool need_std = what.std || what.ci_level > 0.0;
