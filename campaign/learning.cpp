@@ -546,14 +546,10 @@ Judged judge_candidate(const GaussianProcess& served, const GaussianProcess& can
   Judged judged;
   GateDecision& g = judged.decision;
   std::string& why = judged.verdict;
-  if (!same_input_space(served.inputs(), candidate.inputs())) {
-    // The box grew: the inputs must still be the same names in the same order.
-    bool same_names = served.inputs().size() == candidate.inputs().size();
-    for (size_t j = 0; same_names && j < served.inputs().size(); ++j) same_names = served.inputs()[j].name == candidate.inputs()[j].name;
-    if (!same_names) {
-      why = "the candidate's inputs are not the served model's";
-      return judged;
-    }
+  // The box may have grown; the inputs must still be the same names in the same order.
+  if (input_names(served.inputs()) != input_names(candidate.inputs())) {
+    why = "the candidate's inputs are not the served model's";
+    return judged;
   }
   const auto& old_state = served.state();
   const auto& new_state = candidate.state();
@@ -679,10 +675,7 @@ void learn_init(const std::string& directory, const LearnSetup& setup) {
       throw Error(setup.served_model + ": a calibrated model written before calibrated files kept their priors cannot be "
                   "recalibrated by the learner: calibrate it again with mufric calibrate");
     }
-    const InputSpace& emulator_inputs = calibrated->emulator().inputs();
-    bool same_names = emulator_inputs.size() == db.inputs.size();
-    for (size_t j = 0; same_names && j < db.inputs.size(); ++j) same_names = emulator_inputs[j].name == db.inputs[j].name;
-    if (!same_names) {
+    if (input_names(calibrated->emulator().inputs()) != input_names(db.inputs)) {
       throw Error(setup.served_model + ": the calibrated model's emulator is not a GP of " + setup.db + " (its inputs differ)");
     }
   }

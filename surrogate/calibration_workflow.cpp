@@ -280,11 +280,7 @@ Recalibration recalibrate(const CalibratedModel& model, std::shared_ptr<const Ga
     throw Error("the calibrated model's file predates kept priors, so its calibration cannot be run again: calibrate it "
                 "once more with mufric calibrate (its record: priors " + model.record().priors + ")");
   }
-  const InputSpace& before = model.emulator().inputs();
-  const InputSpace& after = emulator->inputs();
-  bool same_names = before.size() == after.size();
-  for (size_t j = 0; same_names && j < before.size(); ++j) same_names = before[j].name == after[j].name;
-  if (!same_names) {
+  if (input_names(*emulator) != input_names(model.emulator())) {
     throw Error("recalibration: the new emulator's inputs (" + joined(input_names(*emulator)) + ") are not the calibrated model's (" +
                 joined(input_names(model.emulator())) + ")");
   }
