@@ -132,38 +132,34 @@ TEST(Learning, PicksRemoveVarianceWhereTheQueriesAre) {
   EXPECT_LT(near, spread - 100e6) << near << " " << spread;
 }
 
-// A campaign of 20 plan rows in the default box, its served GP, and a server log of queries below
-// the box's pressures, written as `serve --log-uncertain` writes it.
-struct LearnerFixture {
-  std::string dir = test::temp_path("learner"), folder = test::temp_path("served"), db = test::temp_path("learn-db.h5");
-  std::string log = test::temp_path("uncertain") + "/gp.csv";
-  LearnerFixture() {
+// A learner's scratch files (its directory, the served folder, the campaign database, the server's
+// log of the served model NAME), emptied; a campaign run there on a closed form, and its GP.
+struct LearnerScratch {
+  std::string dir, folder, db, log, name;
+  LearnerScratch(const std::string& prefix, const std::string& model_name)
+      : dir(test::temp_path(prefix + "learner")),
+        folder(test::temp_path(prefix + "served")),
+        db(test::temp_path(prefix + "learn-db.h5")),
+        log(test::temp_path(prefix + "uncertain") + "/" + model_name + ".csv"),
+        name(model_name) {
     for (const auto& d : {dir, folder, fs::path(log).parent_path().string()}) fs::remove_all(d);
     fs::remove(db);
     fs::create_directories(folder);
     fs::create_directories(fs::path(log).parent_path());
+  }
+  std::string served() const { return folder + "/" + name + ".h5"; }
+  // `rows` Sobol' plan rows over `box` run on `evaluate` into db; their GP, fitted without restarts.
+  GaussianProcess run_campaign(const InputSpace& box, Eigen::Index rows, const std::string& scene, const SampleEvaluator& evaluate) const {
     Dataset plan;
-    plan.inputs = default_friction_box();
-    plan.plan = plan_in_box(PlanDesign::sobol, 20, plan.inputs, 5);
+    plan.inputs = box;
+    plan.plan = plan_in_box(PlanDesign::sobol, rows, plan.inputs, 5);
     plan.plan_design = "sobol";
-    plan.scene_json = "{\"scene\": \"closed form\"}";
+    plan.scene_json = "{\"scene\": \"" + scene + "\"}";
     plan.source = "learner test";
-    generate_dataset(plan, db, smooth_evaluator(), {});
+    generate_dataset(plan, db, evaluate, {});
     GpTrainingOptions o;
     o.restarts = 0;
-    save_model(served(), fit_campaign_gp(training_set(read_dataset(db), db), o));
-    log_queries(6, 100);
-  }
-  std::string served() const { return folder + "/gp.h5"; }
-  // Appends `rows` queries at 150–250 MPa (below the box) and sets the query count to `queries`.
-  void log_queries(int rows, long long queries) const {
-    const bool fresh = !fs::exists(log);
-    std::ofstream out(log, std::ios::app);
-    if (fresh) out << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width,outside_inputs\n";
-    for (int i = 0; i < rows; ++i) out << 150e6 + 20e6 * i << "," << 1.0 + 0.1 * i << "," << 500.0 + 10 * i << ",0.2,1\n";
-    out.close();
-    write_file_atomically(fs::path(log).replace_extension(".outside.json").string(),
-                          "{\"model\": \"gp\", \"queries\": " + std::to_string(queries) + "}");
+    return fit_campaign_gp(training_set(read_dataset(db), db), o);
   }
   LearnRunOptions run(SampleEvaluator evaluate) const {
     LearnRunOptions o;
@@ -180,6 +176,25 @@ struct LearnerFixture {
     s.budget_core_hours = 1.0;
     s.restarts = 0;
     return s;
+  }
+};
+
+// A campaign of 20 plan rows in the default box, its served GP, and a server log of queries below
+// the box's pressures, written as `serve --log-uncertain` writes it.
+struct LearnerFixture : LearnerScratch {
+  LearnerFixture() : LearnerScratch("", "gp") {
+    save_model(served(), run_campaign(default_friction_box(), 20, "closed form", smooth_evaluator()));
+    log_queries(6, 100);
+  }
+  // Appends `rows` queries at 150–250 MPa (below the box) and sets the query count to `queries`.
+  void log_queries(int rows, long long queries) const {
+    const bool fresh = !fs::exists(log);
+    std::ofstream out(log, std::ios::app);
+    if (fresh) out << "contact_pressure[Pa],sliding_velocity[m/s],temperature[K],ci95_width,outside_inputs\n";
+    for (int i = 0; i < rows; ++i) out << 150e6 + 20e6 * i << "," << 1.0 + 0.1 * i << "," << 500.0 + 10 * i << ",0.2,1\n";
+    out.close();
+    write_file_atomically(fs::path(log).replace_extension(".outside.json").string(),
+                          "{\"model\": \"gp\", \"queries\": " + std::to_string(queries) + "}");
   }
 };
 
@@ -332,28 +347,14 @@ SampleEvaluator law_evaluator() {
   };
 }
 
-struct CalibratedLearnerFixture {
-  std::string dir = test::temp_path("cal-learner"), folder = test::temp_path("cal-served"), db = test::temp_path("cal-learn-db.h5");
-  std::string log = test::temp_path("cal-uncertain") + "/calibrated.csv";
+struct CalibratedLearnerFixture : LearnerScratch {
   Measurements data;
   EnsembleOptions sampler;
-  explicit CalibratedLearnerFixture(int sampler_steps = 1200) {
-    for (const auto& d : {dir, folder, fs::path(log).parent_path().string()}) fs::remove_all(d);
-    fs::remove(db);
-    fs::create_directories(folder);
-    fs::create_directories(fs::path(log).parent_path());
-    Dataset plan;
-    plan.inputs = {default_friction_box()[0], default_friction_box()[1], {"shear_factor", "1", 0.2, 0.9}};
-    plan.plan = plan_in_box(PlanDesign::sobol, 24, plan.inputs, 5);
-    plan.plan_design = "sobol";
-    plan.scene_json = "{\"scene\": \"closed form with a law\"}";
-    plan.source = "calibrated learner test";
-    generate_dataset(plan, db, law_evaluator(), {});
-    GpTrainingOptions o;
-    o.restarts = 0;
-    auto emulator = std::make_shared<const GaussianProcess>(fit_campaign_gp(training_set(read_dataset(db), db), o));
+  explicit CalibratedLearnerFixture(int sampler_steps = 1200) : LearnerScratch("cal-", "calibrated") {
+    const InputSpace box = {default_friction_box()[0], default_friction_box()[1], {"shear_factor", "1", 0.2, 0.9}};
+    auto emulator = std::make_shared<const GaussianProcess>(run_campaign(box, 24, "closed form with a law", law_evaluator()));
     data.condition_names = {"contact_pressure", "sliding_velocity"};
-    const Eigen::MatrixXd at = plan_in_box(PlanDesign::sobol, 8, {plan.inputs[0], plan.inputs[1]}, 13);
+    const Eigen::MatrixXd at = plan_in_box(PlanDesign::sobol, 8, {box[0], box[1]}, 13);
     data.conditions = at;
     data.mu.resize(at.rows());
     data.mu_sd = Eigen::VectorXd::Constant(at.rows(), 0.01);
@@ -375,21 +376,6 @@ struct CalibratedLearnerFixture {
     out.close();
     write_file_atomically(fs::path(log).replace_extension(".outside.json").string(), "{\"model\": \"calibrated\", \"queries\": 100}");
   }
-  std::string served() const { return folder + "/calibrated.h5"; }
-  LearnSetup setup() const {
-    LearnSetup s;
-    s.db = db;
-    s.served_model = served();
-    s.log = log;
-    s.round_samples = 4;
-    s.restarts = 0;
-    return s;
-  }
-  LearnRunOptions run() const {
-    LearnRunOptions o;
-    o.make_evaluator = [](const Dataset&) { return law_evaluator(); };
-    return o;
-  }
 };
 
 // A round on a served calibrated model: the picks go to the queried pressures, at shear factors on the
@@ -401,7 +387,7 @@ struct CalibratedLearnerFixture {
 TEST(Learning, ACalibratedModelIsRecalibratedOnItsMeasurementsBeforeTheGate) {
   const CalibratedLearnerFixture f;
   learn_init(f.dir, f.setup());
-  ASSERT_EQ(learn_rounds(f.dir, f.run()).rounds_finished, 1);
+  ASSERT_EQ(learn_rounds(f.dir, f.run(law_evaluator())).rounds_finished, 1);
   const LearnRound r = read_learn_state(f.dir).rounds.at(0);
   ASSERT_TRUE(r.gate.publish) << r.gate.reason;
   EXPECT_EQ(r.gate.old_points, 24);
@@ -445,7 +431,7 @@ TEST(Learning, ARecalibrationWhoseChainsAreNotUsableIsKeptAsideWithItsReason) {
   const CalibratedLearnerFixture f(40);
   learn_init(f.dir, f.setup());
   const std::string before = file_version(f.served());
-  LearnRunOptions o = f.run();
+  LearnRunOptions o = f.run(law_evaluator());
   o.recalibration_max_steps = 0;
   ASSERT_EQ(learn_rounds(f.dir, o).rounds_finished, 1);
   const LearnRound r = read_learn_state(f.dir).rounds.at(0);
