@@ -29,14 +29,12 @@ export PYTHONPATH=$here/build/python:$here/examples/python
 rm -rf "$out" && mkdir -p "$out/served" "$out/logs"
 cp "$here/campaigns/ti6al4v_tin/db.h5" "$out/db.h5"
 cp "$here/models/ti6al4v_tin.h5" "$out/served/ti.h5"
-"$mufric" serve --models "$out/served" --listen 127.0.0.1:0 --ready-file "$out/address" --poll 0.5 \
-  --log-uncertain "$out/logs" 2>"$out/serve.log" &
-server=$!
-trap 'kill -TERM $server 2>/dev/null || true' EXIT
-for _ in $(seq 1 600); do [[ -s $out/address ]] && break; sleep 0.1; done
-[[ -s $out/address ]] || { echo "the server did not start:"; cat "$out/serve.log"; exit 1; }
+# shellcheck source=bench/service_common.sh
+source "$here/bench/service_common.sh"
+trap '[[ -z ${server:-} ]] || kill -TERM "$server" 2>/dev/null || true' EXIT
+server_start_seconds=60 start_server "$out" "$mufric" serve --models "$out/served" --poll 0.5 --log-uncertain "$out/logs"
 # The campaign's box: p 300-2000 MPa, v 1-60 m/min, T 100-1100 C (SI below).
-trace() { "$py" "$here/bench/learn_trace.py" "$(cat "$out/address")" ti --region "$region" \
+trace() { "$py" "$here/bench/learn_trace.py" "$address" ti --region "$region" \
             --box 300e6:2000e6,0.016667:1,373.15:1373.15 --pass-number "$1" "${@:2}"; }
 trace 0 --header > "$out/passes.csv"
 "$mufric" learn init "$out/learner" --db "$out/db.h5" --model "$out/served/ti.h5" --log "$out/logs/ti.csv" \

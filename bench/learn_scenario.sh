@@ -48,13 +48,10 @@ echo "== starting campaign: $start Sobol' points over p 400-1300 MPa (the coarse
 "$mufric" dataset run --plan "$out/plan.h5" --db "$out/db.h5" --jobs "$jobs" | tail -1
 "$mufric" train --data "$out/db.h5" --out "$out/served/gp.h5" | tail -1
 
-"$mufric" serve --models "$out/served" --listen 127.0.0.1:0 --ready-file "$out/address" --poll 0.5 \
-  --log-uncertain "$out/logs" --uncertain-width "$width" 2>"$out/serve.log" &
-server=$!
-trap 'kill -TERM $server 2>/dev/null || true' EXIT
-for _ in $(seq 1 100); do [[ -s $out/address ]] && break; sleep 0.1; done
-[[ -s $out/address ]] || { echo "the server did not start:"; cat "$out/serve.log"; exit 1; }
-address=$(cat "$out/address")
+# shellcheck source=bench/service_common.sh
+source "$here/bench/service_common.sh"
+trap '[[ -z ${server:-} ]] || kill -TERM "$server" 2>/dev/null || true' EXIT
+start_server "$out" "$mufric" serve --models "$out/served" --poll 0.5 --log-uncertain "$out/logs" --uncertain-width "$width"
 
 "$mufric" learn init "$out/learner" --db "$out/db.h5" --model "$out/served/gp.h5" --log "$out/logs/gp.csv" \
   --round-samples "$round_samples" --budget-core-hours "$budget"
