@@ -95,7 +95,7 @@ class DirectoryLock {
 
 // The rows the server appended since `offset` (whole lines only: a line being written is left for
 // the next round), as a CSV with the file's header; the new offset and the file it is in. The server
-// renames a full log to NAME.csv.1 and begins a new one (server/uncertain_log.hpp): when the file read
+// renames a full log to NAME.csv.1 and begins a new one (common/uncertain_log.hpp): when the file read
 // last time (`file_id`, its inode; 0: not known) is now the renamed one, its rest is read first, then
 // the new file from its start. A log shorter than the offset in the same file was started afresh by
 // an operator: it is read from its start.

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <mutex>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <random>
@@ -16,6 +17,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/uncertain_log.hpp"
 #include "common/units.hpp"
 #include "mufric/v1/friction.grpc.pb.h"
 #include "proto/wire_codec.hpp"
@@ -103,9 +105,15 @@ class InProcessClient final : public FrictionClient {
   InProcessClient(const std::string& path, const Options& options)
       : path_(path),
         model_(options.isolate_file_parsing ? load_model_isolated(path) : load_model(path)),
-        unanswered_{options.fill, options.fallback_mu} {
+        unanswered_{options.fill, options.fallback_mu},
+        log_every_(options.log_every) {
     if (const std::string why = servable_inputs_violation(input_names(model_->inputs())); !why.empty()) {
       throw Error("model '" + path + "' cannot be evaluated through a client: " + why);
+    }
+    if (!options.log_uncertain_directory.empty() && model_->has_uncertainty()) {
+      log_ = std::make_unique<UncertainQueryLog>(options.log_uncertain_directory, options.uncertain_width,
+                                                 options.uncertain_max_rows);
+      log_name_ = std::filesystem::path(path).stem().string();
     }
   }
 
@@ -124,11 +132,14 @@ class InProcessClient final : public FrictionClient {
       }
       x.col(static_cast<Eigen::Index>(j)) = Eigen::Map<const Eigen::VectorXd>(values, x.rows());
     }
+    const bool logged = log_ && calls_.fetch_add(1) % log_every_ == 0;
+    if (logged) what.std = true;
     const Evaluation e = model_->evaluate(x, what);
+    if (logged) log_->record(log_name_, inputs, x, e.std);
     Answer a;
     a.model = path_;
     a.mu.assign(e.mu.data(), e.mu.data() + e.mu.size());
-    a.std.assign(e.std.data(), e.std.data() + e.std.size());
+    if (request.std) a.std.assign(e.std.data(), e.std.data() + e.std.size());
     a.lo.assign(e.lo.data(), e.lo.data() + e.lo.size());
     a.hi.assign(e.hi.data(), e.hi.data() + e.hi.size());
     a.patch_std.assign(e.patch_std.data(), e.patch_std.data() + e.patch_std.size());
@@ -174,6 +185,10 @@ class InProcessClient final : public FrictionClient {
   std::unique_ptr<FrictionModel> model_;  // evaluation is const and keeps no state: safe from many threads
   UnansweredValues unanswered_;
   std::atomic<int> in_flight_{0};
+  std::unique_ptr<UncertainQueryLog> log_;  // Options::log_uncertain_directory; null: no log
+  std::string log_name_;                    // the model file's stem, the log's file name
+  long long log_every_;
+  std::atomic<long long> calls_{0};
 };
 
 struct ServerUri {
@@ -562,10 +577,20 @@ Options parse_options(std::string_view text, Options base) {
       o.fill = number_option(key, value, -largest, largest);  // finite: NaN or inf would defeat its purpose
     } else if (key == "fallback_mu") {
       o.fallback_mu = number_option(key, value, 0.0, kLargestFallbackMu);
+    } else if (key == "log_uncertain") {
+      if (value.empty()) throw InvalidArgument("option log_uncertain: a directory is needed");
+      o.log_uncertain_directory = value;
+    } else if (key == "uncertain_width") {
+      o.uncertain_width = number_option(key, value, 1e-12, 1e6);
+    } else if (key == "uncertain_max_rows") {
+      o.uncertain_max_rows = whole_option(key, value, 1, 1'000'000'000);
+    } else if (key == "log_every") {
+      o.log_every = whole_option(key, value, 1, 1'000'000'000);
     } else {
       throw InvalidArgument("option '" + key +
                             "' is unknown (known: deadline, retries, backoff, chunk_points, max_message_mb, stream, "
-                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation, fill, fallback_mu)");
+                            "token, tls_ca, tls_cert, tls_key, mu_tolerance, std_tolerance, extrapolation, fill, fallback_mu, "
+                            "log_uncertain, uncertain_width, uncertain_max_rows, log_every)");
     }
   }
   return o;
@@ -575,6 +600,10 @@ std::unique_ptr<FrictionClient> connect(const std::string& uri, const Options& o
   if (const auto server = parse_server_uri(uri)) {
     if (server->model.empty()) {
       throw Error("model URI '" + uri + "': expected " + (server->tls ? "grpcs" : "grpc") + "://host:port/model");
+    }
+    if (!options.log_uncertain_directory.empty()) {
+      throw InvalidArgument("option log_uncertain is for a model evaluated in-process (file://); over gRPC the server "
+                            "logs: mufric serve --log-uncertain DIR");
     }
     return std::make_unique<GrpcClient>(server->target, server->model, server->tls, options);
   }

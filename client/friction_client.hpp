@@ -101,6 +101,16 @@ struct Options {
   // former constant μ), so that a refused point neither poisons nor reverses its friction force
   // (fill=-1 did, taken for μ). Its σ, lo and hi stay NaN or `fill`; its status says it was not answered.
   std::optional<double> fallback_mu;
+  // file:// only: log the model's uncertain and out-of-box queries as `serve --log-uncertain DIR` does,
+  // into DIR/<model file's stem>.csv and .outside.json, which `mufric learn --log` and `dataset refine
+  // --candidates` read; a meso code evaluating in-process needs no server for the learner to follow
+  // it. Every log_every-th call is logged (each logged call computes the predictive σ, which a
+  // clamped point pays for with the model at the real point: milliseconds for a calibrated model).
+  // Over grpc:// the server logs (`serve --log-uncertain`): refused here.
+  std::string log_uncertain_directory;
+  double uncertain_width = 0.05;           // the 95 % interval's width in μ above which a query is logged
+  long long uncertain_max_rows = 100'000;  // a full file is renamed <stem>.csv.1, as the server's
+  long long log_every = 1;
   // grpc:// only: a TCP connection of this client's own. Without it gRPC shares one connection among
   // every client of the process with the same target and options (what a meso code wants; a load
   // generator measuring N connections does not).
@@ -114,7 +124,8 @@ inline constexpr double kLargestFallbackMu = 10.0;
 // Keys: deadline (s), retries, backoff (s, the first), chunk_points, max_message_mb, stream (0/1),
 // token, tls_ca, tls_cert, tls_key (PEM file paths), mu_tolerance, std_tolerance (0: exact model),
 // extrapolation (raw, clamp or refuse; default: the model's own), fill (a finite number for the outputs
-// of points without an answer; default: NaN), fallback_mu (their μ, 0 to 10, over fill). Starts from `base`; throws InvalidArgument
+// of points without an answer; default: NaN), fallback_mu (their μ, 0 to 10, over fill), log_uncertain
+// (a directory, file:// only), uncertain_width, uncertain_max_rows, log_every. Starts from `base`; throws InvalidArgument
 // naming the key or value it cannot use.
 Options parse_options(std::string_view text, Options base = {});
 

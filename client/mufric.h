@@ -94,6 +94,11 @@ int mufric_open(const char* uri, mufric_client** client);
  *   fallback_mu=V     mu of points without an answer (0 <= V <= 10, over fill): the value the code
  *                     would use there anyway, e.g. its former constant mu; the call still returns
  *                     MUFRIC_PARTIAL and their status says which they are
+ *   log_uncertain=DIR file:// only: log the queries whose 95 % interval is wider than
+ *                     uncertain_width=W (default 0.05) or that lie outside the box into
+ *                     DIR/<model file's stem>.csv (and .outside.json), as `mufric serve
+ *                     --log-uncertain DIR` does, for `mufric learn`; log_every=N logs every N-th
+ *                     call only (each logged call computes the std); uncertain_max_rows=R as the server's
  * e.g. mufric_open_with_options("grpc://node7:50051/gp", "stream=1, deadline=2", &c). */
 int mufric_open_with_options(const char* uri, const char* options, mufric_client** client);
 void mufric_close(mufric_client* client);

@@ -12,7 +12,7 @@
 #include "mufric/v1/friction.grpc.pb.h"
 #include "server/memory_budget.hpp"
 #include "server/model_registry.hpp"
-#include "server/uncertain_log.hpp"
+#include "common/uncertain_log.hpp"
 
 namespace mufric::server {
 

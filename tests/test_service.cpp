@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <condition_variable>
 #include <fstream>
+#include <iterator>
 #include <mutex>
 #include <random>
 #include <sstream>
@@ -196,7 +197,7 @@ TEST_F(Service, UncertainQueriesAreLoggedForActiveLearning) {
   std::vector<double> sorted = widths;
   std::nth_element(sorted.begin(), sorted.begin() + 300, sorted.end());
   const double threshold = sorted[300];  // about a quarter of the points are wider
-  server::UncertainQueryLog log((dir_ / "uncertain").string(), threshold, 1000);
+  UncertainQueryLog log((dir_ / "uncertain").string(), threshold, 1000);
   server::ServiceLimits limits;
   limits.evaluation_threads = 2;
   limits.uncertain_log = &log;
@@ -223,6 +224,53 @@ TEST_F(Service, UncertainQueriesAreLoggedForActiveLearning) {
     EXPECT_EQ(t[k], pts.t[expected[k]]);
   }
   EXPECT_EQ(log.rows("gp"), static_cast<long long>(expected.size()));
+}
+
+// A meso code evaluating in-process logs for the learner without a server (client option
+// log_uncertain=DIR, issue 69): the same block gives the server's log byte for byte (rows and the
+// outside counts), every log_every-th call is logged, a caller asking μ only still gets μ only, and
+// over gRPC the option is refused naming where the log belongs.
+TEST_F(Service, AModelEvaluatedInProcessLogsItsQueriesAsTheServerDoes) {
+  Points pts = random_points(200);
+  for (size_t i = 0; i < pts.t.size(); i += 4) pts.t[i] = 200.0;  // a quarter below the box (cold contact)
+  const double threshold = 0.01;
+  {
+    UncertainQueryLog log((dir_ / "served_log").string(), threshold, 1000);
+    server::ServiceLimits limits;
+    limits.uncertain_log = &log;
+    LoopbackServer server(dir_, 0, limits);
+    client::connect("grpc://" + server.address() + "/gp")->evaluate(pts.block(), {});
+  }
+  const fs::path in_process = dir_ / "in_process_log";
+  client::Options options = client::parse_options("log_uncertain=" + in_process.string() + ", uncertain_width=0.01");
+  {
+    const auto local = client::connect("file://" + (dir_ / "gp.h5").string(), options);
+    const client::Answer a = local->evaluate(pts.block(), {});
+    EXPECT_TRUE(a.std.empty());
+  }
+  const auto text = [](const fs::path& file) {
+    std::ifstream in(file);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  ASSERT_TRUE(fs::exists(in_process / "gp.csv"));
+  EXPECT_EQ(text(in_process / "gp.csv"), text(dir_ / "served_log" / "gp.csv"));
+  EXPECT_EQ(text(in_process / "gp.outside.json"), text(dir_ / "served_log" / "gp.outside.json"));
+  EXPECT_GE(read_csv_table((in_process / "gp.csv").string()).si_column("temperature").size(), 50u);
+
+  // every third call: calls 0 and 3 of five land, each the whole block's out-of-box rows
+  const fs::path thinned = dir_ / "thinned_log";
+  options = client::parse_options("log_uncertain=" + thinned.string() + ", uncertain_width=1e6, log_every=3");
+  {
+    const auto local = client::connect("file://" + (dir_ / "gp.h5").string(), options);
+    for (int call = 0; call < 5; ++call) local->evaluate(pts.block(), {});
+  }
+  EXPECT_EQ(read_csv_table((thinned / "gp.csv").string()).si_column("temperature").size(), 2 * 50u);
+  try {
+    client::connect("grpc://127.0.0.1:1/gp", options);
+    ADD_FAILURE() << "log_uncertain over gRPC was accepted";
+  } catch (const client::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("serve --log-uncertain"), std::string::npos) << e.what();
+  }
 }
 
 // Out-of-box queries are logged whatever their width (under the clamp default their std is the
@@ -257,14 +305,14 @@ TEST_F(Service, OutOfBoxQueriesAreLoggedAndCountedPerInputAndSide) {
   const long long max_rows = 60;
   const fs::path dir = dir_ / "outside";
   {
-    server::UncertainQueryLog log(dir.string(), 1e6, max_rows);  // no interval is that wide: only outside points
+    UncertainQueryLog log(dir.string(), 1e6, max_rows);  // no interval is that wide: only outside points
     server::ServiceLimits limits;
     limits.uncertain_log = &log;
     LoopbackServer server(dir_, 0, limits);
     const auto remote = client::connect("grpc://" + server.address() + "/gp");
     const client::Answer a = remote->evaluate(pts.block(), {});  // the clamp default: every point answered
     for (const double mu : a.mu) EXPECT_TRUE(std::isfinite(mu));
-    const server::OutsideSummary s = log.outside("gp");
+    const OutsideSummary s = log.outside("gp");
     EXPECT_EQ(s.queries, static_cast<long long>(pts.p.size()));
     EXPECT_EQ(s.outside_queries, outside);
     for (size_t j = 0; j < 3; ++j) {
@@ -311,7 +359,7 @@ TEST(UncertainLog, AFullLogIsRenamedAndANewOneBegun) {
   const Eigen::VectorXd std = Eigen::VectorXd::Zero(6);
   const auto pressures = [](const fs::path& file) { return read_csv_table(file.string()).si_column("contact_pressure"); };
   {
-    server::UncertainQueryLog log(dir.string(), 1e6, 10);
+    UncertainQueryLog log(dir.string(), 1e6, 10);
     log.record("gp", box, batch(10e6), std);
     EXPECT_FALSE(fs::exists(dir / "gp.csv.1"));
     log.record("gp", box, batch(20e6), std);  // 12 rows would pass 10: the first six are renamed away
@@ -319,7 +367,7 @@ TEST(UncertainLog, AFullLogIsRenamedAndANewOneBegun) {
     EXPECT_EQ(pressures(dir / "gp.csv").front(), 20e6);
     EXPECT_EQ(log.rows("gp"), 6);
   }
-  server::UncertainQueryLog restarted(dir.string(), 1e6, 10);
+  UncertainQueryLog restarted(dir.string(), 1e6, 10);
   restarted.record("gp", box, batch(30e6), std);  // the file's six rows count: renamed again
   EXPECT_EQ(pressures(dir / "gp.csv.1").front(), 20e6);
   const auto current = pressures(dir / "gp.csv");
@@ -338,13 +386,13 @@ TEST_F(Service, OutsideCountsRestartWhenTheModelsBoxChanges) {
       4e9, 1.0, 400.0;   // above both
   const Eigen::VectorXd std = Eigen::VectorXd::Zero(2);
   const fs::path dir = dir_ / "regrown";
-  server::UncertainQueryLog log(dir.string(), 1e6, 100);
+  UncertainQueryLog log(dir.string(), 1e6, 100);
   log.record("gp", old_box, x, std);
   EXPECT_EQ(log.outside("gp").outside_queries, 2);
   EXPECT_EQ(log.outside("gp").inputs[0].above, 2);
   log.flush();
   log.record("gp", grown, x, std);
-  const server::OutsideSummary s = log.outside("gp");
+  const OutsideSummary s = log.outside("gp");
   EXPECT_EQ(s.queries, 2);
   EXPECT_EQ(s.outside_queries, 1);
   EXPECT_EQ(s.inputs[0].above, 1);

@@ -51,6 +51,7 @@ while IFS=, read -r name options; do
   [[ -f $out/summary.json ]] && continue
   options=${options//MODELS/$models}
   options=${options//DATA/$root/data}
+  options=${options//OUT/$out}
   echo "$(date -u +%FT%TZ) $name: mfree_cut $options"
   # shellcheck disable=SC2086
   taskset -c "$core" "$here/bin/mfree_cut" $options --out "$out" >> "$here/runs/$name.log" 2>&1 &

@@ -4,8 +4,10 @@
 // (unit header, SI values; renamed to <model>.csv.1 when full), the file `mufric dataset refine
 // --candidates [--grow-box]` and `mufric learn` read; and
 // per input and side, how many queries fell outside the box and how far, in DIR/<model>.outside.json.
-// Opt-in (`serve --log-uncertain DIR`): it makes every call compute the predictive std, which a GP
-// pays n²/2 multiply-adds per point for.
+// Opt-in: `serve --log-uncertain DIR` for a served model, or the client option `log_uncertain=DIR` for
+// one evaluated in-process (the same files, so `learn` follows a meso code either way). It makes every
+// logged call compute the predictive std, which a GP pays n²/2 multiply-adds per point for (and a
+// clamped point the model at the real point outside the box, where no fast grid answers).
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -16,7 +18,7 @@
 
 #include "common/input_space.hpp"
 
-namespace mufric::server {
+namespace mufric {
 
 // Queries of one input outside the box: how many on each side, and the farthest seen (SI).
 struct OutsideInputCount {
@@ -33,7 +35,7 @@ struct OutsideSummary {
 
 class UncertainQueryLog {
  public:
-  // Throws Error naming --log-uncertain if the directory cannot be created.
+  // Throws Error naming the directory if it cannot be created.
   UncertainQueryLog(std::string directory, double width_threshold, long long max_rows_per_model);
   // Writes every model's outside summary that changed since its last write.
   ~UncertainQueryLog();
@@ -74,4 +76,4 @@ class UncertainQueryLog {
   std::map<std::string, ModelLog> models_;
 };
 
-}  // namespace mufric::server
+}  // namespace mufric

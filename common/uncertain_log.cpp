@@ -1,4 +1,4 @@
-#include "server/uncertain_log.hpp"
+#include "common/uncertain_log.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 
-namespace mufric::server {
+namespace mufric {
 namespace {
 constexpr double kZ95 = 1.959963984540054;  // two-sided 95 % normal quantile
 // A summary is rewritten at most this often while queries keep falling outside the box.
@@ -44,10 +44,10 @@ long long count_logged_rows(const std::string& file) {
 
 UncertainQueryLog::UncertainQueryLog(std::string directory, double width_threshold, long long max_rows_per_model)
     : directory_(std::move(directory)), width_threshold_(width_threshold), max_rows_(max_rows_per_model) {
-  if (!(width_threshold_ > 0.0)) throw Error("--uncertain-width must be positive");
+  if (!(width_threshold_ > 0.0)) throw Error("the uncertain-query log's interval width must be positive");
   std::error_code ec;
   std::filesystem::create_directories(directory_, ec);
-  if (ec) throw Error("--log-uncertain: cannot create '" + directory_ + "': " + ec.message());
+  if (ec) throw Error("uncertain-query log: cannot create '" + directory_ + "': " + ec.message());
 }
 
 UncertainQueryLog::~UncertainQueryLog() { flush(); }
@@ -115,7 +115,7 @@ void UncertainQueryLog::record(const std::string& model, const InputSpace& input
   }
   if (log.outside.outside_queries > outside_before) {
     if (outside_before == 0) {
-      std::fprintf(stderr, "mufric serve: %s is asked about points outside its box; counts per input in %s\n",
+      std::fprintf(stderr, "mufric: %s is asked about points outside its box; counts per input in %s\n",
                    model.c_str(), outside_path(model).c_str());
     }
     log.summary_dirty = true;
@@ -141,11 +141,11 @@ void UncertainQueryLog::append_rows(const std::string& model, ModelLog& log, con
     std::error_code ec;
     std::filesystem::rename(file, rotated_path(model), ec);
     if (ec) {
-      std::fprintf(stderr, "mufric serve: cannot rename the full %s (%s); uncertain queries of %s are not logged\n",
+      std::fprintf(stderr, "mufric: cannot rename the full %s (%s); uncertain queries of %s are not logged\n",
                    file.c_str(), ec.message().c_str(), model.c_str());
       return;
     }
-    std::fprintf(stderr, "mufric serve: %s reached %lld logged queries; renamed to %s, a new log begins\n", file.c_str(),
+    std::fprintf(stderr, "mufric: %s reached %lld logged queries; renamed to %s, a new log begins\n", file.c_str(),
                  log.rows, rotated_path(model).c_str());
     log.rows = 0;
   }
@@ -159,7 +159,7 @@ void UncertainQueryLog::append_rows(const std::string& model, ModelLog& log, con
   out.write(text.data(), static_cast<std::streamsize>(text.size()));  // one write per batch
   out.flush();
   if (!out) {
-    std::fprintf(stderr, "mufric serve: cannot append to %s; these uncertain queries of %s are not logged\n", file.c_str(),
+    std::fprintf(stderr, "mufric: cannot append to %s; these uncertain queries of %s are not logged\n", file.c_str(),
                  model.c_str());
     return;
   }
@@ -184,11 +184,11 @@ void UncertainQueryLog::write_summary(const std::string& model, ModelLog& log) {
   try {
     write_file_atomically(outside_path(model), summary.dump(2) + "\n");
   } catch (const Error& e) {
-    std::fprintf(stderr, "mufric serve: %s\n", e.what());  // the counts stay in memory and are tried again
+    std::fprintf(stderr, "mufric: %s\n", e.what());  // the counts stay in memory and are tried again
     return;
   }
   log.summary_dirty = false;
   log.summary_written = std::chrono::steady_clock::now();
 }
 
-}  // namespace mufric::server
+}  // namespace mufric
