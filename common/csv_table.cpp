@@ -28,16 +28,37 @@ std::vector<std::string> split(const std::string& line) {
   return cells;
 }
 
-// "name[unit]" or "name (unit)" or "name".
-CsvColumn parse_header_cell(const std::string& cell) {
+// "name[unit]" or "name (unit)" or "name", exactly: text after the unit's bracket is an error (a
+// misplaced suffix such as "temperature[C]_sd" would otherwise read as a second "temperature").
+CsvColumn parse_header_cell(const std::string& path, const std::string& cell) {
   for (const auto& [open, close] : {std::pair{'[', ']'}, std::pair{'(', ')'}}) {
     const auto a = cell.find(open);
-    const auto b = cell.rfind(close);
-    if (a != std::string::npos && b != std::string::npos && b > a) {
-      return {trim(cell.substr(0, a)), trim(cell.substr(a + 1, b - a - 1))};
+    if (a == std::string::npos) continue;
+    const auto b = cell.find(close, a);
+    const std::string name = trim(cell.substr(0, a));
+    if (b == std::string::npos) {
+      throw Error(path + ": header cell '" + cell + "' opens its unit with '" + open + "' and never closes it");
     }
+    const std::string unit = trim(cell.substr(a + 1, b - a - 1));
+    const std::string after = trim(cell.substr(b + 1));
+    if (!after.empty()) {
+      throw Error(path + ": header cell '" + cell + "' has '" + after + "' after its unit: a cell is name" + open +
+                  "unit" + close + " (did you mean '" + name + after + open + unit + close + "'?)");
+    }
+    if (name.empty()) throw Error(path + ": header cell '" + cell + "' has a unit but no name");
+    return {name, unit};
   }
   return {cell, ""};
+}
+
+// What a spreadsheet writes as "CSV UTF-8": a byte-order mark before the first cell.
+void strip_byte_order_mark(std::string& line) {
+  if (line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+}
+
+std::string semicolon_advice(const std::string& path) {
+  return path + ": mufric reads comma-separated files, and this one seems to use ';' between cells (as spreadsheets "
+                "write CSV where the decimal mark is a comma): save it with ',' between cells and '.' as the decimal mark";
 }
 
 }  // namespace
@@ -94,14 +115,26 @@ CsvTable read_csv_table(const std::string& path) {
   int line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number == 1) strip_byte_order_mark(line);
     const std::string content = trim(line);
     if (content.empty() || content.front() == '#') continue;
     const auto cells = split(content);
     if (table.columns.empty()) {
-      for (const auto& cell : cells) table.columns.push_back(parse_header_cell(cell));
+      if (cells.size() == 1 && content.find(';') != std::string::npos) throw Error(semicolon_advice(path));
+      for (const auto& cell : cells) {
+        CsvColumn column = parse_header_cell(path, cell);
+        for (size_t k = 0; k < table.columns.size(); ++k) {
+          if (table.columns[k].name == column.name) {
+            throw Error(path + ": header cells " + std::to_string(k + 1) + " and " + std::to_string(table.columns.size() + 1) +
+                        " are both '" + column.name + "': each column needs a name of its own");
+          }
+        }
+        table.columns.push_back(std::move(column));
+      }
       continue;
     }
     if (cells.size() != table.columns.size()) {
+      if (content.find(';') != std::string::npos) throw Error(semicolon_advice(path));
       throw Error(path + ": line " + std::to_string(line_number) + ": " + std::to_string(cells.size()) +
                   " cells, the header has " + std::to_string(table.columns.size()));
     }
