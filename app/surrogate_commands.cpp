@@ -286,6 +286,23 @@ PredictPoints points_from_csv(const std::string& path, const InputSpace& inputs)
   return p;
 }
 
+// What an EXTRAPOLATED answer is (docs/usage.md, "Outside the box"): under clamp, μ of the nearest
+// point of the box with an interval widened by the distance; under raw, the model itself beyond its data.
+std::string extrapolation_account(const InputSpace& inputs, const PredictPoints& points, Extrapolation policy) {
+  if (policy != Extrapolation::clamp) {
+    return "answered by the raw model beyond its data (policy raw): its interval says how little it knows there";
+  }
+  std::string at;
+  for (size_t j = 0; j < inputs.size(); ++j) {
+    const double x = points.columns[j][0];
+    if (inputs[j].kind() == QuantityKind::angle || inputs[j].contains(x)) continue;
+    const double face = x < inputs[j].lo ? inputs[j].lo : inputs[j].hi;
+    at += (at.empty() ? "" : ", ") + inputs[j].name + " = " + format_human(face, inputs[j].kind());
+  }
+  return "answered at " + at + " (policy clamp: mu of the nearest point of the box, its interval widened by the "
+         "distance; --extrapolation raw or refuse to choose otherwise)";
+}
+
 // dμ/dx in per-human-unit (per MPa, per m/min, per °C), as the inputs are given.
 double gradient_per_human_unit(double per_si, QuantityKind kind) {
   return per_si * unit_to_si(human_unit(kind)).scale;
@@ -394,14 +411,18 @@ void add_predict(CLI::App& app) {
       }
       if (out != stdout && std::fclose(out) != 0) throw Error(o->out + ": write failed");
       std::fprintf(stderr, "%zu points (%lld answered by the fast evaluator)\n", n, a.fast_points);
-    } else {
+    } else if (!has_no_answer(a.status[0])) {  // a point without an answer gets its error line alone
       for (size_t j = 0; j < inputs.size(); ++j) {
         std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(points.columns[j][0], inputs[j].kind()).c_str());
       }
       std::printf("\nmu = %.6g  std %.3g  %.0f %% interval [%.6g, %.6g]  status %s  (%s)\n", a.mu[0], a.std[0],
                   100 * o->level, a.lo[0], a.hi[0], std::string(to_string(a.status[0])).c_str(),
                   a.fast_points > 0 ? "fast evaluator" : "exact model");
-      if (a.status[0] == PointStatus::extrapolated) std::printf("  outside the training box: %s\n", reason_of(0).c_str());
+      if (a.status[0] == PointStatus::extrapolated) {
+        std::printf("  outside the training box: %s\n", reason_of(0).c_str());
+        const Extrapolation policy = what.extrapolation == Extrapolation::model_default ? info.extrapolation : what.extrapolation;
+        std::printf("  %s\n", extrapolation_account(inputs, points, policy).c_str());
+      }
       if (patch) {
         std::printf("  patch scatter %.3g: one contact patch's mu scatters about this mean with this standard deviation "
                     "(the micro-model's per-draw spread; not part of the interval)\n", a.patch_std[0]);
@@ -414,7 +435,7 @@ void add_predict(CLI::App& app) {
       }
     }
     if (unanswered > 0) {
-      throw Error(first_unanswered + (unanswered > 1 ? " (and " + std::to_string(unanswered - 1) + " more points without an answer)" : ""));
+      throw Error(first_unanswered + more_points_tail(unanswered - 1, false));
     }
   });
 }

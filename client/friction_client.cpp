@@ -152,6 +152,11 @@ class InProcessClient final : public FrictionClient {
     a.fast_points = e.fast_points;
     a.range_clipped = e.range_clipped;
     a.message = unanswered_points_message(inputs, x, a.status);  // the server's words for the same block
+    if (a.message.empty()) {
+      const Extrapolation policy =
+          what.extrapolation == Extrapolation::model_default ? model_->default_extrapolation() : what.extrapolation;
+      a.message = extrapolated_points_message(inputs, x, a.status, policy);
+    }
     fill_unanswered(a, unanswered_);
     return a;
   }
@@ -164,7 +169,8 @@ class InProcessClient final : public FrictionClient {
             model_->has_uncertainty(),
             model_->summary(),
             model_->has_patch_scatter(),
-            model_->kind_description().calibration};
+            model_->kind_description().calibration,
+            model_->default_extrapolation()};
   }
 
  private:
@@ -281,6 +287,9 @@ class GrpcClient final : public FrictionClient {
     mufric::v1::ModelDescription d;
     call("DescribeModel", [&](grpc::ClientContext* context) { return stub_->DescribeModel(context, request, &d); });
     ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary(), d.has_patch_scatter(), std::nullopt};
+    if (d.extrapolation() != v1::EXTRAPOLATION_MODEL_DEFAULT && v1::Extrapolation_IsValid(d.extrapolation())) {
+      info.extrapolation = static_cast<Extrapolation>(d.extrapolation());
+    }
     for (const auto& input : d.inputs()) info.inputs.push_back({input.name(), input.unit(), input.lo(), input.hi()});
     if (d.has_calibration()) {
       const auto& c = d.calibration();
@@ -376,8 +385,11 @@ class GrpcClient final : public FrictionClient {
   // renumbered as the block's point and its count of further points made the block's, so the
   // caller reads what an in-process evaluation of the whole block says. The first call with a
   // message comes first (calls go in order), so its first point is the block's first.
+  // A block's message tells of a point without an answer before one outside the box (as in-process).
   static void append(const mufric::v1::EvaluateResponse& response, size_t first, Answer& answer) {
-    if (answer.message.empty() && !response.message().empty()) {
+    const bool replaces = answer.message.empty() ||
+                          (tells_extrapolated(answer.message) && !tells_extrapolated(response.message()));
+    if (replaces && !response.message().empty()) {
       answer.message = renumbered(response.message(), first);
     }
     answer.model = response.model();
@@ -406,15 +418,30 @@ class GrpcClient final : public FrictionClient {
     return std::string(prefix) + std::to_string(index + first) + std::string(end, message.data() + message.size());
   }
 
-  // The whole block's count of further unanswered points in place of the first call's.
+  static bool tells_extrapolated(const std::string& message) {
+    return message.rfind("point ", 0) == 0 && message.find(" EXTRAPOLATED: ") != std::string::npos;
+  }
+
+  // N of " (and N more ...)", 0 when not a count.
+  static long long count_in_tail(const std::string& tail) {
+    constexpr std::string_view prefix = " (and ";
+    long long n = 0;
+    const char* begin = tail.data() + prefix.size();
+    const auto [end, ec] = std::from_chars(begin, tail.data() + tail.size(), n);
+    return ec == std::errc() && end != begin ? n : 0;
+  }
+
+  // The whole block's count of further unanswered (or extrapolated) points in place of the first call's.
   static std::string block_message(const Answer& answer) {
-    constexpr std::string_view more = " more points without an answer)";
+    const bool extrapolated = tells_extrapolated(answer.message);
     std::string message = answer.message;
     const auto tail = message.rfind(" (and ");
-    if (tail != std::string::npos && message.ends_with(more)) message.erase(tail);
-    const auto unanswered = std::count_if(answer.status.begin(), answer.status.end(), has_no_answer);
-    if (unanswered > 1) message += " (and " + std::to_string(unanswered - 1) + std::string(more);
-    return message;
+    if (tail != std::string::npos && message.substr(tail) == more_points_tail(count_in_tail(message.substr(tail)), extrapolated)) {
+      message.erase(tail);
+    }
+    const auto counted = extrapolated ? std::count(answer.status.begin(), answer.status.end(), PointStatus::extrapolated)
+                                      : std::count_if(answer.status.begin(), answer.status.end(), has_no_answer);
+    return message + more_points_tail(counted - 1, extrapolated);
   }
 
   // One request, one response on the open stream; the stream is (re)opened as needed, and a stream

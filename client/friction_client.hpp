@@ -67,6 +67,8 @@ struct ModelInfo {
   // A calibrated model's calibration (DescribeModel's `calibration`): what it was calibrated on, each
   // posterior coordinate's mean, SD and 95 % interval (SI), the interval's parts at the box centre.
   std::optional<CalibrationDescription> calibration;
+  // The model's own policy outside its box (a request's Extrapolation::model_default means this one).
+  Extrapolation extrapolation = Extrapolation::clamp;
 };
 
 struct Options {

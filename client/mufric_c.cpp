@@ -121,7 +121,9 @@ int evaluate_into(const char* function, mufric_client* client, size_t n, const s
     counts.range_clipped = static_cast<size_t>(answer.range_clipped);
     counts.fast_points = static_cast<size_t>(answer.fast_points);
     if (out.counts) *out.counts = counts;
-    last_error = answer.message;  // the first point without an answer, or ""
+    // the first point without an answer, or "" (the message of an answered block outside the box is
+    // the C++ Answer's and the gRPC reply's, not an error)
+    last_error = counts.invalid + counts.out_of_box > 0 ? answer.message : std::string();
     return counts.invalid + counts.out_of_box == 0 ? MUFRIC_OK : MUFRIC_PARTIAL;
   });
 }

@@ -224,6 +224,37 @@ std::string point_reason(const InputSpace& inputs, const double* x) {
   return reasons;
 }
 
+std::string more_points_tail(long long more, bool extrapolated) {
+  if (more <= 0) return {};
+  return " (and " + std::to_string(more) + (more == 1 ? " more point " : " more points ") +
+         (extrapolated ? "outside the box)" : "without an answer)");
+}
+
+std::string extrapolated_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status,
+                                        Extrapolation policy) {
+  long long outside = 0;
+  std::string first;
+  for (size_t i = 0; i < status.size(); ++i) {
+    if (status[i] != PointStatus::extrapolated) continue;
+    if (outside++ > 0) continue;
+    const Eigen::RowVectorXd row = x.row(static_cast<Eigen::Index>(i));
+    first = "point " + std::to_string(i) + " EXTRAPOLATED: " + point_reason(inputs, row.data()) + "; answered ";
+    if (policy == Extrapolation::clamp) {
+      std::string at;
+      for (size_t j = 0; j < inputs.size(); ++j) {
+        if (!clamped_input(inputs[j]) || inputs[j].contains(row(static_cast<Eigen::Index>(j)))) continue;
+        const double face = row(static_cast<Eigen::Index>(j)) < inputs[j].lo ? inputs[j].lo : inputs[j].hi;
+        at += (at.empty() ? "" : ", ") + inputs[j].name + " = " + format_human(face, inputs[j].kind());
+      }
+      first += "at " + at + " (clamp)";
+    } else {
+      first += "by the raw model beyond its data (raw)";
+    }
+  }
+  first += more_points_tail(outside - 1, true);
+  return first;
+}
+
 std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status) {
   long long unanswered = 0;
   std::string first;
@@ -234,7 +265,7 @@ std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch
       first = "point " + std::to_string(i) + " " + std::string(to_string(status[i])) + ": " + point_reason(inputs, row.data());
     }
   }
-  if (unanswered > 1) first += " (and " + std::to_string(unanswered - 1) + " more points without an answer)";
+  first += more_points_tail(unanswered - 1, false);
   return first;
 }
 

@@ -171,7 +171,16 @@ class FrictionModel {
 std::string point_reason(const InputSpace& inputs, const double* x);
 // One line for a response: the first point that got no answer (INVALID_INPUT, OUT_OF_BOX) and why,
 // with how many more there are; "" when every point was answered. x: the batch, one row per point.
+// " (and 2 more points without an answer)", " (and 1 more point outside the box)": how a block's
+// message counts the points after the first it names; "" when there are none.
+std::string more_points_tail(long long more, bool extrapolated);
 std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status);
+// When every point was answered but some lie outside the box: the first such point, which input and
+// how it was answered under `policy` (clamp: at the box's nearest point; raw: the model beyond its
+// data), and how many more, e.g. "point 0 EXTRAPOLATED: contact_pressure: 2500MPa is above the box
+// (300MPa to 2000MPa); answered at contact_pressure = 2000MPa (clamp)". "" when none is outside.
+std::string extrapolated_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status,
+                                        Extrapolation policy);
 
 // Two-sided normal quantile z such that P(|Z| ≤ z) = level (Boost.Math).
 double normal_quantile_two_sided(double level);

@@ -304,9 +304,15 @@ TEST_F(Cli, PredictSaysWhyAPointHasNoAnswerAndAnswersACsv) {
   r = run("predict --model " + path("law.h5") + " --p -5MPa --v 10m/min --angle 90deg");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("INVALID_INPUT: contact_pressure: -5MPa is below 0MPa"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("mu = "), std::string::npos) << "a point without an answer printed a mu block:\n" << r.output;
+  EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
   r = run("predict --model " + path("law.h5") + " --p 10000MPa --v 10m/min --angle 270deg");
-  EXPECT_EQ(r.exit_code, 0) << r.output;  // clamped: answered, and says why it is EXTRAPOLATED
+  EXPECT_EQ(r.exit_code, 0) << r.output;  // clamped: answered, and says why it is EXTRAPOLATED and how it was answered
   EXPECT_NE(r.output.find("outside the training box: contact_pressure"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("answered at contact_pressure = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("policy clamp"), std::string::npos) << r.output;
+  r = run("predict --model " + path("law.h5") + " --p 10000MPa --v 10m/min --angle 270deg --extrapolation raw");
+  EXPECT_NE(r.output.find("policy raw"), std::string::npos) << r.output;
   r = run("predict --model " + path("law.h5") + " --p 80MPa --v 10m/min --angle 270deg");
   EXPECT_NE(r.output.find("status OK"), std::string::npos) << r.output;  // 270° is 90°: inside
   std::ofstream(path("points.csv")) << "contact_pressure[MPa],sliding_velocity[m/min],fibre_angle[deg]\n"

@@ -167,6 +167,20 @@ TEST_F(Service, GrpcAndInProcessTellTheSameMessageAndCounts) {
   EXPECT_EQ(remote->evaluate(random_points(10).block(), refuse).message, "");
   EXPECT_EQ(local->evaluate(random_points(10).block(), refuse).message, "");
 
+  // A block answered but partly outside the box says so, in the same words, with how it was answered
+  // (issue 72: the reply's message was empty for EXTRAPOLATED points); points without an answer come first.
+  Points cold = random_points(600);
+  cold.t[400] = 200.0;  // below the box, in the second call
+  cold.t[500] = 150.0;
+  const client::Answer c1 = remote->evaluate(cold.block(), {}), c2 = local->evaluate(cold.block(), {});
+  EXPECT_EQ(c1.message, c2.message);
+  EXPECT_EQ(c1.message.rfind("point 400 EXTRAPOLATED: temperature: ", 0), 0u) << c1.message;
+  EXPECT_NE(c1.message.find("answered at temperature = "), std::string::npos) << c1.message;
+  EXPECT_NE(c1.message.find("(clamp) (and 1 more point outside the box)"), std::string::npos) << c1.message;
+  cold.p[550] = -5.0;  // invalid: its message wins
+  EXPECT_EQ(remote->evaluate(cold.block(), {}).message.rfind("point 550 INVALID_INPUT", 0), 0u);
+  EXPECT_EQ(local->evaluate(cold.block(), {}).message.rfind("point 550 INVALID_INPUT", 0), 0u);
+
   // The same GP declaring μ ≤ its median over these points: about half of them are clipped.
   const Points inside = random_points(600);
   std::vector<double> mu = local->evaluate(inside.block(), {}).mu;
