@@ -14,6 +14,7 @@
 #include "app/commands.hpp"
 #include "common/error.hpp"
 #include "common/version.hpp"
+#include "common/wording.hpp"
 
 namespace {
 
@@ -53,21 +54,6 @@ std::string one_line(std::string message) {
   return message;
 }
 
-// Edit distance with transpositions (optimal string alignment; Wagner & Fischer 1974, J. ACM 21:168,
-// with Damerau's adjacent swap): "predcit" is 1 from "predict".
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
-  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    for (size_t j = 1; j <= b.size(); ++j) {
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  }
-  return d[a.size()][b.size()];
-}
-
 // A suggestion for a mistyped subcommand: the first word of the command line that names no
 // subcommand where one is expected, and the nearest name there (at most two edits away).
 std::string subcommand_suggestion(const CLI::App& app, int argc, char** argv) {
@@ -79,18 +65,17 @@ std::string subcommand_suggestion(const CLI::App& app, int argc, char** argv) {
     const auto subcommands = level->get_subcommands([](const CLI::App*) { return true; });
     if (subcommands.empty()) return "";
     const CLI::App* exact = nullptr;
-    const CLI::App* nearest = nullptr;
-    size_t nearest_distance = kMostEdits + 1;
+    std::vector<std::string_view> names;
     for (const CLI::App* sub : subcommands) {
       if (sub->get_name() == word) exact = sub;
-      const size_t distance = edit_distance(word, sub->get_name());
-      if (distance < nearest_distance) nearest = sub, nearest_distance = distance;
+      names.push_back(sub->get_name());
     }
     if (exact) {
       level = exact;
       continue;
     }
-    return nearest ? "; did you mean `" + nearest->get_name() + "`?" : "";
+    const std::string_view nearest = mufric::nearest_word(word, names, kMostEdits);
+    return nearest.empty() ? "" : "; did you mean `" + std::string(nearest) + "`?";
   }
   return "";
 }

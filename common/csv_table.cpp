@@ -91,7 +91,7 @@ std::vector<double> CsvTable::si_column(const std::string& name, QuantityKind ki
   UnitToSi map{kind, 1.0, 0.0};
   if (!unit.empty()) {
     try {
-      map = unit_to_si(unit);
+      map = unit_to_si(unit, kind);
     } catch (const Error& e) {
       throw Error(path + ": column '" + name + "': " + e.what());
     }

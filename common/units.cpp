@@ -1,10 +1,13 @@
 #include "common/units.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "common/registry.hpp"
@@ -112,13 +115,40 @@ std::string_view example_quantity(QuantityKind kind) {
   return "";
 }
 
-UnitToSi unit_to_si(std::string_view unit) {
+std::string lower_case(std::string_view text) {
+  std::string lower(text);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower;
+}
+
+// The known unit a typo most likely meant, compared without case ("mpa" is MPa): one of the wanted
+// kind when a kind is wanted (a pressure's typo is never answered with a time), at most one edit per
+// two characters typed and never more than two ("psi" is no typo of "Pa").
+std::string_view nearest_unit(std::string_view unit, std::optional<QuantityKind> wanted) {
+  constexpr size_t kMostEdits = 2;
+  const size_t most_edits = std::min(kMostEdits, std::max<size_t>(1, unit.size() / 2));
+  const std::string typed = lower_case(unit);
+  std::vector<std::string> lowered;
+  std::vector<std::string_view> symbols;
+  for (const auto& entry : kUnits) {
+    if (wanted && entry.to_si.kind != *wanted) continue;
+    lowered.push_back(lower_case(entry.symbol));
+    symbols.push_back(entry.symbol);
+  }
+  const std::vector<std::string_view> candidates(lowered.begin(), lowered.end());
+  const std::string_view near = nearest_word(typed, candidates, most_edits);
+  if (near.empty()) return {};
+  return symbols[static_cast<size_t>(std::find(candidates.begin(), candidates.end(), near) - candidates.begin())];
+}
+
+UnitToSi unit_to_si(std::string_view unit, std::optional<QuantityKind> wanted) {
   unit = trim(unit);
   for (const auto& entry : kUnits) {
     if (entry.symbol == unit) return entry.to_si;
   }
-  throw Error("unknown unit '" + std::string(unit) +
-              "' (known: Pa kPa MPa GPa, m/s m/min mm/s, K C degC, rad deg, m mm um nm, s ms us ns, 1)");
+  const std::string_view near = nearest_unit(unit, wanted);
+  throw Error("unknown unit '" + std::string(unit) + "'" + (near.empty() ? "" : "; did you mean '" + std::string(near) + "'?") +
+              " (known: Pa kPa MPa GPa, m/s m/min mm/s, K C degC, rad deg, m mm um nm, s ms us ns, 1)");
 }
 
 double parse_quantity(std::string_view text, QuantityKind expected, std::string_view field) {
@@ -131,6 +161,11 @@ double parse_quantity(std::string_view text, QuantityKind expected, std::string_
                 std::string(example_quantity(expected)) + ")");
   }
   const std::string_view unit = trim(std::string_view(end, trimmed.data() + trimmed.size() - end));
+  if (unit.size() > 1 && unit.front() == ',' && std::isdigit(static_cast<unsigned char>(unit[1]))) {
+    std::string with_point(trimmed);
+    with_point[static_cast<size_t>(end - trimmed.data())] = '.';
+    throw Error(prefix + " has a decimal comma; mufric reads a decimal point: '" + with_point + "'");
+  }
   if (unit.empty() && expected != QuantityKind::dimensionless) {
     throw Error(prefix + " has no unit; " + with_article(to_string(expected)) +
                 " needs one, e.g. " + std::string(example_quantity(expected)));
@@ -138,7 +173,7 @@ double parse_quantity(std::string_view text, QuantityKind expected, std::string_
   if (unit.empty()) return value;
   UnitToSi map{};
   try {
-    map = unit_to_si(unit);
+    map = unit_to_si(unit, expected);
   } catch (const Error& e) {
     throw Error(prefix + ": " + e.what());
   }

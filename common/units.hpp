@@ -1,6 +1,7 @@
 #pragma once
 // Physical quantities with explicit units at the human boundary (CLI, CSV headers, plots);
 // SI everywhere inside: Pa, m/s, K, rad, m, s.
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,8 +24,9 @@ std::string_view si_unit(QuantityKind kind);
 std::string_view example_quantity(QuantityKind kind);
 
 // Looks up a unit symbol ("MPa", "m/min", "C", "degC", "°C", "K", "deg", ...).
-// Throws Error naming the unit when it is unknown.
-UnitToSi unit_to_si(std::string_view unit);
+// Throws Error naming the unit when it is unknown, with the nearest known one (of the wanted kind
+// when one is near) as a suggestion.
+UnitToSi unit_to_si(std::string_view unit, std::optional<QuantityKind> wanted = std::nullopt);
 
 // Parses "800MPa", "800 MPa", "1.2e9Pa", "100m/min", "500C". A number without a unit, an unknown
 // unit, or a unit of another kind throws Error whose message starts with `field`.

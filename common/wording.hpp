@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace mufric {
 
@@ -32,5 +33,11 @@ inline std::string duration_text(double seconds) {
   }
   return text;
 }
+
+// How many single-character insertions, deletions, substitutions or adjacent swaps turn a into b.
+size_t edit_distance(std::string_view a, std::string_view b);
+
+// The candidate fewest edits from word (the first of equals), if at most most_edits away; "" if none is.
+std::string_view nearest_word(std::string_view word, const std::vector<std::string_view>& candidates, size_t most_edits);
 
 }  // namespace mufric

@@ -45,6 +45,32 @@ TEST(Units, UnknownAndWrongKindUnitsAreErrors) {
   EXPECT_NE(message_of("nanMPa", QuantityKind::pressure).find("not a number"), std::string::npos);
 }
 
+// Issue 72: "10m/mn" and "1,5GPa" got "unknown unit" and nothing more.
+TEST(Units, AMistypedUnitGetsTheNearestKnownOneAndADecimalCommaIsNamed) {
+  EXPECT_NE(message_of("10m/mn", QuantityKind::velocity).find("unknown unit 'm/mn'; did you mean 'm/min'?"), std::string::npos)
+      << message_of("10m/mn", QuantityKind::velocity);
+  // the case alone: "Mpa" is MPa, not the nearer-by-edits "Pa"
+  EXPECT_NE(message_of("800Mpa", QuantityKind::pressure).find("did you mean 'MPa'?"), std::string::npos);
+  EXPECT_NE(message_of("800mpa", QuantityKind::pressure).find("did you mean 'MPa'?"), std::string::npos);
+  // a unit of the wanted kind before a nearer one of another: "Gpq" for a pressure is GPa
+  EXPECT_NE(message_of("1Gpq", QuantityKind::pressure).find("did you mean 'GPa'?"), std::string::npos);
+  EXPECT_NE(message_of("500degK", QuantityKind::temperature).find("did you mean 'degC'?"), std::string::npos);
+  // nothing near: no guess
+  EXPECT_EQ(message_of("800psi", QuantityKind::pressure).find("did you mean"), std::string::npos);
+  const std::string comma = message_of("1,5GPa", QuantityKind::pressure);
+  EXPECT_NE(comma.find("--p: '1,5GPa' has a decimal comma; mufric reads a decimal point: '1.5GPa'"), std::string::npos) << comma;
+  EXPECT_NE(message_of("12,5 m/min", QuantityKind::velocity).find("'12.5 m/min'"), std::string::npos);
+}
+
+TEST(Wording, EditDistanceCountsSwapsAsOneEdit) {
+  EXPECT_EQ(edit_distance("predcit", "predict"), 1u);
+  EXPECT_EQ(edit_distance("m/mn", "m/min"), 1u);
+  EXPECT_EQ(edit_distance("", "abc"), 3u);
+  EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);  // the textbook case
+  EXPECT_EQ(nearest_word("serv", {"predict", "serve", "server"}, 2), "serve");
+  EXPECT_EQ(nearest_word("xyz", {"predict", "serve"}, 2), "");
+}
+
 TEST(Wording, CountsAndArticles) {
   EXPECT_EQ(count_of(1, "file", "files"), "1 file");
   EXPECT_EQ(count_of(0, "file", "files"), "0 files");
