@@ -46,22 +46,11 @@ std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
   return std::shared_ptr<const GaussianProcess>(gp);
 }
 
-// The kind of quantity of each posterior coordinate (for printing it in its human unit).
-QuantityKind coordinate_kind(const CalibrationProblem& problem, Eigen::Index j) {
-  if (j < problem.parameter_count()) return kind_of_input(problem.parameters()[static_cast<size_t>(j)]);
-  if (j >= problem.latent_offset()) {
-    const Eigen::Index condition = problem.latent_cells()[static_cast<size_t>(j - problem.latent_offset())].second;
-    return kind_of_input(problem.data().condition_names[static_cast<size_t>(condition)]);
-  }
-  return QuantityKind::dimensionless;
-}
-
-
 void print_summary(const CalibrationProblem& problem, const CalibrationResult& result, double seconds) {
   std::printf("%-40s %12s %12s %27s %9s %7s\n", "parameter", "mean", "sd", "95 % credible interval", "split-R^", "ESS");
   for (size_t j = 0; j < result.summary.size(); ++j) {
     const ParameterSummary& s = result.summary[j];
-    const QuantityKind kind = coordinate_kind(problem, static_cast<Eigen::Index>(j));
+    const QuantityKind kind = problem.coordinate_kind(static_cast<Eigen::Index>(j));
     const std::string interval = format_human(s.lo95, kind) + " .. " + format_human(s.hi95, kind);
     std::printf("%-40s %12s %12s %27s %9.4f %7.0f\n", s.name.c_str(), format_human(s.mean, kind).c_str(),
                 format_human_difference(s.sd, kind).c_str(), interval.c_str(), s.split_rhat, s.effective_sample_size);

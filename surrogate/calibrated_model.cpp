@@ -206,9 +206,15 @@ std::string CalibratedModel::summary() const {
   if (p.latent_count() > 0) {
     s << "  " << p.latent_count() << " measured conditions known only within an uncertainty, sampled with the coefficients\n";
   }
-  for (const ParameterSummary& q : record_.posterior) {
-    s << "  posterior " << q.name << ": mean " << q.mean << ", sd " << q.sd << ", 95 % " << q.lo95 << " .. " << q.hi95
-      << " (split-R^ " << q.split_rhat << ", ESS " << q.effective_sample_size << ")\n";
+  for (size_t j = 0; j < record_.posterior.size(); ++j) {
+    const ParameterSummary& q = record_.posterior[j];
+    // in the units calibrate prints (MPa, °C), not SI
+    const QuantityKind kind = static_cast<Eigen::Index>(record_.posterior.size()) == p.dimension()
+                                  ? p.coordinate_kind(static_cast<Eigen::Index>(j))
+                                  : QuantityKind::dimensionless;
+    s << "  posterior " << q.name << ": mean " << format_human(q.mean, kind) << ", sd " << format_human_difference(q.sd, kind)
+      << ", 95 % " << format_human(q.lo95, kind) << " .. " << format_human(q.hi95, kind) << " (split-R^ " << q.split_rhat
+      << ", ESS " << q.effective_sample_size << ")\n";
   }
   s << "  sampler: " << record_.walkers << " walkers x " << record_.steps << " steps after " << record_.burn_in_steps
     << " burn-in, seed " << record_.seed << ", acceptance " << record_.acceptance << "\n";

@@ -564,6 +564,15 @@ Eigen::VectorXd CalibrationProblem::discrepancy_variance(const Eigen::MatrixXd& 
   return variance;
 }
 
+QuantityKind CalibrationProblem::coordinate_kind(Eigen::Index j) const {
+  if (j < parameter_count()) return kind_of_input(parameters_[static_cast<size_t>(j)]);
+  if (j >= latent_offset() && j < dimension()) {
+    const Eigen::Index condition = latent_cells_[static_cast<size_t>(j - latent_offset())].second;
+    return kind_of_input(data_.condition_names[static_cast<size_t>(condition)]);
+  }
+  return QuantityKind::dimensionless;
+}
+
 PosteriorPoint CalibrationProblem::point_at(const Eigen::VectorXd& natural) const {
   PosteriorPoint point;
   point.theta = natural.head(parameter_count());

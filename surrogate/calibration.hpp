@@ -157,6 +157,9 @@ class CalibrationProblem {
   // The data set (index) of each bias coordinate, and the (row, condition) of each latent one.
   const std::vector<int>& bias_sets() const { return bias_sets_; }
   const std::vector<std::pair<Eigen::Index, Eigen::Index>>& latent_cells() const { return latent_cells_; }
+  // The kind of quantity of coordinate j, for printing it in its unit: a coefficient's or a latent
+  // condition's input kind; δ's and the biases' dimensionless.
+  QuantityKind coordinate_kind(Eigen::Index j) const;
 
   // The point of natural coordinates (a row of CalibrationResult::samples).
   PosteriorPoint point_at(const Eigen::VectorXd& natural) const;

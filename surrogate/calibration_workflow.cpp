@@ -62,18 +62,24 @@ std::pair<std::string, double> parse_fixed(const GaussianProcess& model, const s
   return {name, value};
 }
 
-// The measurement files' names and '#' provenance lines.
+// The measurement files' names as given, their content's sha256 (a path can be deleted or its file
+// changed; the hash says which file it was) and their '#' provenance lines as the running text they
+// are (a line break in a comment is not a sentence's end).
 std::string data_source_of(const std::vector<std::string>& paths) {
   std::string source;
   for (const std::string& path : paths) {
     if (!source.empty()) source += " | ";
-    source += path;
-    std::istringstream lines(read_whole_file(path).value_or(""));
+    const std::string content = read_whole_file(path).value_or("");
+    source += path + " (sha256 " + sha256_hex(content) + ")";
+    std::istringstream lines(content);
+    std::string provenance;
     for (std::string line; std::getline(lines, line);) {
       if (line.rfind('#', 0) != 0) continue;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
       const auto text = line.find_first_not_of("# ");
-      if (text != std::string::npos) source += "; " + line.substr(text);
+      if (text != std::string::npos) provenance += (provenance.empty() ? "" : " ") + line.substr(text);
     }
+    if (!provenance.empty()) source += ": " + provenance;
   }
   return source;
 }

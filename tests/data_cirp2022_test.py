@@ -7,7 +7,8 @@
   3. one value of the source's figure against the value read by eye from its rendering;
   4. the rake-face analysis (rake_face.py) on forces made from a known friction angle and known edge
      forces: Merchant's closed form and the lines' intercepts come back;
-  5. where a copy of the source repository is given (MUFRIC_CIRP_REPO), the extraction re-run from it
+  5. the shipped model's measurement file (rake_face_mu_calibration.csv) against the validation's rows;
+  6. where a copy of the source repository is given (MUFRIC_CIRP_REPO), the extraction re-run from it
      gives the committed files byte for byte.
 Usage: data_cirp2022_test.py SOURCE_DIR"""
 import csv
@@ -217,6 +218,17 @@ class RakeFaceAnalysisOnKnownForces(unittest.TestCase):
             expected = math.sin(theta) / (math.cos(beta) * math.sin(phi)) * (1.0 + c_neq / (3.0 * math.tan(theta)))
             self.assertAlmostEqual(float(np.mean(r["contact_per_h"])), expected, places=6)
             self.assertAlmostEqual(float(np.mean(r["sliding_velocity"])), r["speed"] / 60.0 / 1.5, places=9)
+
+
+class CalibrationMeasurements(unittest.TestCase):
+    def test_the_shipped_models_measurement_file_is_what_the_validation_calibrates_on(self):
+        # campaigns/ti6al4v_tin/train.sh calibrates on the committed file, which its model records by
+        # path and hash; bench/ti6al4v_validation.py writes the rows it validates: the two must agree.
+        with tempfile.TemporaryDirectory() as folder:
+            written = Path(folder) / "rows.csv"
+            subprocess.run([sys.executable, str(SOURCE_DIR / "bench" / "ti6al4v_validation.py"), "--write-measurements",
+                            str(written)], check=True, capture_output=True)
+            self.assertEqual(written.read_text(), (DATA / "rake_face_mu_calibration.csv").read_text())
 
 
 class ReExtraction(unittest.TestCase):

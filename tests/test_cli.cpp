@@ -439,6 +439,16 @@ TEST_F(Cli, TheShippedTi6Al4VModelIsTheCalibration) {
   r = run("describe ti6al4v_tin");  // the build's copy, by its bare name
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("fast evaluator: grid"), std::string::npos) << r.output;  // stored only when it meets them
+  // It names the repository's data file and its hash, and the conditions' posterior in MPa and °C.
+  const std::string data_file = "data/cirp2022_ti6al4v_tin/rake_face_mu_calibration.csv";
+  const std::string hash = run_shell(std::string("sha256sum ") + MUFRIC_SOURCE_DIR "/" + data_file).output.substr(0, 64);
+  EXPECT_NE(r.output.find("measurements: " + data_file + " (sha256 " + hash + "): Rake-face friction"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("derived by; data/"), std::string::npos) << "a line break shown as '; '";
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("posterior contact_pressure \\(rake_face_mu_calibration.csv line 12\\): "
+                                                     "mean [0-9.]+MPa, sd [0-9.]+MPa, 95 % [0-9.]+MPa \\.\\. [0-9.]+MPa")))
+      << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("posterior temperature \\(rake_face_mu_calibration.csv line 12\\): mean [0-9.]+°C, sd [0-9.]+ K")))
+      << r.output;
   // The file keeps the priors a recalibration needs: an on-line learner takes it with its campaign.
   std::filesystem::create_directories(path("served"));
   std::filesystem::copy_file(MUFRIC_SOURCE_DIR "/models/ti6al4v_tin.h5", path("served/ti.h5"));
@@ -955,7 +965,7 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
       train << p << "," << v << "," << m << "," << synthetic_mu(p, v, m) << "\n";
     }
     std::ofstream measured(path("measured.csv"));
-    measured << "# synthetic: the campaign's mu at shear_factor 0.55, stated SD 0.01\n"
+    measured << "# synthetic: the campaign's mu at shear_factor 0.55,\n# stated SD 0.01\n"
              << "contact_pressure[MPa],sliding_velocity[m/min],mu,mu_sd\n";
     for (const auto& [p, v] : std::vector<std::pair<double, double>>{{400, 30}, {600, 120}, {800, 60}, {1000, 180}, {1200, 90}, {500, 150}}) {
       measured << p << "," << v << "," << synthetic_mu(p, v, 0.55) << ",0.01\n";
@@ -1002,7 +1012,13 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("kind calibrated"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("interval at the box centre: mu "), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("measurements: " + path("measured.csv") + "; synthetic"), std::string::npos) << r.output;
+  // the file by its path and content (issue 72: a deleted temporary path was all a model said), its
+  // provenance as the running text it is
+  const std::string hash = run_shell("sha256sum " + path("measured.csv")).output.substr(0, 64);
+  EXPECT_NE(r.output.find("measurements: " + path("measured.csv") + " (sha256 " + hash +
+                          "): synthetic: the campaign's mu at shear_factor 0.55, stated SD 0.01\n"),
+            std::string::npos)
+      << r.output;
   // `upgrade` grids a calibrated model as it grids a GP, and strips the grid again.
   r = run("upgrade " + path("served/calibrated.h5") + " --out " + path("graded.h5") + " --fast-max-work 0.05");
   ASSERT_EQ(r.exit_code, 0) << r.output;
