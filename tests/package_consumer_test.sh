@@ -53,4 +53,14 @@ echo "== a shipped model's name reaches <prefix>/share/mufric/models of the inst
 mkdir -p "$work/run/dry_default"
 mu=$(cd "$work/run" && "$work/make/shipped_model" dry_default)
 test "$mu" = 0.432100 || { echo "dry_default reached mu = $mu, not the installed prefix's 0.432100"; exit 1; }
+echo "== Python in-process: the installed module finds the installed library by itself"
+if /usr/bin/python3 -c "import numpy" 2>/dev/null; then
+  mu=$(cd "$work/run" && env -u MUFRIC_LIBRARY PYTHONPATH="$prefix/share/mufric/python" /usr/bin/python3 -c "
+from mufric_inprocess import open_model
+with open_model('dry_default') as m:
+    print('%.6f' % m.evaluate(contact_pressure=1e9, sliding_velocity=1.0, temperature=600.0).mu[0])")
+  test "$mu" = 0.432100 || { echo "Python in-process reached mu = $mu, not the installed prefix's 0.432100"; exit 1; }
+else
+  echo "no numpy for /usr/bin/python3: the Python in-process module skipped"
+fi
 echo "== every consumer built and ran"

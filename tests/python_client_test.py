@@ -26,6 +26,8 @@ for name in ("mufric", "stubs", "examples", "c-example", "c-driver"):
     parser.add_argument("--" + name, required=True)
 parser.add_argument("--fortran-driver")
 parser.add_argument("--vfriction")
+parser.add_argument("--library", help="libmufric.so, for the Python in-process module (client/python)")
+parser.add_argument("--inprocess-module", help="the folder of mufric_inprocess.py")
 args = parser.parse_args()
 mufric, c_example, c_driver, fortran_driver = args.mufric, args.c_example, args.c_driver, args.fortran_driver
 sys.path[:0] = [args.stubs, args.examples]
@@ -95,6 +97,63 @@ def run_driver(driver, uri, x, count_first):
         return None, out.stderr
     rows = np.array([[float(w) for w in line.split()] for line in out.stdout.splitlines() if line.strip()])
     return rows, ""
+
+
+def check_example_command_line(address):
+    """evaluate_block.py as a user runs it: points on its command line with units, one-line errors."""
+    example = [sys.executable, str(Path(args.examples) / "evaluate_block.py")]
+    env = {**os.environ, "PYTHONPATH": args.stubs}
+    run = lambda *a: subprocess.run(example + list(a), capture_output=True, text=True, timeout=60, env=env)  # noqa: E731
+    ok = run(address, "law", "--p", "50MPa", "0.12GPa", "--v", "10m/min", "--angle", "90deg")
+    answers = [line for line in ok.stdout.splitlines() if " mu " in line]
+    check(ok.returncode == 0 and len(answers) == 2 and "contact_pressure 120 MPa" in answers[1],
+          f"evaluate_block.py --p 50MPa 0.12GPa --v 10m/min: two points answered\n{ok.stdout}{ok.stderr}")
+    bad = run(address, "law", "--p", "800", "--v", "10m/min")
+    check(bad.returncode != 0 and "--p '800': give a number with a unit" in bad.stderr and "Traceback" not in bad.stderr,
+          f"a bare number refused in one line: {bad.stderr.strip()}")
+    missing = run(address, "no_such_model", "--timeout", "5")
+    check(missing.returncode == 2 and missing.stderr.count("\n") == 1 and "NOT_FOUND" in missing.stderr,
+          f"an unknown model: one line, NOT_FOUND: {missing.stderr.strip()}")
+    nobody = run("127.0.0.1:1", "--timeout", "0.5")
+    check(nobody.returncode == 2 and "no mufric server answered at 127.0.0.1:1" in nobody.stderr and "Traceback" not in nobody.stderr,
+          f"no server: one line: {nobody.stderr.strip()}")
+
+
+def check_python_in_process(tmp, queries, ref_mu, ref_std):
+    """client/python/mufric_inprocess.py: the C ABI through ctypes, no server (issue 72)."""
+    os.environ["MUFRIC_LIBRARY"] = args.library
+    sys.path.insert(0, args.inprocess_module)
+    import mufric_inprocess as mf
+    with mf.open_model(f"file://{tmp}/models/gp.h5", "fallback_mu=0.3") as model:
+        a = model.evaluate(contact_pressure=queries[:, 0], sliding_velocity=queries[:, 1], temperature=queries[:, 2])
+        check_gp_answer("Python in-process", a.mu, a.std, a.lo, a.hi, ref_mu, ref_std)
+        check(a.code == mf.OK and np.all(a.status == mf.POINT_OK) and a.message == "", "Python in-process: every point OK")
+        box = model.box()
+        check(sorted(box) == ["contact_pressure", "sliding_velocity", "temperature"], f"the box's inputs ({sorted(box)})")
+        p_hi = box["contact_pressure"][1]
+        # scalars spread over the block; one point above the pressure box, one invalid
+        b = model.evaluate(contact_pressure=np.array([0.5 * p_hi, 2 * p_hi, -5e6]), sliding_velocity=1.0, temperature=600.0)
+        check(b.status_names() == ["OK", "EXTRAPOLATED", "INVALID_INPUT"], f"statuses ({b.status_names()})")
+        check(b.code == mf.PARTIAL and "point 2 INVALID_INPUT: contact_pressure" in b.message, f"PARTIAL, why: {b.message!r}")
+        check(b.mu[2] == 0.3 and b.outside[1] == 2 and b.outside[0] == 0, "fallback mu; bit 1: pressure above the box")
+        check(b.counts["extrapolated"] == 1 and b.counts["invalid"] == 1, f"counts {b.counts}")
+        try:
+            model.evaluate(contact_pressure=[1e8, 2e8], sliding_velocity=[1.0, 2.0, 3.0], temperature=600.0)
+            check(False, "unequal arrays refused")
+        except ValueError as e:
+            check("contact_pressure 2, sliding_velocity 3" in str(e), f"unequal arrays named: {e}")
+        empty = model.evaluate(contact_pressure=[], sliding_velocity=[], temperature=[])
+        check(empty.code == mf.OK and len(empty.mu) == 0, "an empty block: no-op")
+    try:
+        mf.open_model(f"file://{tmp}/models/none.h5")
+        check(False, "a missing model file refused")
+    except mf.MufricError as e:
+        check("none.h5" in str(e), f"a missing model named: {e}")
+    try:
+        mf.open_model(f"file://{tmp}/models/gp.h5", "fallback=1")
+        check(False, "an unknown option refused")
+    except mf.MufricError as e:
+        check("fallback" in str(e), f"an unknown option named: {e}")
 
 
 def make_gp(tmp):
@@ -192,6 +251,9 @@ with tempfile.TemporaryDirectory() as tmp:
             if rows is not None and rows.shape == (len(queries), 5):
                 check_gp_answer(who, rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3], ref_mu, ref_std)
                 check(np.all(rows[:, 4] == 0), f"{who}: every point OK (statuses {rows[:, 4].astype(int).tolist()})")
+        if args.library:
+            check_python_in_process(tmp, queries, ref_mu, ref_std)
+        check_example_command_line(address)
         # The meso-trace example of the main job: a trace of Gauss points and the plot of mu over the box.
         trace = subprocess.run([sys.executable, str(Path(args.examples) / "meso_trace.py"), address, "gp", "--points", "300",
                                 "--increments", "5", "--plot", str(tmp / "mu.png")],
