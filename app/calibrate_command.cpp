@@ -14,6 +14,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/units.hpp"
+#include "common/wording.hpp"
 #include "surrogate/calibrated_model.hpp"
 #include "surrogate/calibration.hpp"
 #include "surrogate/calibration_workflow.hpp"
@@ -22,6 +23,8 @@
 
 namespace mufric::app {
 namespace {
+
+constexpr long long kDefaultPosteriorRows = 4000;
 
 struct CalibrateOptions {
   std::string model, out, model_out;
@@ -33,6 +36,9 @@ struct CalibrateOptions {
     return o;
   }();
   bool automatic_walkers = true;  // --walkers not given: at least four per coordinate
+  // --out's rows: evenly thinned to about this many (a long chain of many coordinates is tens of MB;
+  // a few thousand samples draw any histogram), 0 for every kept state.
+  long long out_samples = kDefaultPosteriorRows;
 };
 
 std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
@@ -71,10 +77,21 @@ void print_summary(const CalibrationProblem& problem, const CalibrationResult& r
   }
 }
 
+// Every how many kept states --out writes one.
+long long posterior_stride(long long kept, long long out_samples) {
+  return out_samples > 0 ? std::max(1LL, (kept + out_samples - 1) / out_samples) : 1;
+}
+
 void write_posterior(const std::string& path, const CalibrationProblem& problem, const CalibrationResult& result,
                      const CalibrateOptions& o) {
   std::ostringstream text;
-  text << "# posterior samples of mufric calibrate (every walker's kept states, natural units: SI for inputs and conditions)\n";
+  const Eigen::Index kept = result.samples.rows();
+  const Eigen::Index stride = posterior_stride(kept, o.out_samples);
+  text << "# posterior samples of mufric calibrate (natural units: SI for inputs and conditions): "
+       << (stride == 1 ? "every walker's kept states, " + std::to_string(kept)
+                       : "every " + std::to_string(stride) + "th of the walkers' " + std::to_string(kept) +
+                             " kept states (--out-samples 0 for all)")
+       << "\n";
   text << "# model " << o.model << ", measurements";
   for (const std::string& data : o.request.data_files) text << " " << data;
   text << (o.request.priors_file.empty() ? "" : ", priors " + o.request.priors_file) << ", seed " << o.sampler.seed << "\n";
@@ -82,7 +99,7 @@ void write_posterior(const std::string& path, const CalibrationProblem& problem,
   for (size_t j = 0; j < names.size(); ++j) text << (j ? "," : "") << names[j];
   text << "\n";
   char number[32];
-  for (Eigen::Index i = 0; i < result.samples.rows(); ++i) {
+  for (Eigen::Index i = 0; i < kept; i += stride) {
     for (Eigen::Index j = 0; j < result.samples.cols(); ++j) {
       std::snprintf(number, sizeof number, "%.17g", result.samples(i, j));
       text << (j ? "," : "") << number;
@@ -111,9 +128,11 @@ void calibrate_command(const CalibrateOptions& o) {
   const CalibrationSetup setup = prepare_calibration(load_emulator(o.model), o.request);
   const CalibrationProblem& problem = *setup.problem;
   for (const std::string& warning : setup.warnings) std::printf("warning: %s\n", warning.c_str());
-  std::printf("calibrating %lld coefficient(s) against %lld measurements in %zu data set(s), discrepancy %s",
-              static_cast<long long>(problem.parameter_count()), static_cast<long long>(problem.data().rows()),
-              problem.data().data_sets.size(), problem.discrepancy() ? "on" : "off");
+  std::printf("calibrating %s against %s in %s, discrepancy %s",
+              count_of(problem.parameter_count(), "coefficient", "coefficients").c_str(),
+              count_of(problem.data().rows(), "measurement", "measurements").c_str(),
+              count_of(static_cast<long long>(problem.data().data_sets.size()), "data set", "data sets").c_str(),
+              problem.discrepancy() ? "on" : "off");
   if (problem.priors().discrepancy_trend_sd > 0.0) {
     std::printf(" with a linear trend (its coefficients normal(0, %g))", problem.priors().discrepancy_trend_sd);
   }
@@ -154,13 +173,17 @@ void calibrate_command(const CalibrateOptions& o) {
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   print_summary(problem, result, seconds);
+  for (const std::string& warning : posterior_warnings(problem, result)) std::printf("warning: %s\n", warning.c_str());
   std::fflush(stdout);
   if (!result.convergence_failure.empty()) {
     throw Error("the posterior is not usable, nothing written: " + result.convergence_failure);
   }
   if (!o.out.empty()) {
     write_posterior(o.out, problem, result, o);
-    std::printf("wrote %s (%lld samples)\n", o.out.c_str(), static_cast<long long>(result.samples.rows()));
+    const long long kept = result.samples.rows();
+    const long long stride = posterior_stride(kept, o.out_samples);
+    std::printf("wrote %s (%lld of %lld kept samples%s)\n", o.out.c_str(), (kept + stride - 1) / stride, kept,
+                stride > 1 ? ", evenly thinned; --out-samples 0 for all" : "");
   }
   if (!o.model_out.empty()) write_calibrated_model(o, setup, result);
 }
@@ -220,6 +243,11 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--seed", o->sampler.seed, "Seed: the same seed, data and model give the same posterior, bit for bit")
       ->capture_default_str();
   cmd->add_option("--out", o->out, "Write the posterior samples here (CSV, one column per parameter)");
+  cmd->add_option("--out-samples", o->out_samples,
+                  "--out's rows: the kept samples evenly thinned to at most this many (0: every kept state, which for\n"
+                  "many coordinates and a long chain is tens of MB)")
+      ->capture_default_str()
+      ->check(CLI::Range(0LL, 1000000000LL));
   cmd->add_option("--model-out", o->model_out,
                   "Write the calibrated model here (HDF5): mu(conditions) as the posterior predictive, its interval the\n"
                   "roughness mean, the coefficients' posterior and delta; served, described and evaluated like any model");

@@ -106,7 +106,7 @@ void plan_command(const PlanOptions& o) {
   spec.source = "micro-model plan (" + scene_label + ")";
   const Dataset plan = empty_dataset(spec);
   write_dataset(o.out, plan);
-  std::printf("wrote %s: %lld points, %s design (seed %llu), %s, scene %s (sha256 %s)\n", o.out.c_str(), o.samples,
+  std::printf("wrote %s: %s, %s design (seed %llu), %s, scene %s (sha256 %s)\n", o.out.c_str(), count_of(o.samples, "point", "points").c_str(),
               plan.plan_design.c_str(), o.seed,
               o.common_tools ? "every row on the scene's own tool and chip surfaces (common draws)"
                              : "every row its own tool and chip surfaces (independent draws)",
@@ -215,8 +215,8 @@ void refine_command(const RefineCommandOptions& c) {
     std::printf("round %d: %lld training samples, LOO mean relative error %.3f %%, max %.3f %%", r.round,
                 r.training_samples, 100.0 * r.loo_mean_relative_error, 100.0 * r.loo_max_relative_error);
     if (r.held_out != nullptr) {
-      std::printf("; held-out (%s, %lld points) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", r.held_out_source.c_str(),
-                  r.held_out->points, 100.0 * r.held_out->mean_relative_error, 100.0 * r.held_out->max_relative_error,
+      std::printf("; held-out (%s, %s) mean %.3f %%, max %.3f %%, 95 %% coverage %.1f %%", r.held_out_source.c_str(),
+                  count_of(r.held_out->points, "point", "points").c_str(), 100.0 * r.held_out->mean_relative_error, 100.0 * r.held_out->max_relative_error,
                   100.0 * r.held_out->coverage);
     }
     std::printf("\n");
@@ -260,7 +260,7 @@ void status_command(const std::string& path) {
   }
   std::printf("%s: %s\n  code %s, created %s, scene sha256 %s\n", path.c_str(), d.source.c_str(), d.code_version.c_str(),
               d.created_utc.c_str(), d.scene_json.empty() ? "(none)" : sha256_hex(d.scene_json).substr(0, 12).c_str());
-  std::printf("  plan: %lld points%s%s", static_cast<long long>(d.plan.rows()), d.plan_design.empty() ? "" : ", design ",
+  std::printf("  plan: %s%s%s", count_of(static_cast<long long>(d.plan.rows()), "point", "points").c_str(), d.plan_design.empty() ? "" : ", design ",
               d.plan_design.c_str());
   if (!d.plan_design.empty()) std::printf(" (seed %lld)", d.plan_seed);
   std::printf("; draws %s", d.draws == DrawDesign::independent ? "independent (every row its own tool and chip surfaces)"

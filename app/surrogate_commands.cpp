@@ -248,8 +248,8 @@ void add_eval(CLI::App& app) {
     const auto model = load_model_isolated(model_path_from_uri(o->model));
     const TrainingSet test = training_set(read_dataset_isolated(o->test), o->test);
     const AccuracyReport r = held_out_accuracy(*model, test, o->level);
-    std::printf("model %s (%s) on %s: %lld points (%lld outside the training box)\n", o->model.c_str(),
-                std::string(model->kind()).c_str(), o->test.c_str(), r.points, r.extrapolated);
+    std::printf("model %s (%s) on %s: %s (%lld outside the training box)\n", o->model.c_str(),
+                std::string(model->kind()).c_str(), o->test.c_str(), count_of(r.points, "point", "points").c_str(), r.extrapolated);
     std::printf("mean relative error %.4f %%\nmax relative error  %.4f %%\nRMSE                %.4g\n"
                 "%.0f %% interval coverage %.1f %%\nevaluation          %.3g us per point (mean + interval)\n",
                 100 * r.mean_relative_error, 100 * r.max_relative_error, r.rmse, 100 * o->level, 100 * r.coverage,
@@ -410,7 +410,8 @@ void add_predict(CLI::App& app) {
         std::fprintf(out, "\n");
       }
       if (out != stdout && std::fclose(out) != 0) throw Error(o->out + ": write failed");
-      std::fprintf(stderr, "%zu points (%lld answered by the fast evaluator)\n", n, a.fast_points);
+      std::fprintf(stderr, "%s (%lld answered by the fast evaluator)\n", count_of(static_cast<long long>(n), "point", "points").c_str(),
+                   a.fast_points);
     } else if (!has_no_answer(a.status[0])) {  // a point without an answer gets its error line alone
       for (size_t j = 0; j < inputs.size(); ++j) {
         std::printf("%s%s = %s", j ? ", " : "", inputs[j].name.c_str(), format_human(points.columns[j][0], inputs[j].kind()).c_str());

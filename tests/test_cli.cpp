@@ -1002,6 +1002,57 @@ TEST_F(Cli, CalibrateFindsTheShearFactorThatMadeTheMeasurements) {
   EXPECT_NE(posterior.find("\nshear_factor\n"), std::string::npos);
   ASSERT_EQ(run(calibrate + path("again.csv")).exit_code, 0);
   EXPECT_EQ(read_text(path("again.csv")), posterior) << "the same seed, the same posterior";
+  // --out is thinned evenly to --out-samples rows (issue 72: 75 MB by default); 0 writes every state.
+  const auto rows_of = [](const std::string& text) { return std::count(text.begin(), text.end(), '\n') - 3; };  // two comment lines and the names
+  ASSERT_EQ(run(calibrate + path("all.csv") + " --out-samples 0").exit_code, 0);
+  const std::string all = read_text(path("all.csv"));
+  ASSERT_GT(rows_of(all), 1000) << all.substr(0, 300);
+  r = run(calibrate + path("thin.csv") + " --out-samples 100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string thin = read_text(path("thin.csv"));
+  EXPECT_LE(rows_of(thin), 100);
+  EXPECT_GT(rows_of(thin), 50);
+  EXPECT_NE(r.output.find("evenly thinned; --out-samples 0 for all"), std::string::npos) << r.output;
+  // the thinned file's first sample row is the full chain's first, its second the stride-th
+  const auto sample_row = [](const std::string& text, int k) {
+    std::istringstream in(text);
+    std::string line;
+    for (int i = 0; i < 3 + k; ++i) std::getline(in, line);
+    return line;
+  };
+  const long long stride = (rows_of(all) + 99) / 100;
+  EXPECT_EQ(sample_row(thin, 1), sample_row(all, 1));
+  EXPECT_EQ(sample_row(thin, 2), sample_row(all, static_cast<int>(1 + stride)));
+  EXPECT_EQ(r.output.find("hardly inform"), std::string::npos) << "six rows of SD 0.01 inform m: " << r.output;
+  EXPECT_NE(r.output.find("against 6 measurements in 1 data set,"), std::string::npos) << r.output;
+
+  // One row with the discrepancy on: δ explains it alone and m keeps its prior, which calibrate says
+  // (issue 72: exit 0 without a word, and "1 measurements").
+  {
+    std::ifstream full(path("measured.csv"));
+    std::ofstream one(path("one.csv"));
+    std::string line;
+    for (int i = 0; i < 4 && std::getline(full, line); ++i) one << line << "\n";  // two comments, the header, one row
+  }
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("one.csv") +
+          " --discrepancy --walkers 16 --burn-in 300 --steps 1200 --seed 5");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("against 1 measurement in 1 data set,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("warning: with the discrepancy on, 1 measurement cannot tell δ from the law"), std::string::npos)
+      << r.output;
+  // Six rows whose SD (0.5) dwarfs what m changes in μ: the posterior is the prior, and calibrate says so.
+  {
+    std::ifstream full(path("measured.csv"));
+    std::ofstream vague(path("vague.csv"));
+    for (std::string line; std::getline(full, line);) {
+      vague << (line.size() > 5 && line.substr(line.size() - 5) == ",0.01" ? line.substr(0, line.size() - 5) + ",0.5" : line) << "\n";
+    }
+  }
+  r = run("calibrate --model " + path("campaign.h5") + " --data " + path("vague.csv") + " --walkers 12 --burn-in 300 --steps 1200 --seed 5");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: shear_factor: its posterior SD is"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("of its prior's (uniform(0.2, 0.9) within the box): the measurements hardly inform it"), std::string::npos)
+      << r.output;
 
   // The calibrated model: read from its file and served, the same μ both ways; describe shows its parts.
   std::filesystem::create_directories(path("served"));
