@@ -1,5 +1,5 @@
 #pragma once
-// The training database (ARCHITECTURE.md "Dataset"): one HDF5 file, SI units, self-describing.
+// The training database (docs/formats.md, "The dataset file"): one HDF5 file, SI units, self-describing.
 //   /samples/inputs n×d, /samples/mu n, /samples/mu_std n (μ's standard error over tool phases and
 //   realisations; NaN where not known), /samples/status n (0 converged, 1 failed, 2 outside the
 //   model: completed, but e.g. molten), /samples/failure_reason n (why failed / outside the model),

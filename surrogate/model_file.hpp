@@ -1,5 +1,5 @@
 #pragma once
-// Model files (ARCHITECTURE.md "Model"): one HDF5 file per model, self-describing and versioned.
+// Model files (docs/formats.md, "The model file"): one HDF5 file per model, self-describing and versioned.
 //   /  attributes format = "mufric-model", schema_version, kind (gp | mlr | coulomb | calibrated),
 //      code_version, created_utc;   /inputs (names, SI units, box);   /<kind> the model's own data.
 // Loading validates everything and refuses a corrupt or incompatible file naming the field.

@@ -12,7 +12,7 @@ source_dir=$(realpath "$1") mufric=$(realpath "$2") binary=${3:-prebuilt}
 skip() { echo "SKIPPED: $*"; exit 77; }
 command -v podman >/dev/null || skip "podman is not installed (deploy/install-deps.sh installs it)"
 command -v mmdebstrap >/dev/null || skip "mmdebstrap is not installed"
-[[ $(id -u) == 0 ]] || skip "needs root (rootful podman with runc; this sandbox's recipe: shared/notes/containers-offline.md)"
+[[ $(id -u) == 0 ]] || skip "needs root (rootful podman with runc and the offline Debian base image mmdebstrap builds)"
 export CONTAINERS_CONF=$source_dir/deploy/podman/containers.conf
 podman info >/dev/null 2>&1 || skip "podman cannot run here: $(podman info 2>&1 | tail -1)"
 set -e

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # A single-node Slurm cluster for tests and benchmarks on one Debian 12 machine (as root; slurm-wlm and
 # munge from deploy/install-deps.sh): munge, slurmctld and slurmd with their state in a directory of
-# their own and the config passed by SLURM_CONF, so /etc/slurm is untouched
-# (../shared/notes/single-node-slurm.md is the recipe). Source it, then
+# their own and the config passed by SLURM_CONF, so /etc/slurm is untouched (one slurm.conf naming
+# this host as controller and node, process tracking by /proc, no cgroups; munged reused or started). Source it, then
 #   single_node_slurm_start DIR   # exports SLURM_CONF=DIR/slurm.conf; returns 1 (with the logs) if the node does not come up
 #   single_node_slurm_stop DIR    # stops exactly the daemons started with DIR's config, and a munged it started
 #   single_node_slurm_until_exit  # for a benchmark script: refuses (exit 2) without root, slurm-wlm or
