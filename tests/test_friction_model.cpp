@@ -176,8 +176,11 @@ TEST(FrictionModel, PointReasonsNameTheInputAndTheSide) {
   const std::vector<PointStatus> status{PointStatus::ok, PointStatus::invalid_input, PointStatus::out_of_box};
   EXPECT_EQ(unanswered_points_message(box, x, status),
             "point 1 INVALID_INPUT: contact_pressure: -5MPa is below 0MPa, the least a pressure can be (and 1 more "
-            "points without an answer)");
+            "point without an answer)");
   EXPECT_EQ(unanswered_points_message(box, x, {PointStatus::ok, PointStatus::ok, PointStatus::extrapolated}), "");
+  EXPECT_EQ(more_points_tail(0, false), "");
+  EXPECT_EQ(more_points_tail(2, false), " (and 2 more points without an answer)");
+  EXPECT_EQ(more_points_tail(1, true), " (and 1 more point outside the box)");
 }
 
 }  // namespace
