@@ -475,18 +475,27 @@ long long quarantine_round(const std::string& db_path, const LearnRound& round) 
 // Step 5: gated, and published or kept aside.
 void gate_round(const std::string& dir, LearnState& s, const LearnRunOptions& o) {
   LearnRound& round = s.rounds.back();
-  const std::unique_ptr<FrictionModel> served = load_served(s.setup.served_model, "served model");
-  const std::unique_ptr<FrictionModel> candidate = load_served(round.candidate, "candidate");
-  say(o, format("round %d: gating %s against the served model", round.number, round.version.c_str()));
-  const CalibratedModel *served_calibrated = as_calibrated(*served), *candidate_calibrated = as_calibrated(*candidate);
-  if ((served_calibrated == nullptr) != (candidate_calibrated == nullptr)) {  // the served file was replaced meanwhile
-    round.gate = GateDecision{};
-    round.gate.reason = "the candidate is a " + std::string(candidate->kind()) + " model and the served one now a " +
-                        std::string(served->kind()) + " model";
-  } else if (served_calibrated != nullptr) {
-    round.gate = gate_calibrated_candidate(*served_calibrated, *candidate_calibrated, o.fast);
+  // The decision is recorded before it is carried out and never made twice: a learner stopped after
+  // publishing and before recording it would otherwise gate the candidate against itself (now the
+  // served file) and keep it aside as adding no point.
+  if (round.gate.reason.empty()) {
+    const std::unique_ptr<FrictionModel> served = load_served(s.setup.served_model, "served model");
+    const std::unique_ptr<FrictionModel> candidate = load_served(round.candidate, "candidate");
+    say(o, format("round %d: gating %s against the served model", round.number, round.version.c_str()));
+    const CalibratedModel *served_calibrated = as_calibrated(*served), *candidate_calibrated = as_calibrated(*candidate);
+    if ((served_calibrated == nullptr) != (candidate_calibrated == nullptr)) {  // the served file was replaced meanwhile
+      round.gate = GateDecision{};
+      round.gate.reason = "the candidate is a " + std::string(candidate->kind()) + " model and the served one now a " +
+                          std::string(served->kind()) + " model";
+    } else if (served_calibrated != nullptr) {
+      round.gate = gate_calibrated_candidate(*served_calibrated, *candidate_calibrated, o.fast);
+    } else {
+      round.gate = gate_candidate(campaign_gp_of(*served), campaign_gp_of(*candidate), o.fast);
+    }
+    write_state(dir, s);
   } else {
-    round.gate = gate_candidate(campaign_gp_of(*served), campaign_gp_of(*candidate), o.fast);
+    say(o, format("round %d: carrying out the gate's decision on %s, made before the learner stopped", round.number,
+                  round.version.c_str()));
   }
   if (round.gate.publish) {
     keep_version(dir, s, round.candidate, "published by round " + std::to_string(round.number));

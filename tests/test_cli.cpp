@@ -1365,6 +1365,32 @@ TEST_F(Cli, LearnerSurvivesKillNineAndPublishesAGatedRound) {
   EXPECT_NE(r.output.find("its samples were made by another simulator"), std::string::npos) << r.output;
 }
 
+// A learner stopped after it published a round and before it recorded so (the served file already
+// the candidate, the state still at the gate step) carries out the decision it recorded instead of
+// gating the candidate against itself: it was kept aside as "adding no converged point" (found by
+// the kill -9 test above under ASan, where the stop fell there).
+TEST_F(Cli, ALearnerStoppedBetweenPublishingAndRecordingItKeepsThePublication) {
+  const std::string simulator = MUFRIC_SOURCE_DIR "/models/dry_default.h5";
+  set_up_learner(dir_, simulator);
+  CommandResult r = run("learn run " + path("learner") + " --simulator " + simulator);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_NE(r.output.find("round 1: published "), std::string::npos) << r.output;
+  const std::string served_bytes = read_text(path("served/gp.h5"));
+  nlohmann::json state = nlohmann::json::parse(read_text(path("learner/learn.json")));
+  ASSERT_EQ(state["rounds"].back()["step"], "done");
+  state["rounds"].back()["step"] = "gate";  // the stop: the copy done, its record not written
+  state["rounds"].back().erase("finished_utc");
+  std::ofstream(path("learner/learn.json")) << state.dump(2);
+  r = run("learn run " + path("learner") + " --simulator " + simulator);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("round 1: carrying out the gate's decision"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("round 1: published "), std::string::npos) << r.output;
+  EXPECT_EQ(read_text(path("served/gp.h5")), served_bytes);
+  r = run("learn status " + path("learner"));
+  EXPECT_NE(r.output.find("published "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("kept aside"), std::string::npos) << r.output;
+}
+
 // A learner round through Slurm whose controller stops answering for a while (slurmctld restarting):
 // the learner waits for the submitted jobs instead of taking them for gone and submitting the round
 // again. Slurm is faked on PATH: sbatch runs the project's job scripts in the background
