@@ -82,8 +82,9 @@ long long posterior_stride(long long kept, long long out_samples) {
   return out_samples > 0 ? std::max(1LL, (kept + out_samples - 1) / out_samples) : 1;
 }
 
-void write_posterior(const std::string& path, const CalibrationProblem& problem, const CalibrationResult& result,
-                     const CalibrateOptions& o) {
+// Writes --out and returns how many samples it holds.
+long long write_posterior(const std::string& path, const CalibrationProblem& problem, const CalibrationResult& result,
+                          const CalibrateOptions& o) {
   std::ostringstream text;
   const Eigen::Index kept = result.samples.rows();
   const Eigen::Index stride = posterior_stride(kept, o.out_samples);
@@ -107,6 +108,7 @@ void write_posterior(const std::string& path, const CalibrationProblem& problem,
     text << "\n";
   }
   write_file_atomically(path, text.str());
+  return (kept + stride - 1) / stride;
 }
 
 // The calibrated model: served like any other, with a fast evaluator certified against it.
@@ -179,11 +181,10 @@ void calibrate_command(const CalibrateOptions& o) {
     throw Error("the posterior is not usable, nothing written: " + result.convergence_failure);
   }
   if (!o.out.empty()) {
-    write_posterior(o.out, problem, result, o);
     const long long kept = result.samples.rows();
-    const long long stride = posterior_stride(kept, o.out_samples);
-    std::printf("wrote %s (%lld of %lld kept samples%s)\n", o.out.c_str(), (kept + stride - 1) / stride, kept,
-                stride > 1 ? ", evenly thinned; --out-samples 0 for all" : "");
+    const long long written = write_posterior(o.out, problem, result, o);
+    std::printf("wrote %s (%lld of %lld kept samples%s)\n", o.out.c_str(), written, kept,
+                written < kept ? ", evenly thinned; --out-samples 0 for all" : "");
   }
   if (!o.model_out.empty()) write_calibrated_model(o, setup, result);
 }

@@ -292,14 +292,9 @@ std::string extrapolation_account(const InputSpace& inputs, const PredictPoints&
   if (policy != Extrapolation::clamp) {
     return "answered by the raw model beyond its data (policy raw): its interval says how little it knows there";
   }
-  std::string at;
-  for (size_t j = 0; j < inputs.size(); ++j) {
-    const double x = points.columns[j][0];
-    if (inputs[j].kind() == QuantityKind::angle || inputs[j].contains(x)) continue;
-    const double face = x < inputs[j].lo ? inputs[j].lo : inputs[j].hi;
-    at += (at.empty() ? "" : ", ") + inputs[j].name + " = " + format_human(face, inputs[j].kind());
-  }
-  return "answered at " + at + " (policy clamp: mu of the nearest point of the box, its interval widened by the "
+  std::vector<double> first(inputs.size());
+  for (size_t j = 0; j < inputs.size(); ++j) first[j] = points.columns[j][0];
+  return "answered at " + clamped_face_text(inputs, first.data()) + " (policy clamp: mu of the nearest point of the box, its interval widened by the "
          "distance; --extrapolation raw or refuse to choose otherwise)";
 }
 
@@ -421,8 +416,7 @@ void add_predict(CLI::App& app) {
                   a.fast_points > 0 ? "fast evaluator" : "exact model");
       if (a.status[0] == PointStatus::extrapolated) {
         std::printf("  outside the training box: %s\n", reason_of(0).c_str());
-        const Extrapolation policy = what.extrapolation == Extrapolation::model_default ? info.extrapolation : what.extrapolation;
-        std::printf("  %s\n", extrapolation_account(inputs, points, policy).c_str());
+        std::printf("  %s\n", extrapolation_account(inputs, points, effective_extrapolation(what.extrapolation, info.extrapolation)).c_str());
       }
       if (patch) {
         std::printf("  patch scatter %.3g: one contact patch's mu scatters about this mean with this standard deviation "

@@ -151,12 +151,8 @@ class InProcessClient final : public FrictionClient {
     a.status = e.status;
     a.fast_points = e.fast_points;
     a.range_clipped = e.range_clipped;
-    a.message = unanswered_points_message(inputs, x, a.status);  // the server's words for the same block
-    if (a.message.empty()) {
-      const Extrapolation policy =
-          what.extrapolation == Extrapolation::model_default ? model_->default_extrapolation() : what.extrapolation;
-      a.message = extrapolated_points_message(inputs, x, a.status, policy);
-    }
+    // the server's words for the same block
+    a.message = block_message(inputs, x, a.status, effective_extrapolation(what.extrapolation, model_->default_extrapolation()));
     fill_unanswered(a, unanswered_);
     return a;
   }
@@ -276,7 +272,7 @@ class GrpcClient final : public FrictionClient {
       append(response, first, answer);
       if (block.points == 0) break;
     }
-    if (!answer.message.empty() && chunk < block.points) answer.message = block_message(answer);
+    if (!answer.message.empty() && chunk < block.points) answer.message = whole_block_message(answer);
     fill_unanswered(answer, {options_.fill, options_.fallback_mu});
     return answer;
   }
@@ -422,23 +418,12 @@ class GrpcClient final : public FrictionClient {
     return message.rfind("point ", 0) == 0 && message.find(" EXTRAPOLATED: ") != std::string::npos;
   }
 
-  // N of " (and N more ...)", 0 when not a count.
-  static long long count_in_tail(const std::string& tail) {
-    constexpr std::string_view prefix = " (and ";
-    long long n = 0;
-    const char* begin = tail.data() + prefix.size();
-    const auto [end, ec] = std::from_chars(begin, tail.data() + tail.size(), n);
-    return ec == std::errc() && end != begin ? n : 0;
-  }
-
   // The whole block's count of further unanswered (or extrapolated) points in place of the first call's.
-  static std::string block_message(const Answer& answer) {
+  static std::string whole_block_message(const Answer& answer) {
     const bool extrapolated = tells_extrapolated(answer.message);
     std::string message = answer.message;
     const auto tail = message.rfind(" (and ");
-    if (tail != std::string::npos && message.substr(tail) == more_points_tail(count_in_tail(message.substr(tail)), extrapolated)) {
-      message.erase(tail);
-    }
+    if (tail != std::string::npos && message.ends_with(extrapolated ? " outside the box)" : " without an answer)")) message.erase(tail);
     const auto counted = extrapolated ? std::count(answer.status.begin(), answer.status.end(), PointStatus::extrapolated)
                                       : std::count_if(answer.status.begin(), answer.status.end(), has_no_answer);
     return message + more_points_tail(counted - 1, extrapolated);

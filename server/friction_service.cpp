@@ -234,16 +234,11 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   response.set_fast_points(fast);
   response.set_out_of_box_points(out_of_box);
   response.set_range_clipped_points(clipped);
-  if (invalid + out_of_box > 0) {
+  if (invalid + out_of_box + extrapolated > 0) {
     std::vector<PointStatus> all(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) all[static_cast<size_t>(i)] = static_cast<PointStatus>(response.status(i));
-    response.set_message(unanswered_points_message(model.inputs(), batch, all));
-  } else if (extrapolated > 0) {
-    std::vector<PointStatus> all(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) all[static_cast<size_t>(i)] = static_cast<PointStatus>(response.status(i));
-    const Extrapolation policy =
-        what.extrapolation == Extrapolation::model_default ? model.default_extrapolation() : what.extrapolation;
-    response.set_message(extrapolated_points_message(model.inputs(), batch, all, policy));
+    response.set_message(block_message(model.inputs(), batch, all,
+                                       effective_extrapolation(what.extrapolation, model.default_extrapolation())));
   }
   counters_.fast_points += static_cast<long long>(fast);
   for (auto& name : ignored) response.add_ignored_inputs(std::move(name));

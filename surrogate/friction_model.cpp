@@ -111,8 +111,7 @@ Evaluation FrictionModel::evaluate(const QueryBatch& x, const EvaluationRequest&
     throw Error("query has " + std::to_string(x.cols()) + " inputs, the model expects " + std::to_string(d));
   }
   const double z = what.ci_level > 0.0 ? normal_quantile_two_sided(what.ci_level) : 0.0;
-  const Extrapolation policy =
-      what.extrapolation == Extrapolation::model_default ? default_extrapolation_ : what.extrapolation;
+  const Extrapolation policy = effective_extrapolation(what.extrapolation, default_extrapolation_);
   const Eigen::Index m = x.rows();
   Evaluation out;
   out.status.assign(static_cast<size_t>(m), PointStatus::ok);
@@ -230,6 +229,22 @@ std::string more_points_tail(long long more, bool extrapolated) {
          (extrapolated ? "outside the box)" : "without an answer)");
 }
 
+std::string clamped_face_text(const InputSpace& inputs, const double* x) {
+  std::string at;
+  for (size_t j = 0; j < inputs.size(); ++j) {
+    if (!clamped_input(inputs[j]) || inputs[j].contains(x[j])) continue;
+    const double face = x[j] < inputs[j].lo ? inputs[j].lo : inputs[j].hi;
+    at += (at.empty() ? "" : ", ") + inputs[j].name + " = " + format_human(face, inputs[j].kind());
+  }
+  return at;
+}
+
+std::string block_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status,
+                          Extrapolation policy) {
+  std::string message = unanswered_points_message(inputs, x, status);
+  return message.empty() ? extrapolated_points_message(inputs, x, status, policy) : message;
+}
+
 std::string extrapolated_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status,
                                         Extrapolation policy) {
   long long outside = 0;
@@ -240,13 +255,7 @@ std::string extrapolated_points_message(const InputSpace& inputs, const QueryBat
     const Eigen::RowVectorXd row = x.row(static_cast<Eigen::Index>(i));
     first = "point " + std::to_string(i) + " EXTRAPOLATED: " + point_reason(inputs, row.data()) + "; answered ";
     if (policy == Extrapolation::clamp) {
-      std::string at;
-      for (size_t j = 0; j < inputs.size(); ++j) {
-        if (!clamped_input(inputs[j]) || inputs[j].contains(row(static_cast<Eigen::Index>(j)))) continue;
-        const double face = row(static_cast<Eigen::Index>(j)) < inputs[j].lo ? inputs[j].lo : inputs[j].hi;
-        at += (at.empty() ? "" : ", ") + inputs[j].name + " = " + format_human(face, inputs[j].kind());
-      }
-      first += "at " + at + " (clamp)";
+      first += "at " + clamped_face_text(inputs, row.data()) + " (clamp)";
     } else {
       first += "by the raw model beyond its data (raw)";
     }

@@ -35,6 +35,10 @@ enum class Extrapolation : std::uint8_t { model_default = 0, raw = 1, clamp = 2,
 std::string_view to_string(Extrapolation policy);
 // "raw", "clamp" or "refuse"; throws mufric::Error naming the word otherwise.
 Extrapolation extrapolation_from_string(std::string_view word);
+// The policy a request is answered by: its own, or the model's when it asks for the model's default.
+inline Extrapolation effective_extrapolation(Extrapolation requested, Extrapolation model_default) {
+  return requested == Extrapolation::model_default ? model_default : requested;
+}
 
 // What the caller needs; nothing more is computed.
 struct EvaluationRequest {
@@ -181,6 +185,14 @@ std::string unanswered_points_message(const InputSpace& inputs, const QueryBatch
 // (300MPa to 2000MPa); answered at contact_pressure = 2000MPa (clamp)". "" when none is outside.
 std::string extrapolated_points_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status,
                                         Extrapolation policy);
+// Where the clamp policy answers a point x outside the box: "contact_pressure = 2000MPa", each
+// clamped input outside the box at its nearest face (angles are periodic, never clamped).
+std::string clamped_face_text(const InputSpace& inputs, const double* x);
+// A block's message, the same in the server's reply and the in-process Answer: its first point
+// without an answer (unanswered_points_message), else its first point outside the box
+// (extrapolated_points_message), else "".
+std::string block_message(const InputSpace& inputs, const QueryBatch& x, const std::vector<PointStatus>& status,
+                          Extrapolation policy);
 
 // Two-sided normal quantile z such that P(|Z| ≤ z) = level (Boost.Math).
 double normal_quantile_two_sided(double level);
