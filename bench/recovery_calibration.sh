@@ -3,7 +3,7 @@
 # made at known values kept out of the campaign's plan (a campaign's measure.sh), through the GP of the
 # campaign (its samples so far). Prints the posterior with and without the discrepancy delta, whether
 # each true value lies inside its 95 % credible interval, writes the calibrated models and draws
-# recovery.png (bench/plot_calibration.py); figures go to bench/RESULTS.md by hand.
+# recovery.png (tools/plot/plot_calibration.py); figures go to bench/RESULTS.md by hand.
 # With --condition-sd NAME=SD (SI, repeatable) the conditions are also given as uncertain: each row's
 # NAME is replaced by a draw about its true value with that SD (seeded) and NAME_sd is given, as for
 # conditions estimated rather than measured; the coefficients must still be recovered.
@@ -112,6 +112,6 @@ for k in "${!variants[@]}"; do
     posteriors+=(--posterior "$out/posterior${tag}.csv")
   fi
 done
-((${#models[@]} > 0)) && /usr/bin/python3 "$here/bench/plot_calibration.py" --mufric "$mufric" "${models[@]}" "${posteriors[@]}" \
+((${#models[@]} > 0)) && /usr/bin/python3 "$here/tools/plot/plot_calibration.py" --mufric "$mufric" "${models[@]}" "${posteriors[@]}" \
   --data "$out/measured.csv" --label "micro-model at the truth" --x temperature "${truth_flags[@]}" \
   --title "recovery: served at the measured conditions (a fit, not a held-out check)" --out "$out/recovery.png"

@@ -45,10 +45,10 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parent))
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools" / "plot"))
 from plot_calibration import rows_of  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "data" / "cirp2022_ti6al4v_tin"
 NORMAL_RAKE_RAD = math.radians(15.0)
 INCLINATION_RAD = math.radians(6.0)

@@ -57,7 +57,7 @@ for state in "300MPa 22.5m/min 25C" "800MPa 100m/min 500C" "1300MPa 200m/min 900
   printf '%-8s %-10s %-6s ' "$p" "$v" "$t"
   $mufric predict --model dry_default --p "$p" --v "$v" --T "$t" | sed -n -e '2s/ *status.*//p' -e '3s/:.*//p' | paste -sd ' ' 
 done
-/usr/bin/python3 bench/plot_model.py "$mufric" dry_default "$out/dry_default.png"
+/usr/bin/python3 tools/plot/plot_model.py "$mufric" dry_default "$out/dry_default.png"
 
 echo; echo "== 4. The shipped Ti6Al4V model (ti6al4v_tin: calibrated on measured dry cuts by a TiN-coated carbide tool)"
 measured=data/cirp2022_ti6al4v_tin/rake_face_mu_0deg.csv
@@ -77,7 +77,7 @@ for speed, m, c in zip((5, 7.5, 10, 20, 30, 40), rows, served):
     print(f"{speed:5g} m/min      {float(m['mu']):.3f} +- {1.96 * float(m['mu_sd']):.3f}"
           f"              {float(c['mu']):.3f} ({float(c['lo']):.3f} .. {float(c['hi']):.3f})")
 PY
-/usr/bin/python3 bench/plot_calibration.py --mufric "$mufric" --model ti6al4v_tin --data "$measured" \
+/usr/bin/python3 tools/plot/plot_calibration.py --mufric "$mufric" --model ti6al4v_tin --data "$measured" \
   --label "rake-face mu from measured forces" --x sliding_velocity --title "Ti6Al4V / TiN-coated carbide, dry" \
   --out "$out/ti6al4v_tin.png"
 echo; echo "files: $(ls "$out" | tr '\n' ' ')in $out/"

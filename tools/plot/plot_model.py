@@ -3,7 +3,7 @@
 the centre) with the 95 % interval of the mean and, when the model has one, the patch scatter
 (μ ± 1.96 patch_std: where 95 % of single 10 µm contact patches fall), plus μ over (p, T) at the
 centre's v. Asks `mufric predict --csv` (any model: a file, a shipped name, grpc://).
-  /usr/bin/python3 bench/plot_model.py MUFRIC MODEL OUT.png [--data db.h5]"""
+  /usr/bin/python3 tools/plot/plot_model.py MUFRIC MODEL OUT.png [--data db.h5]"""
 import argparse
 import csv
 import io

@@ -11,7 +11,7 @@ speed (where pressure, velocity and temperature all move) shows as a band. Right
 --out's CSV; only the law's coefficients), and with --truth NAME=VALUE the value that made the data,
 when it is known (a recovery study).
 
-  /usr/bin/python3 bench/plot_calibration.py --mufric build/app/mufric --model ti6al4v_tin \\
+  /usr/bin/python3 tools/plot/plot_calibration.py --mufric build/app/mufric --model ti6al4v_tin \\
       --data data/cirp2022_ti6al4v_tin/rake_face_mu_0deg.csv --x sliding_velocity --out mu.png
 Several --data files are drawn each in its marker; --label names them (default: the file's stem);
 --model is repeatable, --model-label names each; --compare FILE:LABEL adds a CSV of (x, mu) rows to
