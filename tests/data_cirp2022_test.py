@@ -223,11 +223,13 @@ class RakeFaceAnalysisOnKnownForces(unittest.TestCase):
 class CalibrationMeasurements(unittest.TestCase):
     def test_the_shipped_models_measurement_file_is_what_the_validation_calibrates_on(self):
         # campaigns/ti6al4v_tin/train.sh calibrates on the committed file, which its model records by
-        # path and hash; bench/ti6al4v_validation.py writes the rows it validates: the two must agree.
+        # path and hash; bench/studies/ti6al4v/ti6al4v_validation.py writes the rows it validates: the
+        # two must agree.
+        validation = SOURCE_DIR / "bench" / "studies" / "ti6al4v" / "ti6al4v_validation.py"
         with tempfile.TemporaryDirectory() as folder:
             written = Path(folder) / "rows.csv"
-            subprocess.run([sys.executable, str(SOURCE_DIR / "bench" / "ti6al4v_validation.py"), "--write-measurements",
-                            str(written)], check=True, capture_output=True)
+            subprocess.run([sys.executable, str(validation), "--write-measurements", str(written)], check=True,
+                           capture_output=True)
             self.assertEqual(written.read_text(), (DATA / "rake_face_mu_calibration.csv").read_text())
 
 

@@ -16,7 +16,7 @@ if [[ -z $first_heading ]] || ((first_heading > 40)); then
   echo "README.md's first section heading is at line ${first_heading:-none}, after line 40"
   status=1
 fi
-/usr/bin/python3 "$1/bench/results_toc.py" --check "$1/bench/RESULTS.md" || status=1
+/usr/bin/python3 "$1/bench/tools/results_toc.py" --check "$1/bench/RESULTS.md" || status=1
 if [[ -d $1/.git ]]; then
   outside=$(git -C "$1" grep -n -I -E 'ARCHITECTURE\.md|\.\./shared/|shared/(notes|seeds)/' -- . ':!tests/docs_shape_test.sh' || true)
   if [[ -n $outside ]]; then

@@ -332,8 +332,9 @@ TEST(StochasticKriging, WarnsWhenTrainedOnTooFewSamplesForACalibratedInterval) {
   }
 }
 
-// A campaign's first few samples (bench/interval_calibration.py in miniature): 8 samples of a known
-// simulator, each with its true variance of the mean on the diagonal, over 40 independent campaigns.
+// A campaign's first few samples (bench/studies/served_interval/interval_calibration.py in
+// miniature): 8 samples of a known simulator, each with its true variance of the mean on the
+// diagonal, over 40 independent campaigns.
 // Taking the samples' average as the known mean (fitted by ML) covered the true mean at 66 %; the
 // estimated mean, fitted by REML, charges the mean level's own uncertainty: 74 %. Neither reaches 95 %
 // with 8 points in 3 inputs (the hyper-parameters are plugged in as if known; at 24 samples 85 %),

@@ -3,7 +3,7 @@
 # that the campaign (run.sh) never ran, at 8 conditions of seed 000's box that it never ran either
 # (a Sobol' plan with another shift), on surfaces of their own. Each measurement is a sample's mean
 # over its four draws, its standard error the measurement's SD: what a tribometer paper reports as a
-# mean and its scatter. bench/recovery_calibration.sh calibrates m back from them. Resumable; never
+# mean and its scatter. bench/studies/calibration/recovery_calibration.sh calibrates m back from them. Resumable; never
 # part of CI.
 #   nohup bash campaigns/recovery_childs/measure.sh > measure.log 2>&1 &      # one core
 set -euo pipefail

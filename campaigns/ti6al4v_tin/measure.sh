@@ -2,7 +2,7 @@
 # The Ti6Al4V recovery study's "measurements" (issue 60): the micro-model on the Ti6Al4V scene with
 # Childs' coefficients mu_a* = 0.45 and m* = 0.7, which the campaign (run.sh) never ran, at 8
 # conditions of the box the rake-face states need (a Sobol' plan of another seed), four draws each on
-# surfaces of their own. bench/recovery_calibration.sh --campaign campaigns/ti6al4v_tin --truth
+# surfaces of their own. bench/studies/calibration/recovery_calibration.sh --campaign campaigns/ti6al4v_tin --truth
 # adhesive_coefficient=0.45 --truth shear_factor=0.7 [--condition-sd temperature=60] calibrates mu_a and m
 # back from them, with the temperatures given exactly or with an SD. Resumable; never part of CI.
 #   nohup bash campaigns/ti6al4v_tin/measure.sh > measure.log 2>&1 &      # one core

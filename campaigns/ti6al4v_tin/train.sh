@@ -3,7 +3,7 @@
 # cuts: the campaign's GP (`mufric train`, its defaults), then `mufric calibrate` of Childs' law on the
 # rake-face friction of all six orthogonal cutting speeds (data/cirp2022_ti6al4v_tin/
 # rake_face_mu_calibration.csv, which the model records by that path and its sha256; pressure and temperature as latent conditions with their SDs, the sliding
-# velocity as given, as in bench/ti6al4v_validation.py, which chose the law variant below by its
+# velocity as given, as in bench/studies/ti6al4v/ti6al4v_validation.py, which chose the law variant below by its
 # held-out error: bench/RESULTS.md, "Ti6Al4V against measured cutting"). Rerun and commit both files
 # together whenever db.h5 is committed: the CLI test Cli.TheShippedTi6Al4VModelIsTheCalibration reruns
 # this script and requires the same answers. Stored without its fast evaluator (the build tabulates

@@ -201,7 +201,8 @@ def write_outputs(results, draws, seed):
     (HERE / "rake_face_analysis.csv").write_text("\n".join(lines) + "\n")
 
     # Only the orthogonal cuts go to calibrate: the oblique ones (lambda_s = 6 deg) are held out of every
-    # calibration, and their conditions must not come from their own feed force (bench/ti6al4v_oblique.py).
+    # calibration, and their conditions must not come from their own feed force (the oblique check of
+    # bench/studies/ti6al4v/ti6al4v_validation.py).
     for inclination in (0.0,):
         rows = [r for r in results if r["inclination"] == inclination]
         header = ["contact_pressure[MPa]", "contact_pressure_sd[MPa]", "sliding_velocity[m/min]",

@@ -15,7 +15,7 @@ when it is known (a recovery study).
       --data data/cirp2022_ti6al4v_tin/rake_face_mu_0deg.csv --x sliding_velocity --out mu.png
 Several --data files are drawn each in its marker; --label names them (default: the file's stem);
 --model is repeatable, --model-label names each; --compare FILE:LABEL adds a CSV of (x, mu) rows to
-draw as a line (e.g. a tabulated law). bench/recovery_calibration.sh draws its study with it."""
+draw as a line (e.g. a tabulated law). bench/studies/calibration/recovery_calibration.sh draws its study with it."""
 import argparse
 import csv
 import io
