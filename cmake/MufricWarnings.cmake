@@ -19,7 +19,8 @@ endif()
 # an object; a null dereference is a SEGV that ASan reports with its stack), pointer-overflow forms
 # a pointer whose dereference ASan checks, and x86-64 loads misaligned data (alignment). Their
 # checks in every Eigen expression stopped clang inlining Eigen's kernels: one draw of the tiny CLI
-# test scene took 18.1 s with them, 2.7 s without, 1.0 s in Release (bench/RESULTS.md, "The
+# test scene took 18.1 s with them, 2.7 s without, 1.0 s in Release
+# (bench/studies/test_time/README.md, "The
 # test command's time"). The code the fuzz targets feed keeps all of UBSan (mufric_fuzz_coverage).
 set(mufric_ubsan_parser_only_checks alignment,null,pointer-overflow,object-size)
 if(MUFRIC_FUZZ OR MUFRIC_SANITIZE)

@@ -10,7 +10,8 @@
 #       and Challen-Oxley studies, the container image compiled from source), ~11 min after the build.
 #       Run them before resolving a physics issue.
 #
-# Each stage's time is printed at the end, also when a stage fails (bench/RESULTS.md, "The test
+# Each stage's time is printed at the end, also when a stage fails
+# (bench/studies/test_time/README.md, "The test
 # command's time", records them). Environment: MUFRIC_JOBS (parallel jobs, default 2),
 # MUFRIC_FUZZ_SECONDS (seconds per fuzz target, default 10).
 set -euo pipefail

@@ -328,7 +328,8 @@ TEST(FastEvaluator, MuIsTheSameBitsWhateverElseIsAsked) {
 
 }  // namespace
 // The default budget covers what a measured model of ordinary size needs (issue 63): a wavy, noise-free
-// 900-point model (bench/RESULTS.md, "The fast evaluator's default budget") certified its grid to the
+// 900-point model (bench/studies/calibration/README.md, "The fast evaluator's default budget")
+// certified its grid to the
 // default tolerances only after 1.7e12 multiply-adds; at the earlier default of 1e11 it stored none.
 // Past a few thousand points the budget grows as a fit's cost does.
 TEST(FastEvaluator, TheDefaultBudgetCoversAMeasuredNoiseFreeModelOfNineHundredPoints) {

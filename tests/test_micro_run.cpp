@@ -74,7 +74,7 @@ TEST(Scene, ShippedScenesStateTheBuiltInDefaultsExceptTheirDeclaredChoices) {
   const std::set<std::string> required = {"load.pressure"};  // (or vertical_displacement: exactly one)
   // The default scene's own choices: its two surfaces' roughness (the chip's Ra and fit, the tool's
   // statistics and seed, against one RoughnessSpec default for both), and time.max_step 4 ns (the
-  // time-step study, bench/RESULTS.md fourth pass; absent, it is time.step).
+  // time-step study, bench/studies/dry_micro_model/README.md fourth pass; absent, it is time.step).
   std::set<std::string> chosen = {"geometry.chip_surface.synthetic.ra", "geometry.chip_surface.fit.degree",
                                   "geometry.tool_surface.synthetic.ra",
                                   "geometry.tool_surface.synthetic.correlation_length",
@@ -913,7 +913,8 @@ TEST(Lubricated, TheTrappedFilmPullsTheChipUnlessItCavitates) {
 }
 
 // The seed-000 protocol is the run mufric made before press-slide existed, to the last digit: the
-// default scene gave 0.180576145017611 with commit 50c7495 on this machine (bench/RESULTS.md).
+// default scene gave 0.180576145017611 with commit 50c7495 on this machine
+// (bench/studies/dry_micro_model/README.md).
 TEST(PressSlide, SeedZeroProtocolReproducesTheEarlierDefaultScene) {
   nlohmann::json j = default_scene_json();
   apply_override(j, "protocol.name=\"seed-000\"");
@@ -988,7 +989,8 @@ TEST(MicroRun, ChildsLawWithASharpTurnIsZorevsAndASoftOneShearsLess) {
 }
 
 TEST(Lubricated, ASealedIncompressibleFilmsStalledInterfaceNamesTheWayOut) {
-  // Seed 000's sealed liquid stalls the interface iteration on an enclosed pocket (bench/RESULTS.md):
+  // Seed 000's sealed liquid stalls the interface iteration on an enclosed pocket
+  // (bench/studies/friction_laws/README.md):
   // the stop says so and names the compressible liquid; other stops and other films keep their reason.
   // The stalled reason is composed as a stopped run composes it, around what coupled_step says when
   // its iteration runs out of exchanges (a scalar iteration that oscillates for ever: λ̃ = 1 − λ).

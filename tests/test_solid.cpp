@@ -201,7 +201,8 @@ void expect_consistent_tangent(VolumetricTreatment volumetric) {
 // Two solvers ordering their patterns at once (draws of a μ measurement side by side) give the
 // same bits as one alone. METIS keeps its random state in a global and reseeds it at each ordering:
 // orderings made at once drew from one sequence in turns, and the first two draws' μ changed in its
-// last digits from run to run (bench/RESULTS.md, "The scenario through Slurm"). A 2D grid's
+// last digits from run to run (bench/studies/online_learning/README.md, "The scenario through
+// Slurm"). A 2D grid's
 // Laplacian, where nested dissection competes with AMD, ordered pairwise at once many times.
 TEST(LinearSolverThreads, OrderingsMadeAtOnceGiveTheSameSolutionAsOneAlone) {
   constexpr int kSide = 70;

@@ -99,7 +99,8 @@ TEST(Pressing, SinusoidalToolOnAnElasticChipFollowsWestergaard) {
 // plastic chip (Johnson–Cook B = C = 0 at the transition temperature: E/σ_y = 1000; no heating) with
 // no interfacial shear: the slip-line wave model (Challen & Oxley 1979, Wear 53:229) gives μ = tan α,
 // the pressure acting on the leading face only. The chip's C¹ surface leaves the apex over about an
-// element, so the contact must span many elements for that share to be small (bench/RESULTS.md,
+// element, so the contact must span many elements for that share to be small
+// (bench/studies/friction_laws/README.md,
 // "Friction at the asperity contacts"): at 100 MPa on 64 elements it spans ~13.
 // The slip-line wave model of Challen & Oxley (1979, Wear 53:229, the wave model's friction
 // coefficient): a rigid wedge of slope α pushing a plastic wave along a rigid–perfectly-plastic
@@ -118,7 +119,7 @@ double wave_model_mu(double alpha, double f) {
 // f = 0 (frictionless) and 0.5 (the shear-factor law), slopes 5° and 10°, within 10 %. And the run's
 // energy books close: μ plus the normal load's work equals the interfacial dissipation plus the
 // plastic work (all per unit slide and load over the window; the elastic energy stored is small).
-// (f = 0.8 misses the wave model by 12–24 %: bench/RESULTS.md.)
+// (f = 0.8 misses the wave model by 12–24 %: bench/studies/friction_laws/README.md.)
 TEST(Ploughing, AWedgeOnAPerfectlyPlasticChipFollowsTheWaveModel) {
   constexpr double kWaveModelTolerance = 0.10;   // the agreement asked of the wave model
   constexpr double kEnergyBalanceTolerance = 0.02;  // of μ: the window's stored elastic energy and step error

@@ -2,7 +2,7 @@
 # calibrate's time on one core, two builds side by side (ratios, not absolute times: the machine is
 # shared), alternated round by round; each run writes its model with the grid, as a user's would.
 #   bash bench/benchmarks/calibrate_time.sh OLD_MUFRIC NEW_MUFRIC GP.h5 DATA.csv [ROUNDS] [-- CALIBRATE-ARGS...]
-# e.g. the Ti6Al4V model's calibration (bench/RESULTS.md, "calibrate's time with δ"):
+# e.g. the Ti6Al4V model's calibration (bench/studies/ti6al4v/README.md, "calibrate's time with δ"):
 #   mufric train --data campaigns/ti6al4v_tin/db.h5 --out gp.h5 --no-fast-evaluator
 #   /usr/bin/python3 bench/studies/ti6al4v/ti6al4v_validation.py --write-measurements rf.csv
 #   bash bench/benchmarks/calibrate_time.sh old/app/mufric build/app/mufric gp.h5 rf.csv 2 -- --discrepancy

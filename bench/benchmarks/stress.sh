@@ -17,7 +17,8 @@ mufric=$(realpath "$build/app/mufric")
 mkdir -p "$out"
 out=$(realpath "$out")
 limit_seconds=900
-# The stress table was measured with seed 000's protocol on a 50 ns window (bench/RESULTS.md).
+# The stress table was measured with seed 000's protocol on a 50 ns window
+# (bench/studies/hardening/README.md).
 short=(--set protocol.name=seed-000 --set time.duration=100ns --set time.average_from=50ns)
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); machine: $(lscpu | sed -n 's/Model name: *//p'), $(nproc) cores; load: $(cut -d' ' -f1 /proc/loadavg)"
 

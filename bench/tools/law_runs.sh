@@ -1,7 +1,8 @@
 #!/bin/bash
 # One small press-slide run per interface law (the small scene of tests/test_micro_run.cpp's
 # small_press_slide, one phase), printing each run's mu with all its digits: the check that a
-# refactor leaves every law's result unchanged to the bit (bench/RESULTS.md, issue 50).
+# refactor leaves every law's result unchanged to the bit
+# (bench/studies/point_kernel_refactor/README.md, issue 50).
 # Usage: bash bench/tools/law_runs.sh MUFRIC_BINARY OUT_DIR > mu.txt; then diff two binaries' mu.txt.
 set -euo pipefail
 bin=${1:?usage: law_runs.sh MUFRIC_BINARY OUT_DIR}

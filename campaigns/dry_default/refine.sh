@@ -2,7 +2,8 @@
 # The production campaign's second part: after a prefix of the Sobol' plan (run.sh), the rest of the
 # budget goes where the served interval is widest, by `dataset refine` (stochastic kriging, picks by
 # the integrated variance of the mean they remove: a new point, or four more draws at one already
-# run). The interval over the box after the Sobol' prefix is widest at its edges (bench/RESULTS.md,
+# run). The interval over the box after the Sobol' prefix is widest at its edges
+# (bench/studies/served_interval/README.md,
 # "The served interval over the whole box"), which a uniform plan samples least.
 # Resumable: run it again after a stop. --drop-pending leaves out the plan rows not yet run (the
 # unrun Sobol' tail the first time, an interrupted round's picks after a stop), and the budget is

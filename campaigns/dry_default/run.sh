@@ -3,7 +3,8 @@
 # (micro/scene/dry_default.json, 64 x 12, 4 draws of tool and chip surfaces per sample) over the box
 # real meso codes ask for, each plan row its own surfaces (independent draws). The box: seed 000's
 # grown to p 300 MPa-3.1 GPa, v 1-2000 m/min, T 25-900 C, where every corner converges at this mesh
-# (bench/RESULTS.md, "The production campaign"). Resumable: run it again after a stop; the database
+# (bench/studies/served_interval/README.md, "The production campaign"). Resumable: run it again
+# after a stop; the database
 # is rewritten after every sample. Never part of CI.
 #   nohup bash campaigns/dry_default/run.sh > campaign.log 2>&1 &       # one core, one free for builds
 #   JOBS=2 bash campaigns/dry_default/run.sh                              # both cores

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The calibration's recovery study on the micro-model itself (issue 51): a campaign whose inputs are
 # seed 000's box and the shear factor m of Childs' law (contact.law=childs, mu_a 0.5, n 1: the
-# smooth law a calibration fits; bench/RESULTS.md, "The interface law as a point kernel" has it
+# smooth law a calibration fits; bench/studies/point_kernel_refactor/README.md, "The interface law
+# as a point kernel" has it
 # completing at the default point), so that "measurements" made by `mufric micro run` at an m* kept
 # out of the plan can be calibrated back through the campaign's GP. The default dry scene, four
 # independent draws per sample. Resumable: run it again after a stop. Never part of CI.

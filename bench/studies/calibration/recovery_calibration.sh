@@ -3,7 +3,7 @@
 # made at known values kept out of the campaign's plan (a campaign's measure.sh), through the GP of the
 # campaign (its samples so far). Prints the posterior with and without the discrepancy delta, whether
 # each true value lies inside its 95 % credible interval, writes the calibrated models and draws
-# recovery.png (tools/plot/plot_calibration.py); figures go to bench/RESULTS.md by hand.
+# recovery.png (tools/plot/plot_calibration.py); figures go to its README.md by hand.
 # With --condition-sd NAME=SD (SI, repeatable) the conditions are also given as uncertain: each row's
 # NAME is replaced by a draw about its true value with that SD (seeded) and NAME_sd is given, as for
 # conditions estimated rather than measured; the coefficients must still be recovered.

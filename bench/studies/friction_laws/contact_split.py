@@ -4,7 +4,8 @@
 the tool's slope at each point's closest point: the leading face (slope within 20 % of -tan(alpha)),
 the trailing face (+tan(alpha)) and the apex between them. Prints each part's share of the normal
 load and its own mu, and the share carried by points that are not penetrating (mortar spread).
-Used for the Challen & Oxley check (bench/studies/friction_laws/challen_oxley_check.sh, bench/RESULTS.md).
+Used for the Challen & Oxley check (bench/studies/friction_laws/challen_oxley_check.sh,
+bench/studies/friction_laws/README.md).
 
   /usr/bin/python3 bench/studies/friction_laws/contact_split.py RUN_DIR/contact.csv ALPHA_DEG
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The micro-model's run time against its error (bench/RESULTS.md, "Run time against error"): the
+"""The micro-model's run time against its error (bench/studies/micro_pareto/README.md, "Run time against error"): the
 well-defined mu of a shipped scene (press-slide protocol) at the box centre over spline degree x
 elements x sliding step, every level on the same 4 synthetic tools so that the error against the
 finest level is paired (tool by tool); and the statistical error of the mean over k tools, from the
@@ -12,7 +12,7 @@ not credited with a small bias it cannot show. Its cost is the one-core seconds 
 dry (the default): degree 2 and 3 x 32x6 / 64x12 / 96x18 x 50 / 25 / 12.5 nm against degree 3,
 128 x 24, 12.5 nm. lubricated (micro/scene/lubricated_default.json): degree 2 x 32x6 / 64x12 / 96x18
 x 50 / 25 nm against degree 2, 128 x 24, 25 nm (the lubricant's coupling was built and verified at
-degree 2, and its ninth pass found a finer step no help: bench/RESULTS.md).
+degree 2, and its ninth pass found a finer step no help: bench/studies/lubricant/README.md).
 Prints markdown tables (every level; the Pareto front) and writes OUT_DIR/micro_pareto[_lubricated].csv
 and .png. Every run's result.json is kept in OUT_DIR (a study resumes).
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The pressing-then-sliding comparison with an independent FE code (bench/RESULTS.md, "The pressing
+"""The pressing-then-sliding comparison with an independent FE code (bench/studies/press_slide_protocol/README.md, "The pressing
 phase against an independent code"): a flat chip (10 um interval, 5 um high), Johnson-Cook at T* = 0
 with no rate term and no heating, displacement-pressed 0.4 um against a rigid sinusoidal tool (one
 wavelength over the interval, amplitude 1 um), then slid. Prints the mean contact pressure after

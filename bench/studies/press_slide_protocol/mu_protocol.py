@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The press-slide protocol's studies (bench/RESULTS.md, "What mu means"): each run is one `mufric
+"""The press-slide protocol's studies (bench/studies/press_slide_protocol/README.md, "What mu means"): each run is one `mufric
 micro run` of the default scene with overrides; prints markdown tables.
 
   /usr/bin/python3 bench/studies/press_slide_protocol/mu_protocol.py MUFRIC OUT_DIR [STUDY ...] [--set key=value ...]

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Does the chip's hardening as it arrives at the tool matter to mu? (issue 60; bench/RESULTS.md, "The chip's
+# Does the chip's hardening as it arrives at the tool matter to mu? (issue 60; bench/studies/ti6al4v/README.md, "The chip's
 # initial plastic strain"). The Ti6Al4V scene at the rake-face states of the slowest and fastest measured cuts
 # (data/cirp2022_ti6al4v_tin/rake_face_mu_0deg.csv: 5 and 40 m/min) with Childs' law at the campaign box's
 # largest coefficients and at its centre, for a virgin chip (seed 000's) and for one that has passed the

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The Ti6Al4V calibration checked on cuts it never saw (issue 60; bench/RESULTS.md, "Ti6Al4V against
+"""The Ti6Al4V calibration checked on cuts it never saw (issue 60; bench/studies/ti6al4v/README.md, "Ti6Al4V against
 measured cutting"). From a GP of the Ti6Al4V campaign (campaigns/ti6al4v_tin, `mufric train`) and the
 rake-face friction derived from the measured orthogonal cuts (data/cirp2022_ti6al4v_tin/
 rake_face_mu_0deg.csv: one row per cutting speed, its conditions with their SDs):
