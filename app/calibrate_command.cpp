@@ -1,5 +1,5 @@
 // `mufric calibrate`: the posterior of an interface law's coefficients given measured friction,
-// through the GP of a campaign that varied them (surrogate/calibration.hpp).
+// through the GP of a campaign that varied them (surrogate/calibration/calibration.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -15,11 +15,11 @@
 #include "common/files.hpp"
 #include "common/units.hpp"
 #include "common/wording.hpp"
-#include "surrogate/calibrated_model.hpp"
-#include "surrogate/calibration.hpp"
-#include "surrogate/calibration_workflow.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/calibration/calibrated_model.hpp"
+#include "surrogate/calibration/calibration.hpp"
+#include "surrogate/calibration/calibration_workflow.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric::app {
 namespace {

@@ -28,8 +28,8 @@
 #include "common/wording.hpp"
 #include "micro/run/dataset_sample.hpp"
 #include "micro/run/measurement.hpp"
-#include "surrogate/accuracy.hpp"
-#include "surrogate/sampling.hpp"
+#include "surrogate/core/accuracy.hpp"
+#include "surrogate/core/sampling.hpp"
 
 namespace mufric::app {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "app/commands.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
+#include "surrogate/gp/gp_grids.hpp"
 
 namespace mufric::app {
 

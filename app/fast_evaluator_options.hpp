@@ -1,16 +1,16 @@
 #pragma once
 // The --fast-* options of train, upgrade and calibrate: what a model's fast evaluator is built to,
-// within which work budget, and the one policy that keeps it (surrogate/fast_evaluator_build.hpp,
+// within which work budget, and the one policy that keeps it (surrogate/fast/fast_evaluator_build.hpp,
 // short_grid_refusal), with the lines that report it.
 #include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
-#include "surrogate/calibrated_model.hpp"
-#include "surrogate/fast_evaluator.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gaussian_process.hpp"
+#include "surrogate/calibration/calibrated_model.hpp"
+#include "surrogate/fast/fast_evaluator.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gaussian_process.hpp"
 
 namespace mufric::app {
 

@@ -22,7 +22,7 @@ namespace {
 // wait policy is unset). On a node shared with another CPU-bound process, a thread spinning at a
 // barrier holds the core its descheduled team-mate needs: the default micro run took 2–8× its one-core
 // time beside one competing process and 9× beside two. 5000 spins keep the idle-machine speed and
-// 1.1× beside one (bench/RESULTS.md, "Threads on a busy machine").
+// 1.1× beside one (bench/studies/hardening/README.md, "Threads on a busy machine").
 constexpr const char* kOpenMpSpinCount = "5000";
 
 // libgomp reads its wait policy once, when it is loaded, so it must be in the environment before

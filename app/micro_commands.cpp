@@ -441,7 +441,7 @@ void add_micro_commands(CLI::App& app) {
                        "thickness, graded towards the contact as the scene's grading says)")
       ->capture_default_str()->check(CLI::IsMember({"both", "x", "y"}));
   converge->footer("The paper refined the region near the contact until mu changed by less than 0.7 %. Doubling one\n"
-                   "direction at a time shows which one the error comes from (bench/RESULTS.md: mostly y for the\n"
+                   "direction at a time shows which one the error comes from (bench/studies/dry_micro_model/README.md: mostly y for the\n"
                    "default scene). --parameter step / window / phases converge the press-slide protocol's own\n"
                    "choices the same way; every level prints mu with its standard error over the draws, and a change\n"
                    "below that error is noise, not convergence. Exit code 0 when converged, 3 when not or when a\n"

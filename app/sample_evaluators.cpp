@@ -11,8 +11,8 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "micro/run/dataset_sample.hpp"
-#include "surrogate/accuracy.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/core/accuracy.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric::app {
 

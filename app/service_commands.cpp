@@ -7,7 +7,7 @@
 #include "common/error.hpp"
 #include "common/wording.hpp"
 #include "server/server.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric::app {
 

@@ -19,13 +19,13 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/wording.hpp"
-#include "surrogate/accuracy.hpp"
-#include "surrogate/calibrated_model.hpp"
-#include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
-#include "surrogate/stochastic_kriging.hpp"
+#include "surrogate/core/accuracy.hpp"
+#include "surrogate/calibration/calibrated_model.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
+#include "surrogate/gp/stochastic_kriging.hpp"
 
 namespace mufric::app {
 namespace {

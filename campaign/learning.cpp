@@ -24,8 +24,8 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/version.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric {
 

@@ -9,7 +9,7 @@
 //      `dataset refine` (campaign/refine.hpp), within the round's samples and the core-hour budget;
 //   3. runs them (the local work pool; the database is rewritten after every sample);
 //   4. retrains the campaign's GP, with the served model's extrapolation policy, μ range and grids;
-//      a served calibrated model (surrogate/calibrated_model.hpp) is recalibrated on its measurements
+//      a served calibrated model (surrogate/calibration/calibrated_model.hpp) is recalibrated on its measurements
 //      with the retrained GP as its emulator (the picks of step 2 then sit at the queried conditions
 //      and at the coefficients' posterior samples);
 //   5. gates it (gate_candidate): the new version replaces the served file only if it is no worse on
@@ -28,10 +28,10 @@
 
 #include "campaign/dataset_generation.hpp"
 #include "common/files.hpp"  // file_version, the versions a learner keeps
-#include "surrogate/calibrated_model.hpp"
-#include "surrogate/calibration_workflow.hpp"  // kDefaultCalibrationMaxSteps
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gaussian_process.hpp"
+#include "surrogate/calibration/calibrated_model.hpp"
+#include "surrogate/calibration/calibration_workflow.hpp"  // kDefaultCalibrationMaxSteps
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gaussian_process.hpp"
 
 namespace mufric {
 

@@ -8,11 +8,11 @@
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "common/version.hpp"
-#include "surrogate/active_learning.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
-#include "surrogate/sampling.hpp"
-#include "surrogate/stochastic_kriging.hpp"
+#include "surrogate/gp/active_learning.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
+#include "surrogate/core/sampling.hpp"
+#include "surrogate/gp/stochastic_kriging.hpp"
 
 namespace mufric {
 namespace {

@@ -3,7 +3,7 @@
 // converged samples, picks a batch of candidates by the largest posterior variance (each pick
 // conditioning the next, away from failed points) — or, for a database of independent draws, trains
 // by stochastic kriging and picks by the integrated variance of the mean each pick removes, among new
-// points and more draws at the existing ones (replicates; surrogate/active_learning.hpp) — appends them to the plan, runs them through
+// points and more draws at the existing ones (replicates; surrogate/gp/active_learning.hpp) — appends them to the plan, runs them through
 // generate_dataset and reads the database back, until the budget of runs is spent or nothing new
 // could be run. Candidates are a Sobol' set in the plan box (shifted per round) plus the rows of a
 // CSV (e.g. the server's --log-uncertain file) inside the box; with `grow` the box first grows toward
@@ -19,9 +19,9 @@
 #include "campaign/dataset_generation.hpp"
 #include "common/dataset_file.hpp"
 #include "common/sample_outcome.hpp"
-#include "surrogate/accuracy.hpp"
-#include "surrogate/gaussian_process.hpp"
-#include "surrogate/gp_training.hpp"
+#include "surrogate/core/accuracy.hpp"
+#include "surrogate/gp/gaussian_process.hpp"
+#include "surrogate/gp/gp_training.hpp"
 
 namespace mufric {
 

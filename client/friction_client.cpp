@@ -21,7 +21,7 @@
 #include "common/units.hpp"
 #include "mufric/v1/friction.grpc.pb.h"
 #include "proto/wire_codec.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric::client {
 namespace {

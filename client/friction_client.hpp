@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/error.hpp"
-#include "surrogate/friction_model.hpp"
+#include "surrogate/core/friction_model.hpp"
 
 namespace mufric::client {
 
@@ -86,7 +86,7 @@ struct Options {
   std::string tls_ca_file;    // PEM roots to verify the server (grpcs://); empty: the system's
   std::string tls_cert_file;  // PEM client certificate chain and key, for mutual TLS
   std::string tls_key_file;
-  // file:// only: parse the model file in a child process first (surrogate/model_file.hpp
+  // file:// only: parse the model file in a child process first (surrogate/models/model_file.hpp
   // load_model_isolated), so a corrupt file is an Error instead of a crash of this process. For
   // command-line tools; a meso code's own process (MPI, many threads) should not fork.
   bool isolate_file_parsing = false;

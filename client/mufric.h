@@ -73,7 +73,7 @@ int mufric_open(const char* uri, mufric_client** client);
  *   (chunk_points: most points per call, default 65536; from 128 up cut to a multiple of 128, so
  *   that a point's std has the same bits as in-process however a block is split)
  *   stream=1          every mufric_evaluate on one long-lived stream of this handle (an explicit
- *                     code's increments; no deadline). Measured (bench/RESULTS.md, a 2-core AMD
+ *                     code's increments; no deadline). Measured (bench/studies/meso_calls/README.md, a 2-core AMD
  *                     EPYC node, client and server on it): 1.6x less time per call than unary
  *                     calls for ~11-point blocks (46 against 75 us), 49 against 73 us for one
  *                     point; no gain for blocks of thousands of points, where evaluation dominates

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "surrogate/gaussian_process.hpp"
 
 namespace mufric::wire {
 
@@ -63,8 +62,8 @@ std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& wha
 }
 
 long long bit_stable_piece(long long wanted) {
-  if (wanted < kGpQueryBlock) return std::max(1LL, wanted);
-  return wanted - wanted % kGpQueryBlock;
+  if (wanted < kEvaluationBlockRows) return std::max(1LL, wanted);
+  return wanted - wanted % kEvaluationBlockRows;
 }
 
 }  // namespace mufric::wire

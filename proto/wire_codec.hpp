@@ -1,5 +1,5 @@
 #pragma once
-// The one translation between the in-process evaluation types (surrogate/friction_model.hpp) and the
+// The one translation between the in-process evaluation types (surrogate/core/friction_model.hpp) and the
 // wire (proto/mufric/v1/friction.proto), shared by the C++ client and the server: which request
 // array carries which model input, and what to compute with which tolerances. Each side used to
 // spell these itself, and "use the exact model" had three encodings.
@@ -7,7 +7,7 @@
 #include <string_view>
 
 #include "mufric/v1/friction.pb.h"
-#include "surrogate/friction_model.hpp"
+#include "surrogate/core/friction_model.hpp"
 
 namespace mufric::wire {
 
@@ -37,8 +37,8 @@ void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out);
 std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& what);
 
 // Points per piece when a batch is cut into pieces (the client's calls, the server's looks at the
-// deadline): `wanted` (at least 1), cut down to a multiple of the GP's query block when it is at
-// least one block, so that a point's σ keeps its bits however a batch is cut (kGpQueryBlock).
+// deadline): `wanted` (at least 1), cut down to a multiple of the models' evaluation block when it is at
+// least one block, so that a point's σ keeps its bits however a batch is cut (kEvaluationBlockRows).
 long long bit_stable_piece(long long wanted);
 
 }  // namespace mufric::wire

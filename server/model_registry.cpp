@@ -9,7 +9,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/isolation.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric::server {
 namespace {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "surrogate/friction_model.hpp"
+#include "surrogate/core/friction_model.hpp"
 
 namespace mufric::server {
 

@@ -43,7 +43,7 @@ constexpr int kTransportShareDivisor = 8;
 constexpr double kLeastRequestMemoryMb = 32.0;
 // Allocations from this size on are mmapped and go back to the system when freed. glibc's default
 // threshold grows with every large block freed (up to 32 MB), after which answers' arrays came from
-// the arenas and stayed resident: 1015 MB idle after a burst (bench/RESULTS.md, "The server's memory").
+// the arenas and stayed resident: 1015 MB idle after a burst (bench/studies/server_memory/README.md, "The server's memory").
 constexpr int kMmapThresholdBytes = 1 << 20;
 
 double resident_mb() {

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "common/dataset_file.hpp"
-#include "surrogate/gp_training.hpp"
+#include "surrogate/gp/gp_training.hpp"
 
 namespace mufric::test {
 

@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "gp_test_data.hpp"
-#include "surrogate/active_learning.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/sampling.hpp"
+#include "surrogate/gp/active_learning.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/core/sampling.hpp"
 
 namespace mufric {
 namespace {

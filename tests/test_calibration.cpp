@@ -1,5 +1,5 @@
 // The ensemble sampler and its diagnostics against closed forms, the GP's joint latent posterior
-// against a dense solve, and Bayesian calibration through an emulator (surrogate/calibration.hpp):
+// against a dense solve, and Bayesian calibration through an emulator (surrogate/calibration/calibration.hpp):
 // synthetic recovery of a known θ*, narrowing with more data, a known discrepancy recovered, and
 // the refusals that name what is wrong.
 #include <gtest/gtest.h>
@@ -18,13 +18,13 @@
 #include "common/error.hpp"
 #include "common/h5_file.hpp"
 #include "common/sanitizers.hpp"
-#include "surrogate/calibrated_model.hpp"
-#include "surrogate/calibration.hpp"
-#include "surrogate/calibration_workflow.hpp"
-#include "surrogate/ensemble_sampler.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/calibration/calibrated_model.hpp"
+#include "surrogate/calibration/calibration.hpp"
+#include "surrogate/calibration/calibration_workflow.hpp"
+#include "surrogate/calibration/ensemble_sampler.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
 #include "tests/gp_test_data.hpp"
 #include "tests/error_text.hpp"
 

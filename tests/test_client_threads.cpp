@@ -21,8 +21,8 @@
 #include "client/friction_client.hpp"
 #include "client/mufric.h"
 #include "gp_test_data.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric {
 namespace {

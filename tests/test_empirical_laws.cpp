@@ -9,7 +9,7 @@
 #include <random>
 
 #include "common/error.hpp"
-#include "surrogate/empirical_laws.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
 
 namespace mufric {
 namespace {

@@ -14,9 +14,9 @@
 
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/tensor_cubic_grid.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/fast/tensor_cubic_grid.hpp"
 #include "common/sanitizers.hpp"
 
 namespace mufric {

@@ -7,8 +7,8 @@
 
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
-#include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
+#include "surrogate/gp/gp_grids.hpp"
 
 namespace mufric {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace mufric {
 namespace {

@@ -10,8 +10,8 @@
 
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
-#include "surrogate/cholesky.hpp"
-#include "surrogate/gp_training.hpp"
+#include "surrogate/core/cholesky.hpp"
+#include "surrogate/gp/gp_training.hpp"
 
 namespace mufric {
 namespace {

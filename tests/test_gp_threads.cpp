@@ -7,8 +7,8 @@
 #include <string>
 
 #include "gp_test_data.hpp"
-#include "surrogate/gaussian_process.hpp"
-#include "surrogate/gp_training.hpp"
+#include "surrogate/gp/gaussian_process.hpp"
+#include "surrogate/gp/gp_training.hpp"
 
 namespace mufric {
 namespace {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "gp_test_data.hpp"
-#include "surrogate/gp_training.hpp"
+#include "surrogate/gp/gp_training.hpp"
 
 namespace mufric {
 namespace {

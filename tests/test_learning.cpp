@@ -14,10 +14,10 @@
 #include "campaign/refine.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
-#include "surrogate/calibration.hpp"
-#include "surrogate/calibration_workflow.hpp"
-#include "surrogate/model_file.hpp"
-#include "surrogate/sampling.hpp"
+#include "surrogate/calibration/calibration.hpp"
+#include "surrogate/calibration/calibration_workflow.hpp"
+#include "surrogate/models/model_file.hpp"
+#include "surrogate/core/sampling.hpp"
 #include "temp_path.hpp"
 
 namespace mufric {

@@ -8,10 +8,10 @@
 #include "common/error.hpp"
 #include "corrupt_files.hpp"
 #include "gp_test_data.hpp"
-#include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
 #include "temp_path.hpp"
 
 namespace mufric {

@@ -8,7 +8,7 @@
 #include <set>
 
 #include "common/error.hpp"
-#include "surrogate/sampling.hpp"
+#include "surrogate/core/sampling.hpp"
 
 namespace mufric {
 namespace {

@@ -36,12 +36,12 @@
 #include "server/friction_service.hpp"
 #include "server/memory_budget.hpp"
 #include "server/server.hpp"
-#include "surrogate/calibrated_model.hpp"
-#include "surrogate/empirical_laws.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
-#include "surrogate/stochastic_kriging.hpp"
+#include "surrogate/calibration/calibrated_model.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
+#include "surrogate/gp/stochastic_kriging.hpp"
 
 namespace mufric {
 namespace {

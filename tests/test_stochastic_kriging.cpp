@@ -12,10 +12,10 @@
 #include "common/error.hpp"
 #include "gp_test_data.hpp"
 #include "temp_path.hpp"
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
-#include "surrogate/stochastic_kriging.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
+#include "surrogate/gp/stochastic_kriging.hpp"
 
 namespace mufric {
 namespace {

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "surrogate/vector_exp.hpp"
+#include "surrogate/core/vector_exp.hpp"
 
 namespace mufric {
 namespace {

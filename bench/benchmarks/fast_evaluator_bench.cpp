@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <random>
 
-#include "surrogate/fast_evaluator_build.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/models/model_file.hpp"
 
 using namespace mufric;
 

@@ -4,7 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include "gp_test_data.hpp"
-#include "surrogate/gp_training.hpp"
+#include "surrogate/gp/gp_training.hpp"
 
 namespace mufric {
 namespace {

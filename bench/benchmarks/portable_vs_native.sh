@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The same commit built native (-DMUFRIC_NATIVE=ON) and portable (OFF), the GP's exact path and the
 # fast evaluator on one core: points per second, each build twice, alternated. The vector exp is
-# dispatched at run time in both (surrogate/vector_exp.cpp); what is left between them is Eigen's
+# dispatched at run time in both (surrogate/core/vector_exp.cpp); what is left between them is Eigen's
 # compile-time vector width in the distances and the triangular product, and the grid lookup.
 # Usage: bash bench/benchmarks/portable_vs_native.sh NATIVE_BUILD PORTABLE_BUILD MODEL.h5 [FAST_MODEL.h5]
 set -euo pipefail

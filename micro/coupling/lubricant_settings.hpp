@@ -1,7 +1,7 @@
 #pragma once
 // The lubricant's options as a scene states them (the `lubricant` section): the liquid, the film's
 // mesh and how it forms, cavitation, the out-of-plane leak and the coupling's iteration, with their
-// defaults (seed 000 Table 2 and the studies in bench/RESULTS.md), their reader, and what the
+// defaults (seed 000 Table 2 and the studies in bench/studies/lubricant/README.md), their reader, and what the
 // coupling makes of them with what the run knows (the chip's mass, its first step, when sliding
 // starts, the applied pressure). The scene only composes these; a lubricant option is added here and
 // nowhere else.
@@ -29,7 +29,7 @@ struct LubricantSettings {
   int elements_x = 0;          // film columns; 0: the chip's discretisation.elements_x
   int elements_y = 4;          // elements across the film
   // m, the film where the chip touches the tool. 20 nm: thinner ones (5, 10 nm) stop the coarse
-  // scene's coupling, 20 and 40 nm give μ within 4 % of each other (bench/RESULTS.md).
+  // scene's coupling, 20 and 40 nm give μ within 4 % of each other (bench/studies/lubricant/README.md).
   double min_film = 20e-9;
   // What the film holds: "gap", all the lubricant in the initial gap from t = 0 (seed-000 protocol's
   // default: it carries the load and no contact forms); "after-pressing" (press-slide's default), the
@@ -43,7 +43,7 @@ struct LubricantSettings {
   // it (seed 000's protocol's default); "ambient" (press-slide's default), draining toward the ambient
   // zero; "cell-mean", moving between the film's parts toward its mean pressure (the film keeps its
   // liquid). Over leak_length either side of the slice. Decided from a study (README, "The lubricant";
-  // bench/RESULTS.md, "The lubricant, eighth pass").
+  // bench/studies/lubricant/README.md, "The lubricant, eighth pass").
   LeakModel leak = LeakModel::ambient;
   double leak_length = 1e-6;  // m: about the roughness' correlation length (tool 0.8 µm, chip 1 µm)
   // Minimum films over which the fluid's load fades out into a contact spot (a continuous switch).
@@ -62,7 +62,7 @@ struct LubricantSettings {
   // Relative, of the interface load and displacement. The chip's own Newton tolerance, amplified by α_R/Δt,
   // leaves the load a noise floor near 1e-4 of its size once the chip yields; with contact spots
   // opening and closing beside the film the iteration stalls near 1e-3 at some points of the box, and
-  // 3e-3 moves μ by 0.4 % where both converge (bench/RESULTS.md).
+  // 3e-3 moves μ by 0.4 % where both converge (bench/studies/lubricant/README.md).
   double coupling_tolerance = 3e-3;
   // Of load.pressure: the interface traction's change, as a root mean square over the film's wall
   // samples, below this is converged whatever the film's own traction (CouplingOptions::load_tolerance).
@@ -71,7 +71,7 @@ struct LubricantSettings {
   double traction_tolerance = 3e-4;
   // The liquid a step's mismatch of interface velocities (fluid against film wall, (λ − λ̃)/α_R)
   // moves through the wall, over the film's volume. The traction tolerance alone left it at up to
-  // 2 % per step and μ 8 % off; 1e-3 puts μ within 0.6 % of 1e-5 (bench/RESULTS.md).
+  // 2 % per step and μ 8 % off; 1e-3 puts μ within 0.6 % of 1e-5 (bench/studies/lubricant/README.md).
   double volume_tolerance = 1e-3;
   int max_coupling_iterations = 50;
   // Exchanges without a new best traction change after which a step fails and is cut back (0: never).

@@ -79,7 +79,7 @@ struct RunOptions {
 MicroResult run_micro(const Scene& scene, const RunOptions& options = {});
 
 // A stopped run's reason with what the scene can change about it: a sealed incompressible film
-// whose interface iteration fails has most likely met an enclosed pocket (bench/RESULTS.md, "Seed
+// whose interface iteration fails has most likely met an enclosed pocket (bench/studies/friction_laws/README.md, "Seed
 // 000's sealed film with a compressible liquid"), which a compressible liquid lets the chip follow.
 std::string explain_stop(const Scene& scene, const std::string& reason);
 

@@ -63,7 +63,7 @@ struct ProtocolSpec {
   // before Γ_B starts to slide; its velocity rises linearly to load.velocity over the first
   // kAccelerationShareOfRunIn of the run-in distance.
   double press_hold = nanoseconds(25);  // s
-  // Defaults from the studies in bench/RESULTS.md ("What mu means"): the tool-to-tool scatter of μ
+  // Defaults from the studies in bench/studies/press_slide_protocol/README.md ("What mu means"): the tool-to-tool scatter of μ
   // dominates the phase-to-phase one, so realisations, not phases; a run-in of 2.5 tool correlation
   // lengths and a window of 3.
   double run_in = 2e-6;           // m of sliding before the window (discarded)
@@ -102,7 +102,7 @@ struct Scene {
   // The chip's equivalent plastic strain as it arrives at the tool (its hardening state; stress-free,
   // in its current shape): 0, seed 000's, a virgin chip; a chip from a cut has passed the primary
   // shear zone, ε̄ = γ/√3 with γ = cos α / (sin φ cos(φ − α)) (Merchant 1945), about 1.1 for
-  // Ti6Al4V at 15° rake (data/cirp2022_ti6al4v_tin). The study that decided it: bench/RESULTS.md.
+  // Ti6Al4V at 15° rake (data/cirp2022_ti6al4v_tin). The study that decided it: bench/studies/ti6al4v/README.md.
   double initial_plastic_strain = 0.0;
   double ramp = nanoseconds(25);      // s, the vertical load rises linearly over this time
   solid::TimeOptions time;
@@ -110,7 +110,7 @@ struct Scene {
   double duration = nanoseconds(250);  // s (seed 000 Figs. 3–5)
   double average_from = 0.5 * duration;  // s, μ is averaged over [average_from, duration] (absent: its second half)
   ProtocolSpec protocol;
-  // Conduction by default for press-slide, adiabatic for seed 000 (bench/RESULTS.md, the heat study).
+  // Conduction by default for press-slide, adiabatic for seed 000 (bench/studies/press_slide_protocol/README.md, the heat study).
   solid::ThermalOptions thermal;
   coupling::LubricantSettings lubricant;  // read by lubricated runs only
   contact::ContactOptions contact;

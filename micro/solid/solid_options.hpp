@@ -38,7 +38,7 @@ struct ChipDiscretisation {
 struct TimeOptions {
   TimeScheme scheme = TimeScheme::generalized_alpha;
   // ρ∞ 0.5: damps the chip's thickness vibration that the pressure ramp excites, which with 0.8 still
-  // rang through the averaging window, and gave μ closest to the small-step runs (bench/RESULTS.md).
+  // rang through the averaging window, and gave μ closest to the small-step runs (bench/studies/dry_micro_model/README.md).
   double spectral_radius = 0.5;
   double dt = nanoseconds(1);  // s, the first step
   double max_dt = dt;          // s, the longest step the step-size control may take (absent: time.step)
@@ -55,7 +55,7 @@ struct NewtonOptions {
   // Cholesky by default: frictionless penalty contact, associative plasticity with the temperature
   // frozen over a step and the mass term make the tangent symmetric positive definite (measured:
   // symmetric to 1e-16); CHOLMOD halves the solve time against UMFPACK at 1800–3300 dofs
-  // (bench/RESULTS.md) and hands any tangent it finds indefinite to LU.
+  // (bench/studies/friction_laws/README.md) and hands any tangent it finds indefinite to LU.
   numerics::LinearSolverKind linear_solver = numerics::LinearSolverKind::cholesky;
   static NewtonOptions read(OptionKeys& keys);
   bool operator==(const NewtonOptions&) const = default;
@@ -71,7 +71,7 @@ struct ThermalOptions {
   ThermalModel model = ThermalModel::conduction;
   double conductivity = 50.0;  // W/(m K), plain carbon steel near room temperature (AISI 1045: ~50)
   bool conducts() const { return model == ThermalModel::conduction; }
-  // `model_default`: what an absent thermal.model means (the protocol decides: bench/RESULTS.md, the heat study).
+  // `model_default`: what an absent thermal.model means (the protocol decides: bench/studies/press_slide_protocol/README.md, the heat study).
   static ThermalOptions read(OptionKeys& keys, ThermalModel model_default);
   bool operator==(const ThermalOptions&) const = default;
 };

@@ -510,7 +510,7 @@ void SolidProblem::assemble_element_mean_dilatation(size_t element, const Eigen:
   left.row(2 * points + 1) = volume * d_mean_j;
   right.row(2 * points + 1) = d_mean_m / mean_j - mean_m / (mean_j * mean_j) * d_mean_j;
   // Lazy (coefficient-wise) products here and below: at these sizes Eigen's GEMM path spent more time
-  // packing its operands than multiplying (perf, bench/RESULTS.md).
+  // packing its operands than multiplying (perf, bench/studies/friction_laws/README.md).
   Eigen::Matrix<double, kDofs, kDofs> k(n, n);
   k.noalias() = left.transpose().lazyProduct(right);
   // Σ w bᵀ Ã b, Ã = s²A + c Cof: the displacement element's blocks with a modified material matrix.

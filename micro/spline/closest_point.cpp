@@ -37,7 +37,7 @@ Stationarity stationarity(const SplineCurve& curve, const Eigen::Vector2d& x, do
 // per coordinate, times |C′|: no iteration gets |f| below that. The relative tolerance alone, 1e-13 of
 // |C′| (d + length scale), asked for less than that once the coordinates are ~20 µm from the origin
 // and the point sits on the curve (d ≈ 0, a short length scale): a 20 µm cell's periodic seam never
-// converged there (bench/RESULTS.md, "The cell width as a lever"). 8 ulps leaves room for the sums in C.
+// converged there (bench/studies/served_interval/README.md, "The cell width as a lever"). 8 ulps leaves room for the sums in C.
 constexpr double kStationarityRoundingUlps = 8.0;
 
 double stationarity_tolerance(const Stationarity& s, const Eigen::Vector2d& x, double length_scale) {

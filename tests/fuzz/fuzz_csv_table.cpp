@@ -7,7 +7,7 @@
 #include "common/dataset_file.hpp"
 #include "common/error.hpp"
 #include "fuzz_support.hpp"
-#include "surrogate/empirical_laws.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = mufric::fuzz::write_input(data, size, ".csv");

@@ -7,9 +7,9 @@
 
 #include "fuzz_support.hpp"
 #include "server/friction_service.hpp"
-#include "surrogate/empirical_laws.hpp"
-#include "surrogate/gp_training.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/laws/empirical_laws.hpp"
+#include "surrogate/gp/gp_training.hpp"
+#include "surrogate/models/model_file.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 
 #include "common/error.hpp"
 #include "fuzz_support.hpp"
-#include "surrogate/model_file.hpp"
+#include "surrogate/models/model_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = mufric::fuzz::write_input(data, size, ".h5");
