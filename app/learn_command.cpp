@@ -173,9 +173,9 @@ void print_status(const std::string& directory) {
   for (const LearnRound& r : s.rounds) {
     char share[32] = "share unknown";
     if (r.uncertain_share >= 0.0) std::snprintf(share, sizeof share, "%.3g %% of queries", 100.0 * r.uncertain_share);
-    std::printf("  round %d: %s; %lld logged rows (%s), plan rows %lld-%lld, %.3g core-hours", r.number, r.step.c_str(),
+    std::printf("  round %d: %s; %lld logged rows (%s), plan rows %lld-%lld, %.3g core-hours", r.number, to_string(r.step),
                 r.logged_rows, share, r.first_plan_row, r.end_plan_row - 1, r.run_core_seconds / 3600.0);
-    if (r.step == "done") {
+    if (r.step == LearnStep::done) {
       std::printf("; %s %s: %s", r.gate.publish ? "published" : "kept aside", r.version.empty() ? "(no candidate)" : r.version.c_str(),
                   r.gate.reason.c_str());
       if (r.quarantined > 0) std::printf("; its %lld samples quarantined (failed, with the reason)", r.quarantined);

@@ -1,5 +1,8 @@
 #include "common/wording.hpp"
 
+#include <cstdarg>
+#include <cstdio>
+
 #include <algorithm>
 #include <vector>
 
@@ -7,6 +10,15 @@ namespace mufric {
 
 // Optimal string alignment distance (Wagner & Fischer 1974, J. ACM 21:168, with Damerau's adjacent
 // swap): "predcit" is 1 from "predict".
+std::string text_printf(const char* pattern, ...) {
+  char text[1024];
+  va_list arguments;
+  va_start(arguments, pattern);
+  std::vsnprintf(text, sizeof text, pattern, arguments);
+  va_end(arguments);
+  return text;
+}
+
 size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
   for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;

@@ -211,7 +211,7 @@ TEST(Learning, ARoundGrowsTheBoxRunsPublishesAndRollsBack) {
   const LearnState s = read_learn_state(f.dir);
   ASSERT_EQ(s.rounds.size(), 1u);
   const LearnRound& r = s.rounds[0];
-  EXPECT_EQ(r.step, "done");
+  EXPECT_EQ(r.step, LearnStep::done);
   EXPECT_EQ(r.logged_rows, 6);
   EXPECT_DOUBLE_EQ(r.uncertain_share, 0.06);
   EXPECT_EQ(r.end_plan_row - r.first_plan_row, 4);
@@ -275,7 +275,7 @@ TEST(Learning, AnUnfinishedRoundIsResumedAtItsStepAndTheBudgetStopsTheLoop) {
   LearnState s = read_learn_state(f.dir);
   ASSERT_EQ(s.rounds.size(), 1u);
   EXPECT_EQ(s.rounds[0].first_plan_row, rows);
-  EXPECT_EQ(s.rounds[0].step, "done");
+  EXPECT_EQ(s.rounds[0].step, LearnStep::done);
   EXPECT_EQ(read_dataset(f.db).size(), rows + 2);
   // 20 s spent of 30: the next round may still plan one run (10 s each), then the budget stops it.
   f.log_queries(6, 200);
@@ -435,7 +435,7 @@ TEST(Learning, ARecalibrationWhoseChainsAreNotUsableIsKeptAsideWithItsReason) {
   o.recalibration_max_steps = 0;
   ASSERT_EQ(learn_rounds(f.dir, o).rounds_finished, 1);
   const LearnRound r = read_learn_state(f.dir).rounds.at(0);
-  EXPECT_EQ(r.step, "done");
+  EXPECT_EQ(r.step, LearnStep::done);
   EXPECT_FALSE(r.gate.publish);
   EXPECT_NE(r.gate.reason.find("the recalibration's chains are not usable: "), std::string::npos) << r.gate.reason;
   EXPECT_TRUE(r.candidate.empty());

@@ -1,0 +1,89 @@
+#include "campaign/learning_state.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+
+namespace mufric {
+
+NLOHMANN_JSON_SERIALIZE_ENUM(LearnStep, {{LearnStep::run, "run"}, {LearnStep::train, "train"}, {LearnStep::gate, "gate"},
+                                         {LearnStep::done, "done"}})
+// The state file's records, each key its member's name (nlohmann/json's macros; at namespace scope,
+// where argument-dependent lookup finds them).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnSetup, db, served_model, log, round_samples, budget_core_hours, rest_below,
+                                   grow_coverage, seed, restarts)
+// With defaults: a state written before the measurements' counts reads them as 0.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GateDecision, publish, reason, old_points, served_loo_rmse, candidate_loo_rmse,
+                                                allowed_loo_rmse, new_points, new_covered, grid_certified, measurements,
+                                                measurements_covered, values_refused)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(LearnRound, number, step, first_plan_row, end_plan_row, logged_rows, uncertain_share,
+                                                run_core_seconds, candidate, gate, quarantined, version, finished_utc)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnState::Served, version, utc, how)
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* to_string(LearnStep step) {
+  switch (step) {
+    case LearnStep::run: return "run";
+    case LearnStep::train: return "train";
+    case LearnStep::gate: return "gate";
+    case LearnStep::done: return "done";
+  }
+  return "?";
+}
+
+std::string learn_state_path(const std::string& directory) { return (fs::path(directory) / "learn.json").string(); }
+
+void write_learn_state(const std::string& dir, const LearnState& s) {
+  const json j = {{"format", "mufric learn state 1"},
+                  {"setup", s.setup},
+                  {"log_offset", s.log_offset},
+                  {"log_file_id", s.log_file_id},
+                  {"queries_seen", s.queries_seen},
+                  {"spent_core_seconds", s.spent_core_seconds},
+                  {"rounds", s.rounds},
+                  {"served", s.served}};
+  write_file_atomically(learn_state_path(dir), j.dump(2) + "\n");
+}
+
+LearnState read_learn_state(const std::string& directory) {
+  const std::string path = learn_state_path(directory);
+  const auto text = read_whole_file(path);
+  if (!text) throw Error(path + ": no learner here (start one with mufric learn init)");
+  try {
+    const json j = json::parse(*text);
+    LearnState s;
+    j.at("setup").get_to(s.setup);
+    j.at("log_offset").get_to(s.log_offset);
+    s.log_file_id = j.value("log_file_id", 0LL);  // absent in states written before the log was renamed when full
+    j.at("queries_seen").get_to(s.queries_seen);
+    j.at("spent_core_seconds").get_to(s.spent_core_seconds);
+    j.at("rounds").get_to(s.rounds);
+    j.at("served").get_to(s.served);
+    return s;
+  } catch (const json::exception& e) {
+    throw Error(path + ": not a learner's state (" + e.what() + ")");
+  }
+}
+
+LearnerLock::LearnerLock(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "lock").string();
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw Error(path + ": cannot open the learner's lock");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd_);
+    throw Error(dir + ": another learner is working in this directory (its lock " + path + " is held)");
+  }
+}
+
+LearnerLock::~LearnerLock() { ::close(fd_); }
+
+}  // namespace mufric
