@@ -17,6 +17,7 @@
 #include "common/wording.hpp"
 #include "micro/fluid/cavity.hpp"
 #include "micro/run/measurement.hpp"
+#include "micro/scene/scene_keys.hpp"
 #include "micro/spline/profile.hpp"
 
 namespace mufric::app {
@@ -412,6 +413,11 @@ void add_micro_commands(CLI::App& app) {
     const int code = run_command(*r);
     if (code != 0) throw CLI::RuntimeError(code);
   });
+
+  auto* keys = micro->add_subcommand("keys", "Every scene key: its type, the value an absent key takes, its range or words (Markdown)");
+  keys->footer("Generated from the scene reader itself (the default dry scene read dry, lubricated and under\n"
+               "seed 000's protocol, and the interface laws' registry); docs/usage.md's \"Scene keys\" is this output.");
+  keys->callback([] { std::fputs(scene::scene_key_reference().c_str(), stdout); });
 
   auto k = std::make_shared<RunCommandOptions>();
   auto* check = micro->add_subcommand("check", "What a scene costs before it runs: unknowns, nonzeros and a memory lower bound");

@@ -18,6 +18,7 @@
 #include "micro/run/chip_model.hpp"
 #include "micro/run/dataset_sample.hpp"
 #include "micro/run/measurement.hpp"
+#include "micro/scene/scene_keys.hpp"
 #include "scene_test_support.hpp"
 
 namespace mufric::scene {
@@ -1028,6 +1029,26 @@ TEST(Lubricated, ASealedIncompressibleFilmsStalledInterfaceNamesTheWayOut) {
   EXPECT_EQ(explain_stop(parse_scene(compressible, "compressible"), stalled), stalled);
   EXPECT_EQ(explain_stop(parse_scene(drained, "drained"), stalled), stalled);
   EXPECT_EQ(explain_stop(parse_scene(dry, "dry"), stalled), stalled);
+}
+
+// The scene-key reference (`mufric micro keys`, docs/usage.md): every key the shipped default scene
+// file sets is there under its own heading, and a key's line says how the reader reads it.
+TEST(Scene, TheKeyReferenceHasEveryKeyOfTheDefaultSceneFileWithHowItIsRead) {
+  const std::string reference = scene_key_reference();
+  std::vector<std::string> leaves;
+  leaf_keys(default_scene_json(), "", leaves);
+  ASSERT_GT(leaves.size(), 20u);
+  for (const auto& key : leaves) EXPECT_NE(reference.find("#### `" + key + "`\n"), std::string::npos) << key;
+  // A lubricated scene's keys (absent from the dry file) and seed 000's are read too.
+  EXPECT_NE(reference.find("#### `lubricant."), std::string::npos);
+  EXPECT_NE(reference.find("#### `time.average_from`\n"), std::string::npos);
+  // How a quantity is read: its kind, the value an absent key takes, its range in human units.
+  EXPECT_NE(reference.find("#### `load.pressure`\npressure; if absent: "), std::string::npos);
+  EXPECT_NE(reference.find("#### `discretisation.volumetric`\nword; if absent: full; one of: full, mean-dilatation\n"),
+            std::string::npos);
+  // A law's coefficient is named with the laws that read it.
+  EXPECT_NE(reference.find("#### `contact.shear_factor`\n"), std::string::npos);
+  EXPECT_NE(reference.find("read when contact.law is shear-factor"), std::string::npos);
 }
 
 }  // namespace

@@ -37,6 +37,15 @@ import sys
 BEGIN = "<!-- BEGIN generated: {} -->"
 END = "<!-- END generated -->"
 TOC_KEY = "commands"
+# The scene keys' reference: `mufric micro keys` prints it (Markdown, from the scene reader itself),
+# kept under "## Scene keys" after "## Scenes".
+SCENE_KEYS_KEY = "mufric micro keys"
+SCENE_KEYS_SECTION = "## Scene keys\n\nEvery key a scene file can set, generated from the scene reader itself (`mufric micro keys`):\n" \
+    "its type (a quantity's kind takes a value with its unit, `\"400MPa\"`), the value an absent key takes and its\n" \
+    "range or words. Keys that only some interface laws read are named with those laws. The readings are the\n" \
+    "default scene's (dry, lubricated and under seed 000's protocol, synthetic surfaces): a surface given by a\n" \
+    "profile file instead, `geometry.tool_surface.csv` or `geometry.chip_surface.csv` (columns `x`, `height` with\n" \
+    "units), is described under Scenes above.\n\n"
 END_OF_COMMANDS = "<!-- END commands"
 BLOCK_RE = re.compile(r"^<!-- BEGIN generated: (.+?) -->\n(.*?)^<!-- END generated -->\n?", re.M | re.S)
 HEADING_RE = re.compile(r"^## (mufric(?: [A-Za-z0-9_-]+)*)[ \t]*$", re.M)
@@ -64,8 +73,8 @@ def fail(message):
     sys.exit(2)
 
 
-def raw_help(binary, path):
-    command = [binary, *path, "--help"]
+def raw_help(binary, path, flag="--help"):
+    command = [binary, *path] + ([flag] if flag else [])
     try:
         done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=60)
     except (OSError, subprocess.TimeoutExpired) as error:
@@ -193,6 +202,7 @@ def main(argv):
     known = {path for path, _, _ in commands}
     wanted = {key_of(path): block_body(text) for path, text, _ in commands}
     wanted[TOC_KEY] = toc_body(commands)
+    wanted[SCENE_KEYS_KEY] = raw_help(binary, ["micro", "keys"], flag=None).rstrip("\n") + "\n"
 
     # A machine-specific path that no normalisation above catches must not reach the document.
     here = {os.path.dirname(binary), os.path.dirname(os.path.dirname(os.path.abspath(usage_md))),
@@ -226,6 +236,10 @@ def main(argv):
             drift.append((key, "differs from the binary's help"))
         elif path not in headings:
             drift.append((key, f"has no heading `## {title_of(path)}`"))
+    if SCENE_KEYS_KEY not in blocks:
+        drift.append((SCENE_KEYS_KEY, "missing (the scene keys' reference)"))
+    elif blocks[SCENE_KEYS_KEY].group(2) != wanted[SCENE_KEYS_KEY]:
+        drift.append((SCENE_KEYS_KEY, "differs from the scene reader's keys"))
     if TOC_KEY not in blocks:
         drift.append((TOC_KEY, "missing (the table of contents' list of commands)"))
     elif blocks[TOC_KEY].group(2) != wanted[TOC_KEY]:
@@ -272,6 +286,11 @@ def main(argv):
             else:
                 doc = doc[:at] + section + doc[at:]
             added.append(title_of(path))
+    if SCENE_KEYS_KEY not in blocks:
+        scenes = re.search(r"^## Scenes[ \t]*$", doc, re.M)
+        after = re.search(r"^## ", doc[scenes.end():], re.M) if scenes else None
+        at = scenes.end() + after.start() if after else len(doc)
+        doc = doc[:at].rstrip("\n") + "\n\n" + SCENE_KEYS_SECTION + wrap(SCENE_KEYS_KEY, wanted[SCENE_KEYS_KEY]) + "\n" + doc[at:]
     if TOC_KEY not in blocks:
         first = re.search(r"^## ", doc, re.M)
         at = first.start() if first else len(doc)

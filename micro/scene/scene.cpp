@@ -262,6 +262,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& source, const std:
   }
   s.warnings = report.warnings;
   s.ineffective_keys = report.ineffective_keys;
+  s.keys_read = report.reads;
   refuse_a_scene_that_cannot_fit(s);
   return s;
 }

@@ -123,6 +123,8 @@ struct Scene {
   nlohmann::json effective;
   std::vector<std::string> warnings;  // keys read but without effect (lubricant.* in a dry scene), one line each
   std::map<std::string, std::string> ineffective_keys;  // their full paths ("contact.shear_factor") → why, to ask by key
+  // Every key this reading read, as it was read (type, value if absent, range): `mufric micro keys`.
+  std::map<std::string, OptionKeyRead> keys_read;
   // Every value alike, the file's words (effective, source) and the warnings included.
   bool operator==(const Scene&) const = default;
 };

@@ -1,6 +1,7 @@
 #include "micro/settings/option_keys.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 #include "common/error.hpp"
 
@@ -32,7 +33,19 @@ const json* OptionKeys::take(const std::string& key) {
   return j_.contains(key) ? &j_.at(key) : nullptr;
 }
 
+void OptionKeys::record(const std::string& key, OptionKeyRead read) { report_.reads[name(key)] = std::move(read); }
+
+namespace {
+std::string plain_number(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+}  // namespace
+
 double OptionKeys::quantity(const std::string& key, QuantityKind kind, double fallback, double lo, double hi) {
+  record(key, {std::string(to_string(kind)), format_human(fallback, kind),
+               "[" + format_human(lo, kind) + ", " + format_human(hi, kind) + "]"});
   const json* v = take(key);
   if (v == nullptr) return fallback;
   if (!v->is_string()) fail(key, "give a value with its unit as a string, e.g. \"" + std::string(example_quantity(kind)) + "\"");
@@ -49,6 +62,7 @@ double OptionKeys::quantity(const std::string& key, QuantityKind kind, double fa
 }
 
 double OptionKeys::number(const std::string& key, double fallback, double lo, double hi) {
+  record(key, {"number", plain_number(fallback), "[" + plain_number(lo) + ", " + plain_number(hi) + "]"});
   const json* v = take(key);
   if (v == nullptr) return fallback;
   if (!v->is_number()) fail(key, "must be a number");
@@ -58,6 +72,7 @@ double OptionKeys::number(const std::string& key, double fallback, double lo, do
 }
 
 int OptionKeys::integer(const std::string& key, int fallback, int lo, int hi) {
+  record(key, {"integer", std::to_string(fallback), "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]"});
   const json* v = take(key);
   if (v == nullptr) return fallback;
   if (!v->is_number_integer()) fail(key, "must be an integer");
@@ -67,6 +82,7 @@ int OptionKeys::integer(const std::string& key, int fallback, int lo, int hi) {
 }
 
 bool OptionKeys::boolean(const std::string& key, bool fallback) {
+  record(key, {"true/false", fallback ? "true" : "false", ""});
   const json* v = take(key);
   if (v == nullptr) return fallback;
   if (!v->is_boolean()) fail(key, "must be true or false");
@@ -74,6 +90,9 @@ bool OptionKeys::boolean(const std::string& key, bool fallback) {
 }
 
 std::string OptionKeys::text(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+  std::string words;
+  for (const auto& a : allowed) words += (words.empty() ? "" : ", ") + a;
+  record(key, {"text", fallback, words.empty() ? "" : "one of: " + words});
   const json* v = take(key);
   if (v == nullptr) return fallback;
   if (!v->is_string()) fail(key, "must be a string");

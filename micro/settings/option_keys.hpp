@@ -45,7 +45,17 @@ const char* choice_name(E value) {
 
 // What one reading of a file found besides the values: keys read but without effect, each with a
 // line for the user. Shared by every section of the file.
+// How a key was read, for the scene-key reference (`mufric micro keys`): its type with its unit's kind,
+// the value an absent key takes, and its range or its words.
+struct OptionKeyRead {
+  std::string type;       // "pressure", "number", "integer", "true/false", "text", "word"
+  std::string if_absent;  // in human units ("400MPa"); "" for a text without one
+  std::string allowed;    // "[0.1MPa, 10GPa]", "one of: a, b"; "" when anything of the type is
+  bool operator==(const OptionKeyRead&) const = default;
+};
+
 struct OptionReport {
+  std::map<std::string, OptionKeyRead> reads;            // every key read, by full path, as it was read
   std::map<std::string, std::string> ineffective_keys;  // full path ("contact.shear_factor") → why
   std::vector<std::string> warnings;                     // one line each, no repeats
   void warn(const std::string& line);
@@ -73,6 +83,9 @@ class OptionKeys {
   // A word from the choice's one table (OptionChoice<E>::names).
   template <class E>
   E choice(const std::string& key, E fallback) {
+    std::string words;
+    for (const auto& c : OptionChoice<E>::names) words += (words.empty() ? "" : ", ") + std::string(c.name);
+    record(key, {"word", choice_name(fallback), "one of: " + words});
     const nlohmann::json* v = take(key);
     if (v == nullptr) return fallback;
     if (!v->is_string()) fail(key, "must be a string");
@@ -95,6 +108,7 @@ class OptionKeys {
 
  private:
   const nlohmann::json* take(const std::string& key);
+  void record(const std::string& key, OptionKeyRead read);
   const nlohmann::json& j_;
   std::string path_;
   const std::string& source_;
