@@ -10,6 +10,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/wording.hpp"
 
 namespace mufric {
 
@@ -72,6 +73,32 @@ LearnState read_learn_state(const std::string& directory) {
   } catch (const json::exception& e) {
     throw Error(path + ": not a learner's state (" + e.what() + ")");
   }
+}
+
+std::string learn_status_text(const std::string& directory) {
+  const LearnState s = read_learn_state(directory);
+  const LearnSetup& u = s.setup;
+  std::string out = text_printf("learner %s\n  database %s\n  serves %s (now version %s)\n  reads %s\n", directory.c_str(),
+                                u.db.c_str(), u.served_model.c_str(), file_version(u.served_model).c_str(), u.log.c_str());
+  out += text_printf("  rounds of at most %lld runs; rests below %.3g %% of queries uncertain or outside\n", u.round_samples,
+                     100.0 * u.rest_below);
+  out += text_printf("  spent %.3g of %.3g core-hours\n", s.spent_core_seconds / 3600.0, u.budget_core_hours);
+  for (const LearnRound& r : s.rounds) {
+    const std::string share =
+        r.uncertain_share >= 0.0 ? text_printf("%.3g %% of queries", 100.0 * r.uncertain_share) : "share unknown";
+    out += text_printf("  round %d: %s; %lld logged rows (%s), plan rows %lld-%lld, %.3g core-hours", r.number, to_string(r.step),
+                       r.logged_rows, share.c_str(), r.first_plan_row, r.end_plan_row - 1, r.run_core_seconds / 3600.0);
+    if (r.step == LearnStep::done) {
+      // The reason may be longer than text_printf's buffer: appended as it is.
+      out += text_printf("; %s %s: ", r.gate.publish ? "published" : "kept aside", r.version.empty() ? "(no candidate)" : r.version.c_str()) +
+             r.gate.reason;
+      if (r.quarantined > 0) out += text_printf("; its %lld samples quarantined (failed, with the reason)", r.quarantined);
+    }
+    out += "\n";
+  }
+  out += "  versions kept (mufric learn rollback " + directory + " VERSION):\n";
+  for (const auto& v : s.served) out += "    " + v.version + "  " + v.utc + "  " + v.how + "\n";
+  return out;
 }
 
 LearnerLock::LearnerLock(const std::string& dir) {

@@ -64,6 +64,8 @@ struct LearnState {
 std::string learn_state_path(const std::string& directory);
 LearnState read_learn_state(const std::string& directory);
 void write_learn_state(const std::string& directory, const LearnState& s);
+// `mufric learn status`: the setup, the spend, each round with its gate's decision, the versions kept.
+std::string learn_status_text(const std::string& directory);
 
 // One learner per directory: DIR/lock held (flock) while it lives; an Error naming the directory when
 // another learner holds it. Closing releases it, as does the process's death.
