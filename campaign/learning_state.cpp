@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -14,8 +15,34 @@
 
 namespace mufric {
 
-NLOHMANN_JSON_SERIALIZE_ENUM(LearnStep, {{LearnStep::run, "run"}, {LearnStep::train, "train"}, {LearnStep::gate, "gate"},
-                                         {LearnStep::done, "done"}})
+namespace {
+
+// A step's word in learn.json and in `learn status`, one table for both.
+constexpr std::pair<LearnStep, const char*> kStepWords[] = {
+    {LearnStep::run, "run"}, {LearnStep::train, "train"}, {LearnStep::gate, "gate"}, {LearnStep::done, "done"}};
+
+}  // namespace
+
+const char* to_string(LearnStep step) {
+  for (const auto& [value, word] : kStepWords) {
+    if (value == step) return word;
+  }
+  return "?";
+}
+
+// A word no step has is an error (read_learn_state names the file), not a silent "run".
+void to_json(nlohmann::json& j, LearnStep step) { j = to_string(step); }
+void from_json(const nlohmann::json& j, LearnStep& step) {
+  const auto word = j.get<std::string>();
+  for (const auto& [value, name] : kStepWords) {
+    if (word == name) {
+      step = value;
+      return;
+    }
+  }
+  throw Error("a round's step '" + word + "' is none of run, train, gate, done");
+}
+
 // The state file's records, each key its member's name (nlohmann/json's macros; at namespace scope,
 // where argument-dependent lookup finds them).
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnSetup, db, served_model, log, round_samples, budget_core_hours, rest_below,
@@ -31,15 +58,6 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(LearnState::Served, version, utc, how)
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const char* to_string(LearnStep step) {
-  switch (step) {
-    case LearnStep::run: return "run";
-    case LearnStep::train: return "train";
-    case LearnStep::gate: return "gate";
-    case LearnStep::done: return "done";
-  }
-  return "?";
-}
 
 std::string learn_state_path(const std::string& directory) { return (fs::path(directory) / "learn.json").string(); }
 
@@ -72,6 +90,8 @@ LearnState read_learn_state(const std::string& directory) {
     return s;
   } catch (const json::exception& e) {
     throw Error(path + ": not a learner's state (" + e.what() + ")");
+  } catch (const Error& e) {
+    throw Error(path + ": not a learner's state (" + e.what() + ")");
   }
 }
 
@@ -89,9 +109,8 @@ std::string learn_status_text(const std::string& directory) {
     out += text_printf("  round %d: %s; %lld logged rows (%s), plan rows %lld-%lld, %.3g core-hours", r.number, to_string(r.step),
                        r.logged_rows, share.c_str(), r.first_plan_row, r.end_plan_row - 1, r.run_core_seconds / 3600.0);
     if (r.step == LearnStep::done) {
-      // The reason may be longer than text_printf's buffer: appended as it is.
-      out += text_printf("; %s %s: ", r.gate.publish ? "published" : "kept aside", r.version.empty() ? "(no candidate)" : r.version.c_str()) +
-             r.gate.reason;
+      out += text_printf("; %s %s: %s", r.gate.publish ? "published" : "kept aside",
+                         r.version.empty() ? "(no candidate)" : r.version.c_str(), r.gate.reason.c_str());
       if (r.quarantined > 0) out += text_printf("; its %lld samples quarantined (failed, with the reason)", r.quarantined);
     }
     out += "\n";

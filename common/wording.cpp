@@ -11,10 +11,13 @@ namespace mufric {
 // Optimal string alignment distance (Wagner & Fischer 1974, J. ACM 21:168, with Damerau's adjacent
 // swap): "predcit" is 1 from "predict".
 std::string text_printf(const char* pattern, ...) {
-  char text[1024];
-  va_list arguments;
+  va_list arguments, measuring;
   va_start(arguments, pattern);
-  std::vsnprintf(text, sizeof text, pattern, arguments);
+  va_copy(measuring, arguments);
+  const int length = std::vsnprintf(nullptr, 0, pattern, measuring);
+  va_end(measuring);
+  std::string text(length > 0 ? static_cast<size_t>(length) : 0, '\0');
+  if (length > 0) std::vsnprintf(text.data(), text.size() + 1, pattern, arguments);
   va_end(arguments);
   return text;
 }

@@ -35,7 +35,7 @@ inline std::string duration_text(double seconds) {
 }
 
 // How many single-character insertions, deletions, substitutions or adjacent swaps turn a into b.
-// printf into a string (at most 1023 bytes), for messages made of figures.
+// printf into a string of whatever length it takes, for messages made of figures.
 __attribute__((format(printf, 1, 2))) std::string text_printf(const char* pattern, ...);
 
 size_t edit_distance(std::string_view a, std::string_view b);

@@ -80,6 +80,31 @@ TEST(Learning, TheGatePassesMoreOfTheSameAndRefusesADamagedRound) {
 }
 
 // The coverage test's tail against the sum of its terms written out: P(X ≤ 5 | 8, 0.95).
+// A state whose round stands at a step no learner has is refused, naming the file and the word (it
+// would otherwise resume at some step silently); the steps' own words read back as written.
+TEST(Learning, AStateWithAnUnknownStepIsAnErrorNamingTheFileAndTheWord) {
+  const std::string dir = test::temp_path("unknown-step-learner");
+  fs::create_directories(dir);
+  LearnState s;
+  s.rounds.push_back(LearnRound{.number = 1, .step = LearnStep::gate});
+  write_learn_state(dir, s);
+  EXPECT_EQ(read_learn_state(dir).rounds.at(0).step, LearnStep::gate);
+  std::string text = *read_whole_file(learn_state_path(dir));
+  const std::string recorded = "\"step\": \"gate\"";
+  const auto at = text.find(recorded);
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(at, recorded.size(), "\"step\": \"walk\"");
+  write_file_atomically(learn_state_path(dir), text);
+  try {
+    read_learn_state(dir);
+    FAIL() << "an unknown step was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("learn.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'walk'"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Learning, TheBinomialTailIsTheSumOfItsTerms) {
   const double p = 0.95, q = 0.05;
   const double by_hand = std::pow(q, 8) + 8 * p * std::pow(q, 7) + 28 * p * p * std::pow(q, 6) + 56 * std::pow(p, 3) * std::pow(q, 5) +

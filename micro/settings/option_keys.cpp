@@ -98,9 +98,7 @@ std::string OptionKeys::text(const std::string& key, const std::string& fallback
   if (!v->is_string()) fail(key, "must be a string");
   const auto s = v->get<std::string>();
   if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
-    std::string list;
-    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-    fail(key, "'" + s + "' is not one of: " + list);
+    fail(key, "'" + s + "' is not one of: " + words);
   }
   return s;
 }

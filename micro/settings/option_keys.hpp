@@ -90,12 +90,10 @@ class OptionKeys {
     if (v == nullptr) return fallback;
     if (!v->is_string()) fail(key, "must be a string");
     const auto word = v->get<std::string>();
-    std::string list;
     for (const auto& c : OptionChoice<E>::names) {
       if (word == c.name) return c.value;
-      list += (list.empty() ? "" : ", ") + std::string(c.name);
     }
-    fail(key, "'" + word + "' is not one of: " + list);
+    fail(key, "'" + word + "' is not one of: " + words);
   }
   // A subsection (an empty one where the key is absent).
   OptionKeys child(const std::string& key);
