@@ -1,11 +1,7 @@
 // `mufric calibrate`: the posterior of an interface law's coefficients given measured friction,
 // through the GP of a campaign that varied them (surrogate/calibration/calibration.hpp).
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <memory>
-#include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -13,12 +9,8 @@
 #include "app/fast_evaluator_options.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
-#include "common/units.hpp"
-#include "common/wording.hpp"
 #include "surrogate/calibration/calibrated_model.hpp"
-#include "surrogate/calibration/calibration.hpp"
-#include "surrogate/calibration/calibration_workflow.hpp"
-#include "surrogate/gp/gp_grids.hpp"
+#include "surrogate/calibration/calibration_run.hpp"
 #include "surrogate/models/model_file.hpp"
 
 namespace mufric::app {
@@ -30,12 +22,12 @@ struct CalibrateOptions {
   std::string model, out, model_out;
   CalibrationRequest request;
   FastOptions fast;  // the calibrated model's grid
-  EnsembleOptions sampler = [] {
-    EnsembleOptions o;
-    o.max_steps = kDefaultCalibrationMaxSteps;
-    return o;
-  }();
-  bool automatic_walkers = true;  // --walkers not given: at least four per coordinate
+  CalibrationRunOptions run{
+      .report = [](const std::string& text) {
+        std::fputs(text.c_str(), stdout);
+        std::fflush(stdout);
+      },
+      .progress = [](const std::string& line) { std::fprintf(stderr, "calibrate: %s\n", line.c_str()); }};
   // --out's rows: evenly thinned to about this many (a long chain of many coordinates is tens of MB;
   // a few thousand samples draw any histogram), 0 for every kept state.
   long long out_samples = kDefaultPosteriorRows;
@@ -52,141 +44,27 @@ std::shared_ptr<const GaussianProcess> load_emulator(const std::string& path) {
   return std::shared_ptr<const GaussianProcess>(gp);
 }
 
-void print_summary(const CalibrationProblem& problem, const CalibrationResult& result, double seconds) {
-  std::printf("%-40s %12s %12s %27s %9s %7s\n", "parameter", "mean", "sd", "95 % credible interval", "split-R^", "ESS");
-  for (size_t j = 0; j < result.summary.size(); ++j) {
-    const ParameterSummary& s = result.summary[j];
-    const QuantityKind kind = problem.coordinate_kind(static_cast<Eigen::Index>(j));
-    const std::string interval = format_human(s.lo95, kind) + " .. " + format_human(s.hi95, kind);
-    std::printf("%-40s %12s %12s %27s %9.4f %7.0f\n", s.name.c_str(), format_human(s.mean, kind).c_str(),
-                format_human_difference(s.sd, kind).c_str(), interval.c_str(), s.split_rhat, s.effective_sample_size);
+void calibrate_command(const CalibrateOptions& o) {
+  const CalibrationRun run = run_calibration(load_emulator(o.model), o.request, o.run);
+  if (!o.out.empty()) {
+    std::string provenance = "model " + o.model + ", measurements";
+    for (const std::string& data : o.request.data_files) provenance += " " + data;
+    provenance += (o.request.priors_file.empty() ? "" : ", priors " + o.request.priors_file) + ", seed " +
+                  std::to_string(o.run.sampler.seed);
+    const PosteriorSamplesCsv csv = posterior_samples_csv(run, o.out_samples, provenance);
+    write_file_atomically(o.out, csv.text);
+    std::printf("wrote %s (%lld of %lld kept samples%s)\n", o.out.c_str(), csv.rows, csv.kept,
+                csv.rows < csv.kept ? ", evenly thinned; --out-samples 0 for all" : "");
   }
-  std::printf("%d walkers x %d steps after %d burn-in, seed %llu; acceptance %.2f; %.1f s\n", result.options.walkers,
-              result.options.steps, result.options.burn_in_steps, static_cast<unsigned long long>(result.options.seed),
-              result.acceptance, seconds);
-  std::printf("how to read it: split-R^ compares each walker's two halves and the walkers with each other (1 when they agree; "
-              "used only at <= %.2f); ESS is the number of independent samples the chains are worth (used only at >= %.0f); "
-              "acceptance is the share of proposed moves taken (0.2-0.5 is usual for this sampler; near 0, the walkers are stuck)\n",
-              kMaximumSplitRhat, kMinimumEffectiveSamples);
-  if (problem.discrepancy()) {
-    std::printf("discrepancy_amplitude in mu units, discrepancy_length_scale in widths of the model's box\n");
-  }
-  if (problem.bias_count() > 0) std::printf("bias[set]: what that data set measures above the others, mu units\n");
-  if (problem.latent_count() > 0) {
-    std::printf("the rows' conditions given with an uncertainty: what the data imply of them (their prior: the stated SD or range)\n");
-  }
-}
-
-// Every how many kept states --out writes one.
-long long posterior_stride(long long kept, long long out_samples) {
-  return out_samples > 0 ? std::max(1LL, (kept + out_samples - 1) / out_samples) : 1;
-}
-
-// Writes --out and returns how many samples it holds.
-long long write_posterior(const std::string& path, const CalibrationProblem& problem, const CalibrationResult& result,
-                          const CalibrateOptions& o) {
-  std::ostringstream text;
-  const Eigen::Index kept = result.samples.rows();
-  const Eigen::Index stride = posterior_stride(kept, o.out_samples);
-  text << "# posterior samples of mufric calibrate (natural units: SI for inputs and conditions): "
-       << (stride == 1 ? "every walker's kept states, " + std::to_string(kept)
-                       : "every " + std::to_string(stride) + "th of the walkers' " + std::to_string(kept) +
-                             " kept states (--out-samples 0 for all)")
-       << "\n";
-  text << "# model " << o.model << ", measurements";
-  for (const std::string& data : o.request.data_files) text << " " << data;
-  text << (o.request.priors_file.empty() ? "" : ", priors " + o.request.priors_file) << ", seed " << o.sampler.seed << "\n";
-  const auto& names = problem.coordinate_names();
-  for (size_t j = 0; j < names.size(); ++j) text << (j ? "," : "") << names[j];
-  text << "\n";
-  char number[32];
-  for (Eigen::Index i = 0; i < kept; i += stride) {
-    for (Eigen::Index j = 0; j < result.samples.cols(); ++j) {
-      std::snprintf(number, sizeof number, "%.17g", result.samples(i, j));
-      text << (j ? "," : "") << number;
-    }
-    text << "\n";
-  }
-  write_file_atomically(path, text.str());
-  return (kept + stride - 1) / stride;
-}
-
-// The calibrated model: served like any other, with a fast evaluator certified against it.
-void write_calibrated_model(const CalibrateOptions& o, const CalibrationSetup& setup, const CalibrationResult& result) {
-  CalibratedModel model = calibrated_model(setup, result);
+  if (o.model_out.empty()) return;
+  // The calibrated model: served like any other, with a fast evaluator certified against it.
+  CalibratedModel model = calibrated_model(run.setup, run.result);
   attach_fast_evaluator(model, o.fast);
   if (o.fast.skip) std::printf("no fast evaluator (--no-fast-evaluator): the exact posterior predictive answers\n");
   save_model(o.model_out, model);
-  const IntervalParts& c = model.centre_parts();
   std::printf("wrote %s (calibrated model of", o.model_out.c_str());
   for (const InputSpec& input : model.inputs()) std::printf(" %s", input.name.c_str());
-  std::printf(")\nat the box centre: mu %.4g, sd %.3g = sqrt(law coefficients %.3g^2 + given them %.3g^2); "
-              "alone: roughness mean %.3g, discrepancy %.3g (parts alone need not add up: given the data, what one "
-              "explains the other need not)\n",
-              c.mu, c.sd, c.parameter_sd, c.conditional_sd, c.emulator_sd, c.discrepancy_sd);
-}
-
-void calibrate_command(const CalibrateOptions& o) {
-  const CalibrationSetup setup = prepare_calibration(load_emulator(o.model), o.request);
-  const CalibrationProblem& problem = *setup.problem;
-  for (const std::string& warning : setup.warnings) std::printf("warning: %s\n", warning.c_str());
-  std::printf("calibrating %s against %s in %s, discrepancy %s",
-              count_of(problem.parameter_count(), "coefficient", "coefficients").c_str(),
-              count_of(problem.data().rows(), "measurement", "measurements").c_str(),
-              count_of(static_cast<long long>(problem.data().data_sets.size()), "data set", "data sets").c_str(),
-              problem.discrepancy() ? "on" : "off");
-  if (problem.priors().discrepancy_trend_sd > 0.0) {
-    std::printf(" with a linear trend (its coefficients normal(0, %g))", problem.priors().discrepancy_trend_sd);
-  }
-  if (problem.latent_count() > 0) {
-    std::printf(", %lld conditions with their uncertainty", static_cast<long long>(problem.latent_count()));
-  }
-  std::printf("\n");
-  for (Eigen::Index k = 0; k < problem.parameter_count(); ++k) {
-    const std::string& name = problem.parameters()[static_cast<size_t>(k)];
-    std::printf("  prior of %s: %s\n", name.c_str(), problem.prior_of(k).describe(kind_of_input(name)).c_str());
-  }
-  for (const auto& [name, value] : problem.held()) {
-    std::printf("  held: %s = %s\n", name.c_str(), format_human(value, kind_of_input(name)).c_str());
-  }
-  for (const auto& [set, prior] : problem.priors().biases) {
-    std::printf("  bias of data set %s: %s\n", set.c_str(), prior.describe().c_str());
-  }
-  std::fflush(stdout);
-  EnsembleOptions sampler = o.sampler;
-  // Walkers: four per coordinate (the stretch move needs more than two, and mixes better with more).
-  if (o.automatic_walkers) sampler.walkers = std::max(sampler.walkers, static_cast<int>(4 * problem.dimension()));
-  if (sampler.walkers < 2 * problem.dimension() + 2) {
-    throw Error("--walkers " + std::to_string(sampler.walkers) + ": the posterior has " + std::to_string(problem.dimension()) +
-                " coordinates; give at least " + std::to_string(2 * problem.dimension() + 2) + " walkers");
-  }
-  const auto started = std::chrono::steady_clock::now();
-  int reported = 0, run = 0;
-  const CalibrationResult result = calibrate(problem, sampler, [&](int done, int total) {
-    if (done == 1) {
-      reported = 0;
-      if (run++ > 0) std::fprintf(stderr, "calibrate: not yet within the limits: running on for %d steps\n", total);
-    }
-    const int tenth = done * 10 / total;
-    if (tenth > reported) {
-      reported = tenth;
-      std::fprintf(stderr, "calibrate: %d %% of the steps (%d of %d)\n", tenth * 10, done, total);
-    }
-  });
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  print_summary(problem, result, seconds);
-  for (const std::string& warning : posterior_warnings(problem, result)) std::printf("warning: %s\n", warning.c_str());
-  std::fflush(stdout);
-  if (!result.convergence_failure.empty()) {
-    throw Error("the posterior is not usable, nothing written: " + result.convergence_failure);
-  }
-  if (!o.out.empty()) {
-    const long long kept = result.samples.rows();
-    const long long written = write_posterior(o.out, problem, result, o);
-    std::printf("wrote %s (%lld of %lld kept samples%s)\n", o.out.c_str(), written, kept,
-                written < kept ? ", evenly thinned; --out-samples 0 for all" : "");
-  }
-  if (!o.model_out.empty()) write_calibrated_model(o, setup, result);
+  std::printf(")\n%s", describe_calibrated_centre(model).c_str());
 }
 
 }  // namespace
@@ -230,18 +108,18 @@ void add_calibrate_command(CLI::App& app) {
                   "model ships with 0.15): it sharpens the prediction and widens the coefficients' posterior (the trend\n"
                   "can stand in for them); to read the coefficients themselves, calibrate without it. Default: none")
       ->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--walkers", o->sampler.walkers,
+  cmd->add_option("--walkers", o->run.sampler.walkers,
                   "Ensemble walkers (Goodman & Weare 2010); default: 32, or four per posterior coordinate when more")
       ->check(CLI::Range(4, 100000))
-      ->each([o](const std::string&) { o->automatic_walkers = false; });
-  cmd->add_option("--burn-in", o->sampler.burn_in_steps, "Steps discarded")->capture_default_str()->check(CLI::Range(0, 10000000));
-  cmd->add_option("--steps", o->sampler.steps, "Steps kept")->capture_default_str()->check(CLI::Range(4, 10000000));
-  cmd->add_option("--max-steps", o->sampler.max_steps,
+      ->each([o](const std::string&) { o->run.automatic_walkers = false; });
+  cmd->add_option("--burn-in", o->run.sampler.burn_in_steps, "Steps discarded")->capture_default_str()->check(CLI::Range(0, 10000000));
+  cmd->add_option("--steps", o->run.sampler.steps, "Steps kept")->capture_default_str()->check(CLI::Range(4, 10000000));
+  cmd->add_option("--max-steps", o->run.sampler.max_steps,
                   "A run not yet within the limits goes on, its length doubling, up to this many steps in all, and is\n"
                   "judged on its latest run (0: never)")
       ->capture_default_str()
       ->check(CLI::Range(0, 100000000));
-  cmd->add_option("--seed", o->sampler.seed, "Seed: the same seed, data and model give the same posterior, bit for bit")
+  cmd->add_option("--seed", o->run.sampler.seed, "Seed: the same seed, data and model give the same posterior, bit for bit")
       ->capture_default_str();
   cmd->add_option("--out", o->out, "Write the posterior samples here (CSV, one column per parameter)");
   cmd->add_option("--out-samples", o->out_samples,

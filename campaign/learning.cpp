@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <utility>
 
 #include "campaign/campaign_summary.hpp"
@@ -18,6 +19,7 @@
 #include "common/files.hpp"
 #include "common/version.hpp"
 #include "common/wording.hpp"
+#include "surrogate/calibration/calibration_run.hpp"
 #include "surrogate/gp/gp_training.hpp"
 #include "surrogate/models/model_file.hpp"
 
@@ -286,7 +288,15 @@ void train_round(const std::string& dir, LearnState& s, const LearnRunOptions& o
   } else {
     say(o, text_printf("round %d: recalibrating on the served model's %lld measurements", round.number,
                   static_cast<long long>(calibrated->problem().data().rows())));
-    const Recalibration r = recalibrate(*calibrated, std::make_shared<const GaussianProcess>(std::move(emulator)), o.recalibration_max_steps);
+    // The sampler's words as the round's: its summary and warnings line by line, its progress by tenths.
+    const std::string prefix = text_printf("round %d: ", round.number);
+    const CalibrationSay report = [&o, &prefix](const std::string& text) {
+      std::istringstream lines(text);
+      for (std::string line; std::getline(lines, line);) say(o, prefix + line);
+    };
+    const CalibrationSay progress = [&o, &prefix](const std::string& line) { say(o, prefix + "recalibration " + line); };
+    const CalibrationRun r = recalibrate(*calibrated, std::make_shared<const GaussianProcess>(std::move(emulator)),
+                                         o.recalibration_max_steps, report, progress);
     if (!r.result.convergence_failure.empty()) {  // no candidate: kept aside at once, with the reason
       round.candidate.clear();
       round.gate = GateDecision{};

@@ -20,7 +20,7 @@
 #include "common/sanitizers.hpp"
 #include "surrogate/calibration/calibrated_model.hpp"
 #include "surrogate/calibration/calibration.hpp"
-#include "surrogate/calibration/calibration_workflow.hpp"
+#include "surrogate/calibration/calibration_run.hpp"
 #include "surrogate/calibration/ensemble_sampler.hpp"
 #include "surrogate/gp/gp_grids.hpp"
 #include "surrogate/gp/gp_training.hpp"

@@ -324,27 +324,4 @@ CalibratedModel calibrated_model(const CalibrationSetup& setup, const Calibratio
   return model;
 }
 
-Recalibration recalibrate(const CalibratedModel& model, std::shared_ptr<const GaussianProcess> emulator, int max_steps) {
-  if (!model.record().priors_kept) {
-    throw Error("the calibrated model's file predates kept priors, so its calibration cannot be run again: calibrate it "
-                "once more with mufric calibrate (its record: priors " + model.record().priors + ")");
-  }
-  if (input_names(*emulator) != input_names(model.emulator())) {
-    throw Error("recalibration: the new emulator's inputs (" + joined(input_names(*emulator)) + ") are not the calibrated model's (" +
-                joined(input_names(model.emulator())) + ")");
-  }
-  const CalibrationProblem& old = model.problem();
-  Recalibration r;
-  r.setup.problem = std::make_shared<const CalibrationProblem>(std::move(emulator), old.data(), old.parameters(), old.priors(), old.held());
-  r.setup.data_source = model.record().data_source;
-  EnsembleOptions sampler;
-  sampler.walkers = model.record().walkers;
-  sampler.steps = model.record().steps;
-  sampler.burn_in_steps = model.record().burn_in_steps;
-  sampler.seed = model.record().seed;
-  sampler.max_steps = max_steps;
-  r.result = calibrate(*r.setup.problem, sampler);
-  return r;
-}
-
 }  // namespace mufric

@@ -72,16 +72,4 @@ CalibratedModel calibrated_model(const CalibrationSetup& setup, const Calibratio
 // --max-steps default, and a recalibration's).
 inline constexpr int kDefaultCalibrationMaxSteps = 40000;
 
-// A calibrated model's calibration run again with another emulator: its campaign's GP retrained on
-// more runs (`mufric learn`). The same measurements, calibrated and held inputs and priors, and the
-// sampler its record keeps (walkers, steps, burn-in, seed); a run not within the limits goes on up to
-// max_steps. The result's convergence_failure says when its chains are not usable. Throws Error when
-// the model's file predates kept priors, or the emulator's inputs are not its emulator's (names and order).
-struct Recalibration {
-  CalibrationSetup setup;
-  CalibrationResult result;
-};
-Recalibration recalibrate(const CalibratedModel& model, std::shared_ptr<const GaussianProcess> emulator,
-                          int max_steps = kDefaultCalibrationMaxSteps);
-
 }  // namespace mufric
