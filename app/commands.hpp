@@ -23,6 +23,8 @@ inline CLI::Validator FiniteRange(double lo, double hi) {
 
 // Each adds its subcommand(s) to the application; the callbacks print and may throw mufric::Error.
 void add_surrogate_commands(CLI::App& app);
+// eval and predict, which add_surrogate_commands wires.
+void add_predict_commands(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 void add_service_commands(CLI::App& app);
