@@ -61,59 +61,35 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
+// Each kind's words: its name, its SI unit, the unit people write it in, an example of a value.
+struct KindWords {
+  QuantityKind kind;
+  std::string_view name, si_unit, human_unit, example;
+};
+constexpr KindWords kKindWords[] = {
+    {QuantityKind::pressure, "pressure", "Pa", "MPa", "800MPa"},
+    {QuantityKind::velocity, "velocity", "m/s", "m/min", "100m/min"},
+    {QuantityKind::temperature, "temperature", "K", "°C", "500C"},
+    {QuantityKind::angle, "angle", "rad", "deg", "90deg"},
+    {QuantityKind::length, "length", "m", "um", "10um"},
+    {QuantityKind::time, "time", "s", "s", "2.5e-7s"},
+    {QuantityKind::dimensionless, "dimensionless", "1", "", "0.3"},
+};
+constexpr KindWords kUnknownKind{QuantityKind::dimensionless, "unknown", "1", "", ""};
+
+const KindWords& words_of(QuantityKind kind) {
+  for (const KindWords& words : kKindWords) {
+    if (words.kind == kind) return words;
+  }
+  return kUnknownKind;
+}
+
 }  // namespace
 
-std::string_view to_string(QuantityKind kind) {
-  switch (kind) {
-    case QuantityKind::pressure: return "pressure";
-    case QuantityKind::velocity: return "velocity";
-    case QuantityKind::temperature: return "temperature";
-    case QuantityKind::angle: return "angle";
-    case QuantityKind::length: return "length";
-    case QuantityKind::time: return "time";
-    case QuantityKind::dimensionless: return "dimensionless";
-  }
-  return "unknown";
-}
-
-std::string_view si_unit(QuantityKind kind) {
-  switch (kind) {
-    case QuantityKind::pressure: return "Pa";
-    case QuantityKind::velocity: return "m/s";
-    case QuantityKind::temperature: return "K";
-    case QuantityKind::angle: return "rad";
-    case QuantityKind::length: return "m";
-    case QuantityKind::time: return "s";
-    case QuantityKind::dimensionless: return "1";
-  }
-  return "1";
-}
-
-std::string_view human_unit(QuantityKind kind) {
-  switch (kind) {
-    case QuantityKind::pressure: return "MPa";
-    case QuantityKind::velocity: return "m/min";
-    case QuantityKind::temperature: return "°C";
-    case QuantityKind::angle: return "deg";
-    case QuantityKind::length: return "um";
-    case QuantityKind::time: return "s";
-    case QuantityKind::dimensionless: return "";
-  }
-  return "";
-}
-
-std::string_view example_quantity(QuantityKind kind) {
-  switch (kind) {
-    case QuantityKind::pressure: return "800MPa";
-    case QuantityKind::velocity: return "100m/min";
-    case QuantityKind::temperature: return "500C";
-    case QuantityKind::angle: return "90deg";
-    case QuantityKind::length: return "10um";
-    case QuantityKind::time: return "2.5e-7s";
-    case QuantityKind::dimensionless: return "0.3";
-  }
-  return "";
-}
+std::string_view to_string(QuantityKind kind) { return words_of(kind).name; }
+std::string_view si_unit(QuantityKind kind) { return words_of(kind).si_unit; }
+std::string_view human_unit(QuantityKind kind) { return words_of(kind).human_unit; }
+std::string_view example_quantity(QuantityKind kind) { return words_of(kind).example; }
 
 std::string lower_case(std::string_view text) {
   std::string lower(text);
