@@ -364,6 +364,24 @@ int fluid_check_cavity(const FluidCheckOptions& o) {
   return 0;
 }
 
+namespace {
+
+// A scene file argument and --set, as every subcommand that reads a scene takes them.
+void add_scene_arguments(CLI::App* cmd, RunCommandOptions& o) {
+  cmd->add_option("scene", o.scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
+  cmd->add_option("--set", o.overrides, "Override a scene value, e.g. --set load.pressure=1300MPa (repeatable)");
+}
+
+// A command's exit code as the process's: CLI11 exits with a RuntimeError's code.
+std::function<void()> exiting_with_code(std::function<int()> command) {
+  return [command = std::move(command)] {
+    const int code = command();
+    if (code != 0) throw CLI::RuntimeError(code);
+  };
+}
+
+}  // namespace
+
 void add_micro_commands(CLI::App& app) {
   auto* micro = app.add_subcommand("micro", "The high-fidelity micro-model of the tool-chip contact zone");
   micro->require_subcommand(1);
@@ -395,8 +413,7 @@ void add_micro_commands(CLI::App& app) {
 
   auto r = std::make_shared<RunCommandOptions>();
   auto* run = micro->add_subcommand("run", "One high-fidelity run, dry or lubricated: mu by eq. 17 with its history and diagnostics");
-  run->add_option("scene", r->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
-  run->add_option("--set", r->overrides, "Override a scene value, e.g. --set load.pressure=1300MPa (repeatable)");
+  add_scene_arguments(run, *r);
   run->add_option("--out", r->out, "Directory for result.json, chip.vtu, tool.vtu, contact.csv (and film.vtu when lubricated)")->capture_default_str();
   run->add_flag("--quiet", r->quiet, "No per-step progress on stderr");
   run->footer("The scene's protocol says what mu means. press-slide (the default): the chip is pressed, then slid;\n"
@@ -409,10 +426,7 @@ void add_micro_commands(CLI::App& app) {
               "averaged over [time.average_from, time.duration].\n"
               "Exit code 0 when the run completed and mu was averaged, 3 when it did not (result.json says why),\n"
               "2 for a bad scene (the message names the key). The default scene is micro/scene/dry_default.json.");
-  run->callback([r] {
-    const int code = run_command(*r);
-    if (code != 0) throw CLI::RuntimeError(code);
-  });
+  run->callback(exiting_with_code([r] { return run_command(*r); }));
 
   auto* keys = micro->add_subcommand("keys", "Every scene key: its type, the value an absent key takes, its range or words (Markdown)");
   keys->footer("Generated from the scene reader itself (the default dry scene read dry, lubricated and under\n"
@@ -421,8 +435,7 @@ void add_micro_commands(CLI::App& app) {
 
   auto k = std::make_shared<RunCommandOptions>();
   auto* check = micro->add_subcommand("check", "What a scene costs before it runs: unknowns, nonzeros and a memory lower bound");
-  check->add_option("scene", k->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
-  check->add_option("--set", k->overrides, "Override a scene value, e.g. --set discretisation.elements_x=128");
+  add_scene_arguments(check, *k);
   check->footer("A scene whose lower bound exceeds the machine's memory is refused by every command that loads it.\n"
                 "Exit code 2 for a scene that is invalid or cannot fit; 0 otherwise.");
   check->callback([k] { run_check(*k); });
@@ -431,8 +444,7 @@ void add_micro_commands(CLI::App& app) {
   auto* converge = micro->add_subcommand(
       "converge", "Refine the mesh (or the sliding step, the window, the number of tool phases) until mu changes by\n"
                   "less than the tolerance between levels; a table of mu, its standard error and the wall time");
-  converge->add_option("scene", c->scene_path, "Scene file (JSON); without it the default dry scene")->check(CLI::ExistingFile);
-  converge->add_option("--set", c->overrides, "Override a scene value (repeatable)");
+  add_scene_arguments(converge, *c);
   converge->add_option("--tolerance", c->tolerance, "Relative change of mu that counts as converged")
       ->capture_default_str()->check(FiniteRange(1e-6, 1.0));
   converge->add_option("--parameter", c->parameter,
@@ -452,10 +464,7 @@ void add_micro_commands(CLI::App& app) {
                    "choices the same way; every level prints mu with its standard error over the draws, and a change\n"
                    "below that error is noise, not convergence. Exit code 0 when converged, 3 when not or when a\n"
                    "level failed.");
-  converge->callback([c] {
-    const int code = converge_command(*c);
-    if (code != 0) throw CLI::RuntimeError(code);
-  });
+  converge->callback(exiting_with_code([c] { return converge_command(*c); }));
 
   auto fc = std::make_shared<FluidCheckOptions>();
   auto* fluid_check = micro->add_subcommand("fluid-check", "Verify the lubricant's flow solver on a published benchmark");
@@ -470,10 +479,7 @@ void add_micro_commands(CLI::App& app) {
                  "x = 0.5, v on y = 0.5) in lid speeds U, and Ghia et al.'s value where they tabulate it (Re = 100).\n"
                  "Above Re = 100 the solve is continued from Re = 100 in doublings. Exit code 0 when converged, 3 when\n"
                  "not (stderr says why).");
-  cavity->callback([fc] {
-    const int code = fluid_check_cavity(*fc);
-    if (code != 0) throw CLI::RuntimeError(code);
-  });
+  cavity->callback(exiting_with_code([fc] { return fluid_check_cavity(*fc); }));
 }
 
 }  // namespace mufric::app
