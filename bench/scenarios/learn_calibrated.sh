@@ -12,27 +12,20 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 mufric=$here/build/app/mufric out=/tmp/learn-calibrated rounds=1 round_samples=4 jobs=2 region=200e6:300e6
+# shellcheck source=bench/tools/learn_common.sh
+source "$here/bench/tools/learn_common.sh"
 while (($#)); do
+  learn_common_option "$@" && { shift 2; continue; }
   case $1 in
-    --mufric) mufric=$2; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    --rounds) rounds=$2; shift 2 ;;
-    --round-samples) round_samples=$2; shift 2 ;;
-    --jobs) jobs=$2; shift 2 ;;
     --region) region=$2; shift 2 ;;
     -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
     *) echo "unknown argument $1 (--help)"; exit 2 ;;
   esac
 done
-py=/usr/bin/python3
-export PYTHONPATH=$here/build/python:$here/examples/python
-rm -rf "$out" && mkdir -p "$out/served" "$out/logs"
+prepare_learn_dir
 cp "$here/campaigns/ti6al4v_tin/db.h5" "$out/db.h5"
 cp "$here/models/ti6al4v_tin.h5" "$out/served/ti.h5"
-# shellcheck source=bench/tools/service_common.sh
-source "$here/bench/tools/service_common.sh"
-trap '[[ -z ${server:-} ]] || kill -TERM "$server" 2>/dev/null || true' EXIT
-server_start_seconds=60 start_server "$out" "$mufric" serve --models "$out/served" --poll 0.5 --log-uncertain "$out/logs"
+server_start_seconds=60 start_learning_server --models "$out/served" --poll 0.5 --log-uncertain "$out/logs"
 # The campaign's box: p 300-2000 MPa, v 1-60 m/min, T 100-1100 C (SI below).
 trace() { "$py" "$here/bench/scenarios/learn_trace.py" "$address" ti --region "$region" \
             --box 300e6:2000e6,0.016667:1,373.15:1373.15 --pass-number "$1" "${@:2}"; }

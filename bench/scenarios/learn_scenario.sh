@@ -20,14 +20,12 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 mufric=$here/build/app/mufric out=/tmp/learn-scenario rounds=6 round_samples=8 budget=0.5 jobs=1 start=16 width=0.05
 engine=() damage_round=0
+# shellcheck source=bench/tools/learn_common.sh
+source "$here/bench/tools/learn_common.sh"
 while (($#)); do
+  learn_common_option "$@" && { shift 2; continue; }
   case $1 in
-    --mufric) mufric=$2; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    --rounds) rounds=$2; shift 2 ;;
-    --round-samples) round_samples=$2; shift 2 ;;
     --budget) budget=$2; shift 2 ;;
-    --jobs) jobs=$2; shift 2 ;;
     --start-samples) start=$2; shift 2 ;;
     --uncertain-width) width=$2; shift 2 ;;
     --slurm-tasks) engine=(--slurm-tasks "$2" --slurm-poll 1); shift 2 ;;
@@ -38,9 +36,7 @@ while (($#)); do
 done
 if ((damage_round > 0 && ${#engine[@]} == 0)); then echo "--damage-round needs --slurm-tasks (the faulty site is a Slurm site)"; exit 2; fi
 source "$here/deploy/coarse_scene.sh"
-py=/usr/bin/python3
-export PYTHONPATH=$here/build/python:$here/examples/python
-rm -rf "$out" && mkdir -p "$out/served" "$out/logs"
+prepare_learn_dir
 started=$SECONDS
 
 echo "== starting campaign: $start Sobol' points over p 400-1300 MPa (the coarse scene)"
@@ -48,10 +44,7 @@ echo "== starting campaign: $start Sobol' points over p 400-1300 MPa (the coarse
 "$mufric" dataset run --plan "$out/plan.h5" --db "$out/db.h5" --jobs "$jobs" | tail -1
 "$mufric" train --data "$out/db.h5" --out "$out/served/gp.h5" | tail -1
 
-# shellcheck source=bench/tools/service_common.sh
-source "$here/bench/tools/service_common.sh"
-trap '[[ -z ${server:-} ]] || kill -TERM "$server" 2>/dev/null || true' EXIT
-start_server "$out" "$mufric" serve --models "$out/served" --poll 0.5 --log-uncertain "$out/logs" --uncertain-width "$width"
+start_learning_server --models "$out/served" --poll 0.5 --log-uncertain "$out/logs" --uncertain-width "$width"
 
 "$mufric" learn init "$out/learner" --db "$out/db.h5" --model "$out/served/gp.h5" --log "$out/logs/gp.csv" \
   --round-samples "$round_samples" --budget-core-hours "$budget"
