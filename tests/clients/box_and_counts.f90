@@ -4,6 +4,7 @@
 program box_and_counts
   use, intrinsic :: iso_c_binding
   use mufric
+  use client_checks
   implicit none
   integer, parameter :: n = 8
   real(c_double), target :: p(n), v(n), t(n), mu(n), lo_ci(n), hi_ci(n)
@@ -15,11 +16,11 @@ program box_and_counts
   character(len=1024) :: uri
   character(len=*), parameter :: options(2) = [character(len=32) :: 'extrapolation=clamp', &
                                                                      'extrapolation=refuse, fill=-1']
-  integer :: k, failures, policy
+  integer :: k, policy
 
   call get_command_argument(1, uri)
-  failures = 0
   do policy = 1, 2
+    write (check_context, '(a, i0, a)') ' (policy ', policy, ')'
     if (mufric_connect(uri, client, trim(options(policy))) /= MUFRIC_OK) then
       write (0, *) 'mufric_connect: ', mufric_error()
       stop 1
@@ -66,16 +67,5 @@ program box_and_counts
   end do
   if (failures > 0) stop 1
   print '(a)', 'box_and_counts (Fortran): every check passed'
-
-contains
-
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (.not. ok) then
-      write (0, '(a, i0, 2a)') 'FAILED (policy ', policy, '): ', what
-      failures = failures + 1
-    end if
-  end subroutine
 
 end program

@@ -4,6 +4,7 @@
 program patch_scatter
   use, intrinsic :: iso_c_binding
   use mufric
+  use client_checks
   implicit none
   integer, parameter :: n = 4
   real(c_double), target :: p(n), v(n), t(n), patch(n)
@@ -12,11 +13,9 @@ program patch_scatter
   real(c_double) :: lo(4), hi(4)
   type(c_ptr) :: client
   character(len=1024) :: sk_uri, plain_uri
-  integer :: failures
 
   call get_command_argument(1, sk_uri)
   call get_command_argument(2, plain_uri)
-  failures = 0
   if (mufric_connect(sk_uri, client, 'fill=-1') /= MUFRIC_OK) then
     write (0, *) 'mufric_connect: ', mufric_error()
     stop 1
@@ -50,16 +49,5 @@ program patch_scatter
   call c_mufric_close(client)
   if (failures > 0) stop 1
   print '(a)', 'patch_scatter (Fortran): every check passed'
-
-contains
-
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (.not. ok) then
-      write (0, '(2a)') 'FAILED: ', what
-      failures = failures + 1
-    end if
-  end subroutine
 
 end program
