@@ -282,24 +282,9 @@ class GrpcClient final : public FrictionClient {
     request.set_model(model_);
     mufric::v1::ModelDescription d;
     call("DescribeModel", [&](grpc::ClientContext* context) { return stub_->DescribeModel(context, request, &d); });
-    ModelInfo info{d.name(), d.version(), d.kind(), {}, d.has_uncertainty(), d.summary(), d.has_patch_scatter(), std::nullopt};
-    if (d.extrapolation() != v1::EXTRAPOLATION_MODEL_DEFAULT && v1::Extrapolation_IsValid(d.extrapolation())) {
-      info.extrapolation = static_cast<Extrapolation>(d.extrapolation());
-    }
-    for (const auto& input : d.inputs()) info.inputs.push_back({input.name(), input.unit(), input.lo(), input.hi()});
-    if (d.has_calibration()) {
-      const auto& c = d.calibration();
-      CalibrationDescription calibration;
-      calibration.data_source = c.data_source();
-      calibration.measurements = static_cast<long long>(c.measurements());
-      calibration.posterior_samples = static_cast<long long>(c.posterior_samples());
-      calibration.discrepancy = c.discrepancy();
-      for (const auto& p : c.parameters()) calibration.parameters.push_back({p.name(), p.mean(), p.sd(), p.lo95(), p.hi95()});
-      const auto& parts = c.at_box_centre();
-      calibration.at_box_centre = {parts.mu(), parts.sd(), parts.parameter_sd(), parts.conditional_sd(), parts.emulator_sd(),
-                                   parts.discrepancy_sd()};
-      info.calibration = std::move(calibration);
-    }
+    ModelInfo info{d.name(), d.version(), d.kind(), wire::decode_inputs(d), d.has_uncertainty(), d.summary(),
+                   d.has_patch_scatter(), wire::decode_calibration(d)};
+    if (const auto policy = wire::decode_extrapolation(d)) info.extrapolation = *policy;
     return info;
   }
 

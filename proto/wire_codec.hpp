@@ -1,8 +1,10 @@
 #pragma once
 // The one translation between the in-process evaluation types (surrogate/core/friction_model.hpp) and the
 // wire (proto/mufric/v1/friction.proto), shared by the C++ client and the server: which request
-// array carries which model input, and what to compute with which tolerances. Each side used to
-// spell these itself, and "use the exact model" had three encodings.
+// array carries which model input, what to compute with which tolerances, and the replies (a model's
+// description, an evaluation's answers). Each side used to spell these itself, and "use the exact
+// model" had three encodings.
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -35,6 +37,22 @@ void encode_options(const EvaluationRequest& what, v1::EvaluateRequest& out);
 // The wire's options as an EvaluationRequest (its defaults where the wire leaves them); "" or the
 // reason a request is invalid, naming the field.
 std::string decode_options(const v1::EvaluateRequest& in, EvaluationRequest& what);
+
+// DescribeModel's reply: a served model (its name and version as the registry serves them) onto
+// the wire, and back the parts a client keeps (its inputs with their box, its own policy outside the
+// box, a calibrated model's calibration).
+void encode_description(const FrictionModel& model, const std::string& name, const std::string& version,
+                        v1::ModelDescription& out);
+InputSpace decode_inputs(const v1::ModelDescription& in);
+// The model's own policy outside its box; nullopt when the reply leaves it unsaid (an older server).
+std::optional<Extrapolation> decode_extrapolation(const v1::ModelDescription& in);
+std::optional<CalibrationDescription> decode_calibration(const v1::ModelDescription& in);
+
+// An Evaluate reply's answers: room for n points of what `what` asks (the gradient's inputs named),
+// then each piece of an evaluation appended in order (the gradient row-major, one row per point).
+void reserve_answers(const EvaluationRequest& what, bool patch_std, int n, const InputSpace& inputs,
+                     v1::EvaluateResponse& out);
+void append_answers(const Evaluation& e, const EvaluationRequest& what, bool patch_std, v1::EvaluateResponse& out);
 
 // Points per piece when a batch is cut into pieces (the client's calls, the server's looks at the
 // deadline): `wanted` (at least 1), cut down to a multiple of the models' evaluation block when it is at

@@ -90,55 +90,7 @@ grpc::Status batch_from_request(const EvaluateRequest& request, const InputSpace
 }
 
 void describe(const ServedModel& served, mufric::v1::ModelDescription& out) {
-  const FrictionModel& model = *served.model;
-  out.set_name(served.name);
-  out.set_version(served.version);
-  out.set_kind(std::string(model.kind()));
-  for (const auto& input : model.inputs()) {
-    auto* d = out.add_inputs();
-    d->set_name(input.name);
-    d->set_unit(input.unit);
-    d->set_lo(input.lo);
-    d->set_hi(input.hi);
-  }
-  out.set_has_uncertainty(model.has_uncertainty());
-  out.set_extrapolation(static_cast<mufric::v1::Extrapolation>(model.default_extrapolation()));
-  out.set_mu_min(model.mu_min());
-  out.set_mu_max(model.mu_max());
-  const KindDescription kind = model.kind_description();
-  if (const auto& training = kind.training) {
-    out.set_training_points(static_cast<uint64_t>(training->training_points));
-    out.set_loo_mean_relative_error(training->loo_mean_relative_error);
-    out.set_loo_max_relative_error(training->loo_max_relative_error);
-    out.set_loo_coverage_95(training->loo_coverage_95);
-    out.set_interval_meaning(training->interval_meaning);
-    out.set_interval(training->interval);
-    out.set_micro_std_error(training->micro_std_error);
-  }
-  if (const auto& calibration = kind.calibration) {
-    auto* c = out.mutable_calibration();
-    c->set_data_source(calibration->data_source);
-    c->set_measurements(static_cast<uint64_t>(calibration->measurements));
-    c->set_discrepancy(calibration->discrepancy);
-    c->set_posterior_samples(static_cast<uint64_t>(calibration->posterior_samples));
-    for (const auto& p : calibration->parameters) {
-      auto* q = c->add_parameters();
-      q->set_name(p.name);
-      q->set_mean(p.mean);
-      q->set_sd(p.sd);
-      q->set_lo95(p.lo95);
-      q->set_hi95(p.hi95);
-    }
-    auto* parts = c->mutable_at_box_centre();
-    parts->set_mu(calibration->at_box_centre.mu);
-    parts->set_sd(calibration->at_box_centre.sd);
-    parts->set_parameter_sd(calibration->at_box_centre.parameter_sd);
-    parts->set_conditional_sd(calibration->at_box_centre.conditional_sd);
-    parts->set_emulator_sd(calibration->at_box_centre.emulator_sd);
-    parts->set_discrepancy_sd(calibration->at_box_centre.discrepancy_sd);
-  }
-  out.set_has_patch_scatter(model.has_patch_scatter());
-  out.set_summary(model.summary());
+  wire::encode_description(*served.model, served.name, served.version, out);
 }
 
 std::size_t evaluation_bytes(const EvaluateRequest& request, int gradient_width, bool patch_std) {
@@ -183,19 +135,7 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
   UncertainQueryLog* const log = model.has_uncertainty() ? limits_.uncertain_log : nullptr;
   EvaluationRequest computed = what;
   computed.std = what.std || log != nullptr;
-  response.mutable_mu()->Reserve(n);
-  if (what.std) response.mutable_std()->Reserve(n);
-  if (what.ci_level > 0.0) {
-    response.mutable_lo()->Reserve(n);
-    response.mutable_hi()->Reserve(n);
-  }
-  if (what.gradient) {
-    response.mutable_gradient()->Reserve(n * static_cast<int>(batch.cols()));
-    for (const auto& input : model.inputs()) response.add_gradient_inputs(input.name);
-  }
-  if (patch) response.mutable_patch_std()->Reserve(n);
-  auto* statuses = response.mutable_status();
-  statuses->Reserve(n);
+  wire::reserve_answers(what, patch, n, model.inputs(), response);
   uint64_t extrapolated = 0, invalid = 0, fast = 0, out_of_box = 0, clipped = 0;
   // Chunks, so that a call whose caller has given up (deadline passed, cancelled) stops within a
   // few milliseconds instead of computing an answer nobody reads.
@@ -211,19 +151,8 @@ grpc::Status FrictionService::evaluate(const EvaluateRequest& request, mufric::v
     if (log != nullptr) log->record(served->name, model.inputs(), batch.middleRows(first, count), e.std);
     fast += static_cast<uint64_t>(e.fast_points);
     clipped += static_cast<uint64_t>(e.range_clipped);
-    response.mutable_mu()->Add(e.mu.data(), e.mu.data() + count);
-    if (what.std) response.mutable_std()->Add(e.std.data(), e.std.data() + count);
-    if (what.ci_level > 0.0) {
-      response.mutable_lo()->Add(e.lo.data(), e.lo.data() + count);
-      response.mutable_hi()->Add(e.hi.data(), e.hi.data() + count);
-    }
-    if (what.gradient) {
-      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = e.gradient;
-      response.mutable_gradient()->Add(rows.data(), rows.data() + rows.size());
-    }
-    if (patch) response.mutable_patch_std()->Add(e.patch_std.data(), e.patch_std.data() + count);
+    wire::append_answers(e, what, patch, response);
     for (const PointStatus s : e.status) {
-      statuses->Add(static_cast<int>(s));
       extrapolated += s == PointStatus::extrapolated;
       invalid += s == PointStatus::invalid_input;
       out_of_box += s == PointStatus::out_of_box;
