@@ -102,15 +102,15 @@ void CalibratedPosterior::predict_block(const Eigen::MatrixXd& conditions, Eigen
   // last group is padded with copies of the last sample, so every block has the same shape and a
   // sample's bits do not depend on how many were kept. Each sample writes its own columns: the
   // threads share nothing but what they read.
-  static_assert(kGpQueryBlock % kPredictionBlockRows == 0);
-  constexpr Eigen::Index kSamplesPerWhitening = kGpQueryBlock / kPredictionBlockRows;
+  static_assert(kEvaluationBlockRows % kPredictionBlockRows == 0);
+  constexpr Eigen::Index kSamplesPerWhitening = kEvaluationBlockRows / kPredictionBlockRows;
   const Eigen::Index groups = (used + kSamplesPerWhitening - 1) / kSamplesPerWhitening;
   auto predict_group = [&](Eigen::Index group) {
     Eigen::MatrixXd stacked;
     for (Eigen::Index j = 0; j < kSamplesPerWhitening; ++j) {
       const Eigen::Index s = std::min(group * kSamplesPerWhitening + j, used - 1);
       const Eigen::MatrixXd points = problem.emulator_points(conditions, samples_[static_cast<size_t>(s)].point.theta);
-      if (j == 0) stacked.resize(kGpQueryBlock, points.cols());
+      if (j == 0) stacked.resize(kEvaluationBlockRows, points.cols());
       stacked.middleRows(j * q, q) = points;
     }
     const GaussianProcess::LatentPoints all = emulator.latent_points(stacked);

@@ -25,7 +25,7 @@ namespace {
 
 // Queries per block: the n × block kernel slab stays in L2 for n ≈ 1000 while the triangular solve
 // still runs as a matrix–matrix (level-3) operation.
-constexpr Eigen::Index kQueryBlock = kGpQueryBlock;
+constexpr Eigen::Index kQueryBlock = kEvaluationBlockRows;  // the one block size (friction_model.hpp)
 // Below this many queries a parallel region costs more than it saves.
 constexpr Eigen::Index kParallelThreshold = 2 * kQueryBlock;
 // Up to this many queries with a variance read L⁻¹ row by row once for all of them (memory-bound,

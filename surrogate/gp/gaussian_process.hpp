@@ -11,9 +11,6 @@
 
 namespace mufric {
 
-// The GP answers a batch in blocks of kEvaluationBlockRows queries (surrogate/core/friction_model.hpp).
-inline constexpr long long kGpQueryBlock = kEvaluationBlockRows;
-
 class FastEvaluator;
 
 struct GpHyperParameters {
@@ -173,7 +170,7 @@ class GaussianProcess final : public FrictionModel {
       return {scaled.middleRows(first, count), mean.segment(first, count), whitened.middleCols(first, count)};
     }
   };
-  // Up to kLatentSmallBatch points are whitened by Eigen's product; more in blocks of kGpQueryBlock
+  // Up to kLatentSmallBatch points are whitened by Eigen's product; more in blocks of kEvaluationBlockRows
   // through the batch variance's product (OpenBLAS's dtrmm in a portable build, each block full and
   // zero-padded). A caller that wants a point's bits independent of the batch keeps its row count
   // on one side of the line (a calibration's likelihood: its measurements; its predictive: whole blocks).
@@ -202,7 +199,7 @@ class GaussianProcess final : public FrictionModel {
   void evaluate_block(const QueryBatch& x, Eigen::Index first, Eigen::Index count, const EvaluationRequest& what,
                       Eigen::MatrixXd& k_block, Eigen::MatrixXd& v_block, Evaluation& out, long long& clamped) const;
 
-  // v_block's first columns ← L⁻¹ k_block (k_block: n × at most kGpQueryBlock columns): Eigen's
+  // v_block's first columns ← L⁻¹ k_block (k_block: n × at most kEvaluationBlockRows columns): Eigen's
   // product in a build for a vector ISA, OpenBLAS's dtrmm on a full zero-padded block in a portable one.
   void whiten_block(const Eigen::Ref<const Eigen::MatrixXd>& k_block, Eigen::MatrixXd& v_block) const;
   // ((x − lo)/width)/l per row: the space the training inputs are scaled to.
