@@ -5,11 +5,7 @@
 namespace mufric {
 namespace {
 
-QueryBatch rows_of(const QueryBatch& x, const std::vector<Eigen::Index>& which) {
-  QueryBatch part(static_cast<Eigen::Index>(which.size()), x.cols());
-  for (size_t r = 0; r < which.size(); ++r) part.row(static_cast<Eigen::Index>(r)) = x.row(which[r]);
-  return part;
-}
+QueryBatch rows_of(const QueryBatch& x, const std::vector<Eigen::Index>& which) { return x(which, Eigen::all); }
 
 }  // namespace
 
