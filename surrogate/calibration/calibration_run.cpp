@@ -118,30 +118,13 @@ CalibrationRun run_calibration(std::shared_ptr<const GaussianProcess> emulator, 
 
 CalibrationRun recalibrate(const CalibratedModel& model, std::shared_ptr<const GaussianProcess> emulator, int max_steps,
                            const CalibrationSay& report, const CalibrationSay& progress) {
-  if (!model.record().priors_kept) {
-    throw Error("the calibrated model's file predates kept priors, so its calibration cannot be run again: calibrate it "
-                "once more with mufric calibrate (its record: priors " + model.record().priors + ")");
-  }
-  const auto names = [](const GaussianProcess& gp) {
-    std::string text;
-    for (const InputSpec& input : gp.inputs()) text += (text.empty() ? "" : ", ") + input.name;
-    return text;
-  };
-  if (names(*emulator) != names(model.emulator())) {
-    throw Error("recalibration: the new emulator's inputs (" + names(*emulator) + ") are not the calibrated model's (" +
-                names(model.emulator()) + ")");
-  }
-  const CalibrationProblem& old = model.problem();
-  CalibrationSetup setup;
-  setup.problem = std::make_shared<const CalibrationProblem>(std::move(emulator), old.data(), old.parameters(), old.priors(), old.held());
-  setup.data_source = model.record().data_source;
   CalibrationRunOptions options{.automatic_walkers = false, .report = report, .progress = progress};
   options.sampler.walkers = model.record().walkers;
   options.sampler.steps = model.record().steps;
   options.sampler.burn_in_steps = model.record().burn_in_steps;
   options.sampler.seed = model.record().seed;
   options.sampler.max_steps = max_steps;
-  return sample_calibration(std::move(setup), options);
+  return sample_calibration(recalibration_setup(model, std::move(emulator)), options);
 }
 
 PosteriorSamplesCsv posterior_samples_csv(const CalibrationRun& run, long long most_rows, const std::string& provenance) {

@@ -48,10 +48,9 @@ CalibrationRun run_calibration(std::shared_ptr<const GaussianProcess> emulator, 
                                const CalibrationRunOptions& options);
 
 // A calibrated model's calibration run again with another emulator: its campaign's GP retrained on
-// more runs (`mufric learn`). The same measurements, calibrated and held inputs and priors, and the
-// sampler its record keeps (walkers, steps, burn-in, seed); a run not within the limits goes on up to
-// max_steps. The result's convergence_failure says when its chains are not usable. Throws Error when
-// the model's file predates kept priors, or the emulator's inputs are not its emulator's (names and order).
+// more runs (`mufric learn`). Set up by recalibration_setup (which throws for what cannot be run
+// again), sampled with the sampler its record keeps (walkers, steps, burn-in, seed); a run not within
+// the limits goes on up to max_steps. The result's convergence_failure says when its chains are not usable.
 CalibrationRun recalibrate(const CalibratedModel& model, std::shared_ptr<const GaussianProcess> emulator,
                            int max_steps = kDefaultCalibrationMaxSteps, const CalibrationSay& report = {},
                            const CalibrationSay& progress = {});

@@ -290,6 +290,22 @@ CalibrationSetup prepare_calibration(std::shared_ptr<const GaussianProcess> emul
   return setup;
 }
 
+CalibrationSetup recalibration_setup(const CalibratedModel& model, std::shared_ptr<const GaussianProcess> emulator) {
+  if (!model.record().priors_kept) {
+    throw Error("the calibrated model's file predates kept priors, so its calibration cannot be run again: calibrate it "
+                "once more with mufric calibrate (its record: priors " + model.record().priors + ")");
+  }
+  if (input_names(*emulator) != input_names(model.emulator())) {
+    throw Error("recalibration: the new emulator's inputs (" + joined(input_names(*emulator)) + ") are not the calibrated model's (" +
+                joined(input_names(model.emulator())) + ")");
+  }
+  const CalibrationProblem& old = model.problem();
+  CalibrationSetup setup;
+  setup.problem = std::make_shared<const CalibrationProblem>(std::move(emulator), old.data(), old.parameters(), old.priors(), old.held());
+  setup.data_source = model.record().data_source;
+  return setup;
+}
+
 CalibrationRecord calibration_record(const CalibrationSetup& setup, const CalibrationResult& result) {
   const CalibrationProblem& problem = *setup.problem;
   std::string priors;

@@ -62,6 +62,11 @@ std::vector<std::string> posterior_warnings(const CalibrationProblem& problem, c
 // cause (file, line, column, input) for what cannot be calibrated.
 CalibrationSetup prepare_calibration(std::shared_ptr<const GaussianProcess> emulator, const CalibrationRequest& request);
 
+// A calibrated model's calibration set up again on another emulator (its campaign's GP retrained):
+// the same measurements, calibrated and held inputs, priors and data source. Throws Error when the
+// model's file predates kept priors, or the emulator's inputs are not its emulator's (names and order).
+CalibrationSetup recalibration_setup(const CalibratedModel& model, std::shared_ptr<const GaussianProcess> emulator);
+
 // The record a calibrated model keeps of its calibration.
 CalibrationRecord calibration_record(const CalibrationSetup& setup, const CalibrationResult& result);
 
