@@ -27,6 +27,8 @@ void add_surrogate_commands(CLI::App& app);
 void add_predict_commands(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
+// measurements orthogonal: measured tests turned into calibration rows.
+void add_measurements_command(CLI::App& app);
 void add_service_commands(CLI::App& app);
 void add_micro_commands(CLI::App& app);
 // plan / run / refine / status / merge under the `dataset` subcommand that add_surrogate_commands

@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   mufric::app::add_surrogate_commands(app);
   mufric::app::add_calibrate_command(app);
+  mufric::app::add_measurements_command(app);
   mufric::app::add_bench_command(app);
   mufric::app::add_service_commands(app);
   mufric::app::add_micro_commands(app);

@@ -19,12 +19,34 @@ std::string trim(const std::string& s) {
   return s.substr(begin, end - begin + 1);
 }
 
+// RFC 4180 cells: a cell in double quotes may hold commas, and "" inside it is one quote (how a
+// spreadsheet writes a text column, e.g. a provenance note).
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> cells;
-  std::stringstream stream(line);
   std::string cell;
-  while (std::getline(stream, cell, ',')) cells.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        cell += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        cell += c;
+      }
+    } else if (c == '"' && trim(cell).empty()) {
+      quoted = true;
+      cell.clear();
+    } else if (c == ',') {
+      cells.push_back(trim(cell));
+      cell.clear();
+    } else {
+      cell += c;
+    }
+  }
+  cells.push_back(trim(cell));
   return cells;
 }
 
@@ -106,11 +128,19 @@ std::vector<double> CsvTable::si_column(const std::string& name, QuantityKind ki
   return values;
 }
 
-CsvTable read_csv_table(const std::string& path) {
+namespace {
+
+// The header and every data row's cells as text, with the rows' line numbers.
+struct CsvCells {
+  std::vector<CsvColumn> columns;
+  std::vector<std::vector<std::string>> rows;
+  std::vector<int> line_of_row;
+};
+
+CsvCells read_cells(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot open (no such file or not readable)");
-  CsvTable table;
-  table.path = path;
+  CsvCells table;
   std::string line;
   int line_number = 0;
   while (std::getline(in, line)) {
@@ -118,7 +148,7 @@ CsvTable read_csv_table(const std::string& path) {
     if (line_number == 1) strip_byte_order_mark(line);
     const std::string content = trim(line);
     if (content.empty() || content.front() == '#') continue;
-    const auto cells = split(content);
+    auto cells = split(content);
     if (table.columns.empty()) {
       if (cells.size() == 1 && content.find(';') != std::string::npos) throw Error(semicolon_advice(path));
       for (const auto& cell : cells) {
@@ -138,24 +168,57 @@ CsvTable read_csv_table(const std::string& path) {
       throw Error(path + ": line " + std::to_string(line_number) + ": " + std::to_string(cells.size()) +
                   " cells, the header has " + std::to_string(table.columns.size()));
     }
-    std::vector<double> row(cells.size());
-    for (size_t j = 0; j < cells.size(); ++j) {
-      const std::string& cell = cells[j];
-      const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), row[j]);
-      if (ec != std::errc() || end != cell.data() + cell.size() || cell.empty()) {
-        throw Error(path + ": line " + std::to_string(line_number) + ", column '" + table.columns[j].name +
-                    "': '" + cell + "' is not a number");
-      }
-      if (!std::isfinite(row[j])) {
-        throw Error(path + ": line " + std::to_string(line_number) + ", column '" + table.columns[j].name +
-                    "': " + cell + " is not a finite number");
-      }
-    }
-    table.rows.push_back(std::move(row));
+    table.rows.push_back(std::move(cells));
     table.line_of_row.push_back(line_number);
   }
   if (table.columns.empty()) throw Error(path + ": empty file (no header line)");
   return table;
+}
+
+double parse_cell(const std::string& path, int line_number, const std::string& column, const std::string& cell) {
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+  if (ec != std::errc() || end != cell.data() + cell.size() || cell.empty()) {
+    throw Error(path + ": line " + std::to_string(line_number) + ", column '" + column + "': '" + cell +
+                "' is not a number");
+  }
+  if (!std::isfinite(value)) {
+    throw Error(path + ": line " + std::to_string(line_number) + ", column '" + column + "': " + cell +
+                " is not a finite number");
+  }
+  return value;
+}
+
+// The numeric table of the columns at `indices` (in that order).
+CsvTable numeric_table(const std::string& path, const CsvCells& cells, const std::vector<size_t>& indices) {
+  CsvTable table;
+  table.path = path;
+  for (size_t j : indices) table.columns.push_back(cells.columns[j]);
+  table.line_of_row = cells.line_of_row;
+  for (size_t i = 0; i < cells.rows.size(); ++i) {
+    std::vector<double> row;
+    row.reserve(indices.size());
+    for (size_t j : indices) row.push_back(parse_cell(path, cells.line_of_row[i], cells.columns[j].name, cells.rows[i][j]));
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+}  // namespace
+
+CsvTable read_csv_table(const std::string& path) {
+  const CsvCells cells = read_cells(path);
+  std::vector<size_t> every(cells.columns.size());
+  for (size_t j = 0; j < every.size(); ++j) every[j] = j;
+  return numeric_table(path, cells, every);
+}
+
+CsvTable read_csv_columns(const std::string& path, const std::vector<std::string>& names) {
+  const CsvCells cells = read_cells(path);
+  CsvTable header{path, cells.columns, {}, {}};
+  std::vector<size_t> indices;
+  for (const auto& name : names) indices.push_back(header.column(name));
+  return numeric_table(path, cells, indices);
 }
 
 }  // namespace mufric

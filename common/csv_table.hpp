@@ -1,6 +1,7 @@
 #pragma once
 // A numeric CSV table whose header names each column and its unit: "contact_pressure[MPa],mu".
-// Lines starting with '#' are comments. Errors name the file, line and column.
+// Lines starting with '#' are comments; a cell in double quotes may hold commas. Errors name the
+// file, line and column.
 #include <string>
 #include <vector>
 
@@ -31,5 +32,9 @@ struct CsvTable {
 
 // Parses `path`; every cell must be a finite number. Throws Error naming line and column.
 CsvTable read_csv_table(const std::string& path);
+// Only the columns called `names`, in that order, each cell a finite number; the file's other
+// columns may hold text or be empty (a test log with a notes column). A missing column throws Error
+// naming the file and the columns present.
+CsvTable read_csv_columns(const std::string& path, const std::vector<std::string>& names);
 
 }  // namespace mufric

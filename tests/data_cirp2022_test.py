@@ -5,11 +5,10 @@
   2. the extraction method on a figure drawn here by matplotlib from known values (the same kind of
      figure: grouped bars with error bars, hatched narrower bars, rotated labels): exact recovery;
   3. one value of the source's figure against the value read by eye from its rendering;
-  4. the rake-face analysis (rake_face.py) on forces made from a known friction angle and known edge
-     forces: Merchant's closed form and the lines' intercepts come back;
-  5. the shipped model's measurement file (rake_face_mu_calibration.csv) against the validation's rows;
-  6. where a copy of the source repository is given (MUFRIC_CIRP_REPO), the extraction re-run from it
+  4. the shipped model's measurement file (rake_face_mu_calibration.csv) against the validation's rows;
+  5. where a copy of the source repository is given (MUFRIC_CIRP_REPO), the extraction re-run from it
      gives the committed files byte for byte.
+The rake-face analysis (forces to the rake face) is the library's, tested in tests/test_reduction.cpp.
 Usage: data_cirp2022_test.py SOURCE_DIR"""
 import csv
 import io
@@ -24,7 +23,6 @@ SOURCE_DIR = Path(sys.argv.pop(1) if len(sys.argv) > 1 else Path(__file__).resol
 DATA = SOURCE_DIR / "data" / "cirp2022_ti6al4v_tin"
 sys.path.insert(0, str(DATA))
 import extract  # noqa: E402
-import rake_face  # noqa: E402
 
 
 def read_csv(path):
@@ -183,41 +181,6 @@ class OneValueReadByEye(unittest.TestCase):
         self.assertAlmostEqual(mean, 176.0, delta=2.0)
         self.assertAlmostEqual(mean - half, 163.0, delta=2.0)
         self.assertAlmostEqual(mean + half, 189.0, delta=2.0)
-
-
-class RakeFaceAnalysisOnKnownForces(unittest.TestCase):
-    def test_friction_angle_edge_forces_and_oxley_contact_length_come_back(self):
-        import math
-        import numpy as np
-        # Chip-forming forces whose resultant makes the friction angle beta with the rake face's normal:
-        # Fc = R cos(beta - gamma), Ff = R sin(beta - gamma) per unit h (Merchant's force circle), plus
-        # edge forces that do not grow with h.
-        gamma, beta = math.radians(rake_face.RAKE_ANGLE_DEG), math.radians(24.0)
-        k = 1.7  # N per um of h, 1 mm wide
-        edge_c, edge_f = 30.0, 35.0
-        rows = []
-        for v in (5.0, 40.0):
-            for h in rake_face.THICKNESSES_UM:
-                fc = edge_c + k * h * math.cos(beta - gamma)
-                ff = edge_f + k * h * math.sin(beta - gamma)
-                rows.append({"inclination_angle[deg]": "0", "cutting_speed[m/min]": str(v),
-                             "uncut_chip_thickness[um]": str(h), "Fc_exp_mean[N]": str(fc), "Fc_exp_2sd[N]": "1e-6",
-                             "Ff_exp_mean[N]": str(ff), "Ff_exp_2sd[N]": "1e-6", "chip_ratio_exp_mean[1]": "1.5",
-                             "chip_ratio_exp_2sd[1]": "1e-9"})
-        results = rake_face.analyse(rows, 0.0, 64, np.random.default_rng(1))
-        for r in results:
-            self.assertAlmostEqual(float(np.mean(r["mu"])), math.tan(beta), places=6)
-            self.assertAlmostEqual(float(np.mean(r["edge_c"])), edge_c, places=4)
-            self.assertAlmostEqual(float(np.mean(r["edge_f"])), edge_f, places=4)
-            # tan(phi) = cos(gamma) / (lambda_h - sin(gamma)); with C n_eq = 0 Oxley's l_c / h is the
-            # geometric sin(theta) / (cos(beta) sin(phi)), theta = beta + phi - gamma.
-            phi = math.atan(math.cos(gamma) / (1.5 - math.sin(gamma)))
-            self.assertAlmostEqual(float(np.mean(r["phi"])), math.degrees(phi), places=6)
-            theta = beta + phi - gamma
-            c_neq = max(0.0, 1.0 + math.pi / 2.0 - 2.0 * phi - math.tan(theta))
-            expected = math.sin(theta) / (math.cos(beta) * math.sin(phi)) * (1.0 + c_neq / (3.0 * math.tan(theta)))
-            self.assertAlmostEqual(float(np.mean(r["contact_per_h"])), expected, places=6)
-            self.assertAlmostEqual(float(np.mean(r["sliding_velocity"])), r["speed"] / 60.0 / 1.5, places=9)
 
 
 class CalibrationMeasurements(unittest.TestCase):

@@ -64,3 +64,21 @@ TEST(CsvTable, WellFormedHeadersStillRead) {
   EXPECT_EQ(t.columns[1].name, "chip_ratio_exp_mean");
   EXPECT_EQ(t.columns[2].unit, "");
 }
+
+TEST(CsvTable, QuotedCellsHoldCommasAndOnlyTheAskedColumnsMustBeNumbers) {
+  // A test log as a spreadsheet writes it: a quoted note with commas and "" quotes, an empty cell.
+  const std::string path = file_with("log.csv",
+                                     "speed[m/min],note,force[N],spare\n"
+                                     "5,\"steady, after \"\"run-in\"\"\",105.5,\n"
+                                     "10,plain,98.25,\n");
+  const CsvTable table = read_csv_columns(path, {"force", "speed"});
+  ASSERT_EQ(table.columns.size(), 2u);
+  EXPECT_EQ(table.columns[0].name, "force");
+  EXPECT_EQ(table.rows[0][0], 105.5);
+  EXPECT_EQ(table.rows[1][1], 10.0);
+  EXPECT_EQ(table.line_of_row[1], 3);
+  // The whole table still wants every cell a number, and names the first that is not.
+  EXPECT_NE(error_of([&] { read_csv_table(path); }).find("line 2, column 'note'"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_csv_columns(path, {"spare"}); }).find("line 2, column 'spare': '' is not a number"),
+            std::string::npos);
+}

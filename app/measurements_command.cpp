@@ -1,0 +1,52 @@
+// measurements: a pair's measured tests turned into the rows `mufric calibrate` reads.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "app/commands.hpp"
+#include "common/files.hpp"
+#include "surrogate/reduction/orthogonal_cut_files.hpp"
+
+namespace mufric::app {
+
+void add_measurements_command(CLI::App& app) {
+  auto* measurements = app.add_subcommand("measurements", "A pair's measured tests turned into the rows calibrate reads");
+  measurements->require_subcommand(1);
+  struct Options {
+    std::string setup, out_dir;
+    int draws = 0;
+    long long seed = -1;
+  };
+  auto options = std::make_shared<Options>();
+  auto* orthogonal = measurements->add_subcommand(
+      "orthogonal",
+      "Orthogonal cutting tests (forces per speed and uncut chip thickness, chip ratio) to the rake face: mu, normal stress, "
+      "sliding velocity and interface temperature per speed, with their SDs by Monte Carlo (edge forces apart by the "
+      "forces' lines in h, Merchant's friction, Oxley's contact length and temperature). Writes the analysis table and the "
+      "calibration rows beside the setup (or in --out-dir) and prints one line per speed");
+  orthogonal->add_option("setup", options->setup, "the setup (JSON): the tests' CSV, their columns, the tool's rake, the cut's width, "
+                                                  "the work material's density and thermal ranges (docs/new-pair.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  orthogonal->add_option("--out-dir", options->out_dir, "where the tables go (default: the setup's folder)");
+  orthogonal->add_option("--draws", options->draws, "Monte Carlo draws (default: the setup's, or 20000)")->check(CLI::Range(2, 100000000));
+  orthogonal->add_option("--seed", options->seed, "the draws' seed, as numpy.random.default_rng(seed) (default: the setup's, or 2026)")
+      ->check(CLI::Range(0LL, 4294967295LL));
+  orthogonal->callback([options] {
+    OrthogonalCutStudy study = read_orthogonal_cut_study(options->setup);
+    if (options->draws > 0) study.setup.draws = options->draws;
+    if (options->seed >= 0) study.setup.seed = static_cast<std::uint32_t>(options->seed);
+    const auto results = rake_face_from_orthogonal_cuts(study.cuts, study.setup);
+    const std::filesystem::path folder =
+        options->out_dir.empty() ? std::filesystem::path(options->setup).parent_path() : std::filesystem::path(options->out_dir);
+    if (!folder.empty()) std::filesystem::create_directories(folder);
+    std::fputs(orthogonal_cut_summary(study, results).c_str(), stdout);
+    for (const auto& table : orthogonal_cut_tables(study, results)) {
+      const std::string path = (folder / table.file_name).string();
+      write_file_atomically(path, table.text);
+      std::printf("wrote %s\n", path.c_str());
+    }
+  });
+}
+
+}  // namespace mufric::app
