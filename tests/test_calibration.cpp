@@ -21,6 +21,7 @@
 #include "surrogate/calibration/calibrated_model.hpp"
 #include "surrogate/calibration/calibration.hpp"
 #include "surrogate/calibration/calibration_run.hpp"
+#include "surrogate/calibration/coefficient_evidence.hpp"
 #include "surrogate/calibration/ensemble_sampler.hpp"
 #include "surrogate/gp/gp_grids.hpp"
 #include "surrogate/gp/gp_training.hpp"
@@ -293,6 +294,82 @@ TEST(Calibration, AKnownShearFactorLiesInsideIts95PercentIntervalInAtLeast90Perc
   RecordProperty("covered", covered);
   EXPECT_GE(covered, (9 * repeats + 9) / 10) << covered << " of " << repeats;  // ≥ 90 %
   EXPECT_EQ(converged, repeats);
+}
+
+// --- what the measurements determine (issue 70) -------------------------------------------------
+
+// Two coefficients over (p, v): in the first simulator μ does not depend on the adhesive
+// coefficient at all (the data cannot see it) and rises with the shear factor; in the second μ
+// depends on their sum only (the data see a combination).
+double blind_to_adhesion(double p, double v, double /*adhesion*/, double m) { return synthetic_simulator(p, v, m); }
+double sees_only_the_sum(double p, double v, double adhesion, double m) { return synthetic_simulator(p, v, 0.5 * (adhesion + m)); }
+
+std::shared_ptr<const GaussianProcess> two_coefficient_emulator(double (*simulator)(double, double, double, double)) {
+  TrainingSet data;
+  data.inputs = synthetic_box();
+  data.inputs.insert(data.inputs.end() - 1, {"adhesive_coefficient", "1", 0.2, 0.9});
+  const Eigen::Index n = 90;
+  data.x.resize(n, 4);
+  data.mu.resize(n);
+  data.mu_std = Eigen::VectorXd::Constant(n, 0.003);
+  std::mt19937_64 random(31);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < 4; ++j) {
+      const InputSpec& in = data.inputs[static_cast<size_t>(j)];
+      data.x(i, j) = in.lo + (in.hi - in.lo) * uniform01(random());
+    }
+    data.mu(i) = simulator(data.x(i, 0), data.x(i, 1), data.x(i, 2), data.x(i, 3)) + noise(random);
+  }
+  data.source_path = "synthetic";
+  GpTrainingOptions options;
+  options.sample_noise = true;
+  options.interval_of_mean = true;
+  options.estimate_mean = true;
+  options.noise_term = false;
+  options.threads = 1;
+  return std::make_shared<const GaussianProcess>(train_gaussian_process(data, options));
+}
+
+// Eight rows of SD 0.01 at random (p, v), from the simulator at (a*, m*); calibrated without δ.
+std::vector<CoefficientEvidence> evidence_of_a_repeat(const std::shared_ptr<const GaussianProcess>& emulator,
+                                                      double (*simulator)(double, double, double, double), std::uint64_t seed) {
+  std::mt19937_64 random(seed);
+  const double a_star = 0.3 + 0.5 * uniform01(random()), m_star = 0.3 + 0.5 * uniform01(random());
+  Measurements data = synthetic_measurements(8, m_star, 0.01, seed + 1000);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (Eigen::Index i = 0; i < data.rows(); ++i)
+    data.mu(i) = simulator(data.conditions(i, 0), data.conditions(i, 1), a_star, m_star) + noise(random);
+  const CalibrationProblem problem(emulator, data, {"adhesive_coefficient", "shear_factor"}, {});
+  EnsembleOptions sampler = quick_sampler(seed + 2000);
+  sampler.walkers = 16;
+  return coefficient_evidence(problem, calibrate(problem, sampler));
+}
+
+TEST(CoefficientEvidence, ACoefficientTheDataCannotSeeIsReportedNotDeterminedAndOneTheySeeDetermined) {
+  const auto emulator = two_coefficient_emulator(blind_to_adhesion);
+  const int repeats = MUFRIC_ADDRESS_SANITIZER ? 3 : 10;
+  int blind_reported = 0, seen_determined = 0;
+  for (int r = 0; r < repeats; ++r) {
+    const auto evidence = evidence_of_a_repeat(emulator, blind_to_adhesion, 500 + static_cast<std::uint64_t>(r));
+    ASSERT_EQ(evidence.size(), 2u);
+    if (evidence[0].determination == Determination::not_determined) ++blind_reported;
+    if (evidence[1].determination == Determination::determined) ++seen_determined;
+    EXPECT_EQ(evidence[0].partner, -1) << "repeat " << r;
+  }
+  EXPECT_GE(blind_reported, (9 * repeats + 9) / 10) << blind_reported << " of " << repeats;
+  EXPECT_GE(seen_determined, (9 * repeats + 9) / 10) << seen_determined << " of " << repeats;
+}
+
+TEST(CoefficientEvidence, TwoCoefficientsSeenOnlyAsTheirSumAreReportedAsACombination) {
+  const auto emulator = two_coefficient_emulator(sees_only_the_sum);
+  const int repeats = MUFRIC_ADDRESS_SANITIZER ? 3 : 10;
+  int combined = 0;
+  for (int r = 0; r < repeats; ++r) {
+    const auto evidence = evidence_of_a_repeat(emulator, sees_only_the_sum, 700 + static_cast<std::uint64_t>(r));
+    if (evidence[0].correlations[1] <= -kCombinedCorrelation && evidence[0].partner == 1 && evidence[1].partner == 0) ++combined;
+  }
+  EXPECT_GE(combined, (9 * repeats + 9) / 10) << combined << " of " << repeats;
 }
 
 // Errors in variables (issue 60): the stated pressure of each row is its true value plus noise of a

@@ -6,6 +6,7 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/wording.hpp"
+#include "surrogate/calibration/coefficient_evidence.hpp"
 
 namespace mufric {
 namespace {
@@ -63,7 +64,9 @@ std::string describe_posterior(const CalibrationProblem& problem, const Calibrat
   if (problem.latent_count() > 0) {
     text += "the rows' conditions given with an uncertainty: what the data imply of them (their prior: the stated SD or range)\n";
   }
-  for (const std::string& warning : posterior_warnings(problem, result)) text += "warning: " + warning + "\n";
+  const auto evidence = coefficient_evidence(problem, result);
+  text += describe_evidence(problem, evidence);
+  for (const std::string& warning : evidence_warnings(problem, evidence)) text += "warning: " + warning + "\n";
   return text;
 }
 

@@ -144,42 +144,6 @@ void check_prior_mass(const Prior& prior, const InputSpec& input, const std::str
 
 }  // namespace
 
-namespace {
-
-// A prior's SD within [lo, hi] (the box cuts it), by the trapezoid rule on its density.
-double prior_sd_within(const Prior& prior, double lo, double hi) {
-  constexpr int kIntervals = 2000;
-  double mass = 0.0, first = 0.0, second = 0.0;
-  for (int k = 0; k <= kIntervals; ++k) {
-    const double x = lo + (hi - lo) * k / kIntervals;
-    const double log_density = prior.log_density(x);
-    const double weight = (k == 0 || k == kIntervals ? 0.5 : 1.0) * (std::isfinite(log_density) ? std::exp(log_density) : 0.0);
-    mass += weight, first += weight * x, second += weight * x * x;
-  }
-  if (!(mass > 0.0)) return 0.0;
-  const double mean = first / mass;
-  return std::sqrt(std::max(0.0, second / mass - mean * mean));
-}
-
-}  // namespace
-
-std::vector<std::string> posterior_warnings(const CalibrationProblem& problem, const CalibrationResult& result) {
-  std::vector<std::string> warnings;
-  for (Eigen::Index j = 0; j < problem.parameter_count() && j < static_cast<Eigen::Index>(result.summary.size()); ++j) {
-    const std::string& name = problem.parameters()[static_cast<size_t>(j)];
-    const InputSpec& input = input_of(problem.emulator(), name);
-    const double prior_sd = prior_sd_within(problem.prior_of(j), input.lo, input.hi);
-    const double posterior_sd = result.summary[static_cast<size_t>(j)].sd;
-    if (!(prior_sd > 0.0) || posterior_sd <= kUninformedPosteriorShare * prior_sd) continue;
-    char share[32];
-    std::snprintf(share, sizeof share, "%.0f %%", 100.0 * posterior_sd / prior_sd);
-    std::string warning = name + ": its posterior SD is " + share + " of its prior's (" + problem.prior_of(j).describe(input.kind()) +
-                          " within the box): the measurements hardly inform it, the result is mostly the prior";
-    warnings.push_back(warning);
-  }
-  return warnings;
-}
-
 CalibrationSetup prepare_calibration(std::shared_ptr<const GaussianProcess> emulator, const CalibrationRequest& request) {
   const GaussianProcess& model = *emulator;
   const std::vector<std::string> inputs = input_names(model);

@@ -46,17 +46,9 @@ inline constexpr double kSuspiciousMeasurementSds = 2.0;
 // than this is mostly cut away: a warning (the posterior piles at the box's edge).
 inline constexpr double kLeastPriorMassInsideBox = 0.5;
 
-// A calibrated coefficient whose posterior SD is more than this share of its prior's (within the box)
-// was hardly informed by the measurements: a warning that the result is mostly the prior.
-inline constexpr double kUninformedPosteriorShare = 0.8;
-
 // With the discrepancy on, δ (a zero-mean GP of sampled amplitude) can explain this few measurements
 // by itself: what the posterior then says of the coefficients comes from δ's amplitude prior, a warning.
 inline constexpr long long kRowsTheDiscrepancyExplainsAlone = 2;
-
-// After sampling: the coefficients the measurements hardly informed, each one line (the caller prints
-// them).
-std::vector<std::string> posterior_warnings(const CalibrationProblem& problem, const CalibrationResult& result);
 
 // Reads, checks and sets up a calibration of `emulator` (a campaign's GP). Throws Error naming the
 // cause (file, line, column, input) for what cannot be calibrated.
