@@ -22,6 +22,7 @@
 #include "surrogate/calibration/calibration.hpp"
 #include "surrogate/calibration/calibration_run.hpp"
 #include "surrogate/calibration/coefficient_evidence.hpp"
+#include "surrogate/calibration/held_out_check.hpp"
 #include "surrogate/calibration/ensemble_sampler.hpp"
 #include "surrogate/gp/gp_grids.hpp"
 #include "surrogate/gp/gp_training.hpp"
@@ -370,6 +371,71 @@ TEST(CoefficientEvidence, TwoCoefficientsSeenOnlyAsTheirSumAreReportedAsACombina
     if (evidence[0].correlations[1] <= -kCombinedCorrelation && evidence[0].partner == 1 && evidence[1].partner == 0) ++combined;
   }
   EXPECT_GE(combined, (9 * repeats + 9) / 10) << combined << " of " << repeats;
+}
+
+// --- held-out check (PSIS-LOO) ------------------------------------------------------------------
+
+// Importance sampling from N(0, 1) to N(0, σ²): the ratio's tail is Pareto with k = 1 − 1/σ²
+// (Vehtari et al. 2024, sec. 3.2, the normal example); to N(0.5, 1) it is light (k ≤ 0).
+TEST(ParetoSmoothing, TheTailShapeIsTheClosedFormsAndTheWeightsEstimateTheTargetsMean) {
+  std::mt19937_64 random(5);
+  std::normal_distribution<double> proposal(0.0, 1.0);
+  const int s = 20000;
+  Eigen::VectorXd draws(s), wide(s), shifted(s);
+  for (int i = 0; i < s; ++i) {
+    draws(i) = proposal(random);
+    wide(i) = 0.5 * draws(i) * draws(i) * (1.0 - 1.0 / 9.0);  // log N(0, 9) / N(0, 1), up to a constant
+    shifted(i) = 0.5 * draws(i) - 0.125;                      // log N(0.5, 1) / N(0, 1)
+  }
+  const SmoothedWeights heavy = pareto_smoothed_weights(wide);
+  EXPECT_NEAR(heavy.pareto_k, 1.0 - 1.0 / 9.0, 0.12);
+  EXPECT_GT(heavy.pareto_k, kParetoKUnreliable);
+  const SmoothedWeights light = pareto_smoothed_weights(shifted);
+  EXPECT_LT(light.pareto_k, 0.5);
+  EXPECT_NEAR(light.log_weights.array().exp().sum(), 1.0, 1e-12);
+  EXPECT_NEAR((light.log_weights.array().exp() * draws.array()).sum(), 0.5, 0.03);
+}
+
+// PSIS-LOO of one calibration against the brute force: each row held out, the calibration rerun on
+// the rest, and the held-out row's predictive density averaged over that run's posterior.
+TEST(HeldOutCheck, ItsElpdIsTheBruteForceRefitsWithinMonteCarloError) {
+  const auto emulator = synthetic_emulator();
+  const Measurements data = synthetic_measurements(6, 0.55, 0.02, 41);
+  CalibrationPriors priors;
+  priors.discrepancy = true;
+  const CalibrationProblem problem(emulator, data, {"shear_factor"}, priors);
+  EnsembleOptions sampler = quick_sampler(42);
+  sampler.steps = 2000;
+  const HeldOutCheck check = leave_one_out(problem, calibrate(problem, sampler));
+  ASSERT_EQ(check.rows.size(), 6u);
+  double brute_sum = 0.0;
+  for (Eigen::Index i = 0; i < data.rows(); ++i) {
+    Measurements rest = data;
+    const auto keep = [&](const Eigen::MatrixXd& m) {
+      Eigen::MatrixXd out(m.rows() - 1, m.cols());
+      for (Eigen::Index r = 0, k = 0; r < m.rows(); ++r)
+        if (r != i) out.row(k++) = m.row(r);
+      return out;
+    };
+    rest.conditions = keep(data.conditions);
+    rest.mu = keep(data.mu);
+    rest.mu_sd = keep(data.mu_sd);
+    rest.row_names.erase(rest.row_names.begin() + i);
+    const CalibrationProblem held_out(emulator, rest, {"shear_factor"}, priors);
+    const CalibrationResult refit = calibrate(held_out, quick_sampler(60 + static_cast<std::uint64_t>(i)));
+    // The refit's points (θ, δ's hyper-parameters) are points of the full problem: the held-out
+    // row's density given the others there is the full problem's conditional at that point.
+    const Eigen::Index points = std::min<Eigen::Index>(refit.samples.rows(), 3000);
+    Eigen::VectorXd log_density(points);
+    for (Eigen::Index k = 0; k < points; ++k)
+      log_density(k) = conditional_predictives(problem, refit.samples.row(k * refit.samples.rows() / points).transpose()).log_density(i);
+    const double top = log_density.maxCoeff();
+    const double brute = top + std::log((log_density.array() - top).exp().mean());
+    brute_sum += brute;
+    EXPECT_NEAR(check.rows[static_cast<size_t>(i)].elpd, brute, 0.1) << "row " << i;
+    EXPECT_LE(check.rows[static_cast<size_t>(i)].pareto_k, kParetoKUnreliable) << "row " << i;
+  }
+  EXPECT_NEAR(check.elpd, brute_sum, 0.3);
 }
 
 // Errors in variables (issue 60): the stated pressure of each row is its true value plus noise of a

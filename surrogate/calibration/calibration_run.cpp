@@ -7,6 +7,7 @@
 #include "common/units.hpp"
 #include "common/wording.hpp"
 #include "surrogate/calibration/coefficient_evidence.hpp"
+#include "surrogate/calibration/held_out_check.hpp"
 
 namespace mufric {
 namespace {
@@ -67,6 +68,7 @@ std::string describe_posterior(const CalibrationProblem& problem, const Calibrat
   const auto evidence = coefficient_evidence(problem, result);
   text += describe_evidence(problem, evidence);
   for (const std::string& warning : evidence_warnings(problem, evidence)) text += "warning: " + warning + "\n";
+  text += describe_held_out(problem, leave_one_out(problem, result));
   return text;
 }
 
