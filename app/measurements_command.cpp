@@ -6,8 +6,25 @@
 #include "app/commands.hpp"
 #include "common/files.hpp"
 #include "surrogate/reduction/orthogonal_cut_files.hpp"
+#include "surrogate/reduction/tribometer.hpp"
 
 namespace mufric::app {
+namespace {
+
+void write_tables(const std::filesystem::path& folder, const std::vector<WrittenTable>& tables) {
+  if (!folder.empty()) std::filesystem::create_directories(folder);
+  for (const auto& table : tables) {
+    const std::string path = (folder / table.file_name).string();
+    write_file_atomically(path, table.text);
+    std::printf("wrote %s\n", path.c_str());
+  }
+}
+
+std::filesystem::path output_folder(const std::string& setup, const std::string& out_dir) {
+  return out_dir.empty() ? std::filesystem::path(setup).parent_path() : std::filesystem::path(out_dir);
+}
+
+}  // namespace
 
 void add_measurements_command(CLI::App& app) {
   auto* measurements = app.add_subcommand("measurements", "A pair's measured tests turned into the rows calibrate reads");
@@ -37,15 +54,32 @@ void add_measurements_command(CLI::App& app) {
     if (options->draws > 0) study.setup.draws = options->draws;
     if (options->seed >= 0) study.setup.seed = static_cast<std::uint32_t>(options->seed);
     const auto results = rake_face_from_orthogonal_cuts(study.cuts, study.setup);
-    const std::filesystem::path folder =
-        options->out_dir.empty() ? std::filesystem::path(options->setup).parent_path() : std::filesystem::path(options->out_dir);
-    if (!folder.empty()) std::filesystem::create_directories(folder);
     std::fputs(orthogonal_cut_summary(study, results).c_str(), stdout);
-    for (const auto& table : orthogonal_cut_tables(study, results)) {
-      const std::string path = (folder / table.file_name).string();
-      write_file_atomically(path, table.text);
-      std::printf("wrote %s\n", path.c_str());
-    }
+    write_tables(output_folder(options->setup, options->out_dir), orthogonal_cut_tables(study, results));
+  });
+
+  auto tribometer_options = std::make_shared<Options>();
+  auto* tribometer = measurements->add_subcommand(
+      "tribometer",
+      "Pin-on-disc or open-tribometer tests (apparent mu against sliding velocity and normal force, a spherical pin) to "
+      "the interface's mu: the pin's ploughing taken out (Goddard & Wilman's sphere ploughing a plastic surface at the "
+      "work's flow pressure) or kept and stated (\"ploughing\": \"none\"), with SDs by Monte Carlo. Writes the analysis "
+      "table and the calibration rows beside the setup (or in --out-dir) and prints one line per test");
+  tribometer->add_option("setup", tribometer_options->setup, "the setup (JSON): the tests' CSV, their columns, the pin's radius, the "
+                                                             "work's flow pressure, the ploughing correction (docs/new-pair.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  tribometer->add_option("--out-dir", tribometer_options->out_dir, "where the tables go (default: the setup's folder)");
+  tribometer->add_option("--draws", tribometer_options->draws, "Monte Carlo draws (default: the setup's, or 20000)")->check(CLI::Range(2, 100000000));
+  tribometer->add_option("--seed", tribometer_options->seed, "the draws' seed, as numpy.random.default_rng(seed) (default: the setup's, or 2026)")
+      ->check(CLI::Range(0LL, 4294967295LL));
+  tribometer->callback([options = tribometer_options] {
+    TribometerStudy study = read_tribometer_study(options->setup);
+    if (options->draws > 0) study.setup.draws = options->draws;
+    if (options->seed >= 0) study.setup.seed = static_cast<std::uint32_t>(options->seed);
+    const auto results = friction_from_tribometer(study.tests, study.setup);
+    std::fputs(tribometer_summary(study, results).c_str(), stdout);
+    write_tables(output_folder(options->setup, options->out_dir), tribometer_tables(study, results));
   });
 }
 

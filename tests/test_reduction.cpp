@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -13,6 +14,9 @@
 #include "common/numpy_random.hpp"
 #include "surrogate/reduction/orthogonal_cut_files.hpp"
 #include "surrogate/reduction/orthogonal_cutting.hpp"
+#include "surrogate/reduction/tribometer.hpp"
+#include "surrogate/calibration/measurements.hpp"
+#include "error_text.hpp"
 #include "temp_path.hpp"
 
 namespace mufric {
@@ -197,6 +201,98 @@ TEST(OrthogonalCuts, ASetupsErrorsNameTheField) {
   EXPECT_NE(setup_with(good_units + R"("density_kg_per_m3": 4430, "conductivity_W_per_m_K": 7, "specific_heat_J_per_kg_K": 560, "repeats": 3)")
                 .find("no column 'chip_ratio' (columns: inclination_angle, cutting_speed"),
             std::string::npos);
+}
+
+}  // namespace
+}  // namespace mufric
+
+namespace mufric {
+namespace {
+
+// The groove's frontal area by quadrature (Simpson): depth √(R² − y²) − √(R² − a²) across |y| ≤ a;
+// over the front half-circle's area π a²/2, the load's, it is the ploughing coefficient.
+double brute_force_ploughing(double a_over_r) {
+  constexpr int kIntervals = 20000;
+  const double r = 1.0, a = a_over_r, floor = std::sqrt(r * r - a * a);
+  double area = 0.0;
+  for (int k = 0; k <= kIntervals; ++k) {
+    const double y = -a + 2.0 * a * k / kIntervals;
+    const double weight = (k == 0 || k == kIntervals) ? 1.0 : (k % 2 ? 4.0 : 2.0);
+    area += weight * (std::sqrt(std::max(0.0, r * r - y * y)) - floor);
+  }
+  area *= 2.0 * a / kIntervals / 3.0;
+  return area / (std::numbers::pi * a * a / 2.0);
+}
+
+TEST(Tribometer, GoddardWilmansPloughingIsTheGroovesFrontalAreaOverTheLoadsHalfCircle) {
+  for (double x : {0.01, 0.05, 0.2, 0.5, 0.9, 1.0}) EXPECT_NEAR(sphere_ploughing_coefficient(x), brute_force_ploughing(x), 1e-6) << x;
+  EXPECT_NEAR(sphere_ploughing_coefficient(1e-3) / 1e-3, 4.0 / (3.0 * std::numbers::pi), 1e-5);  // shallow: 4a/(3πR)
+  EXPECT_NEAR(sphere_ploughing_coefficient(1.0), 1.0, 1e-12);                                    // to the equator
+  EXPECT_THROW(sphere_ploughing_coefficient(1.2), Error);
+}
+
+TribometerTest pin_test(double force, double mu_apparent, double pressure, int line) {
+  TribometerTest t;
+  t.sliding_velocity = 1.0;
+  t.normal_force = force;
+  t.mu_apparent = {mu_apparent, 0.01};
+  t.contact_pressure = pressure;
+  t.row_name = "pins.csv line " + std::to_string(line);
+  return t;
+}
+
+TEST(Tribometer, TheInterfacesFrictionComesBackFromApparentFrictionMadeOfItAndThePinsPloughing) {
+  TribometerSetup setup;
+  setup.pin_radius = 4.5e-3;
+  setup.draws = 4000;
+  const double pressure = 3e9, adhesive = 0.2;
+  std::vector<TribometerTest> tests;
+  for (double force : {100.0, 1000.0, 4000.0}) {
+    const double a = std::sqrt(2.0 * force / (std::numbers::pi * pressure));
+    tests.push_back(pin_test(force, adhesive + sphere_ploughing_coefficient(a / setup.pin_radius), pressure, 2 + static_cast<int>(tests.size())));
+  }
+  const auto results = friction_from_tribometer(tests, setup);
+  ASSERT_EQ(results.size(), 3u);
+  for (const auto& r : results) {
+    EXPECT_NEAR(r.mu.mean, adhesive, 5.0 * 0.01 / std::sqrt(4000.0));
+    EXPECT_NEAR(r.mu.sd, 0.01, 0.001);
+    EXPECT_DOUBLE_EQ(r.contact_pressure.mean, pressure);
+  }
+  EXPECT_LT(results[0].mu_ploughing.mean, results[2].mu_ploughing.mean);  // more load, deeper groove
+  setup.ploughing = PloughingCorrection::none;
+  EXPECT_NEAR(friction_from_tribometer(tests, setup)[2].mu.mean, tests[2].mu_apparent.mean, 0.001);
+}
+
+TEST(Tribometer, RefusesAContactWiderThanThePinAndPloughingThatTakesAllTheFriction) {
+  TribometerSetup setup;
+  setup.pin_radius = 1e-4;
+  EXPECT_NE(test::error_of([&] { friction_from_tribometer({pin_test(1000.0, 0.3, 1e9, 4)}, setup); }).find("pins.csv line 4: the contact's radius"),
+            std::string::npos);
+  setup.pin_radius = 1e-3;
+  EXPECT_NE(test::error_of([&] { friction_from_tribometer({pin_test(1000.0, 0.01, 1e9, 5)}, setup); }).find("takes all of the apparent friction"),
+            std::string::npos);
+}
+
+TEST(Tribometer, ItsCalibrationRowsAreWhatCalibrateReads) {
+  const std::string folder = test::temp_path("tribometer");
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder + "/pins.csv") << "# a made-up test log\nsliding_velocity[m/s],normal_force[N],mu,mu_sd,temperature[C],notes\n"
+                                         "0.5,1000,0.42,0.02,350,\"dry, first run\"\n2.0,1000,0.31,0.03,520,dry\n";
+  std::ofstream(folder + "/pins.json") << R"({"tests": "pins.csv", "pin_radius": "4.5mm", "flow_pressure": ["2.5GPa", "3.5GPa"],
+      "repeats": 3, "columns": {"temperature": "temperature"}, "provenance": ["made up for a test"]})";
+  const TribometerStudy study = read_tribometer_study(folder + "/pins.json");
+  const auto tables = tribometer_tables(study, friction_from_tribometer(study.tests, study.setup));
+  ASSERT_EQ(tables.size(), 2u);
+  write_file_atomically(folder + "/" + tables[1].file_name, tables[1].text);
+  const Measurements rows = read_measurements(folder + "/" + tables[1].file_name);
+  ASSERT_EQ(rows.rows(), 2);
+  EXPECT_EQ(rows.condition_names, (std::vector<std::string>{"contact_pressure", "sliding_velocity", "temperature"}));
+  EXPECT_NEAR(rows.conditions(1, 1), 2.0, 1e-6);
+  EXPECT_NEAR(rows.conditions(0, 2), 350.0 + 273.15, 1e-6);
+  EXPECT_NEAR(rows.conditions(0, 0), 3e9, 0.02e9);                 // the flow pressure's middle
+  EXPECT_NEAR(rows.condition_sd(0, 0), 1e9 / std::sqrt(12.0), 0.02e9);  // uniform over 2.5-3.5 GPa
+  EXPECT_LT(rows.mu(0), 0.42);                                     // the ploughing taken out
+  EXPECT_NE(tables[1].text.find("# made up for a test"), std::string::npos);
 }
 
 }  // namespace

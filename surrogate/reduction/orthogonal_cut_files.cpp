@@ -14,89 +14,17 @@
 #include "common/error.hpp"
 #include "common/units.hpp"
 #include "common/wording.hpp"
+#include "surrogate/reduction/setup_fields.hpp"
 
 namespace mufric {
+using namespace reduction_setup;
 namespace {
 
-constexpr double kCelsiusOffset = 273.15;
-
-// How the tests' uncertainty columns are meant: a mean's standard error, the repeats' SD, or an
-// error bar of twice their SD (the figures of data/cirp2022_ti6al4v_tin).
-enum class UncertaintyKind { standard_error, sd, two_sd };
-
-std::string g_text(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*g", digits, value);
-  return text;
-}
-
-std::string with_value(const std::string& pattern, double value) {
-  const auto at = pattern.find("{}");
-  if (at == std::string::npos) return pattern;
-  return pattern.substr(0, at) + g_text(value, 6) + pattern.substr(at + 2);
-}
-
-const nlohmann::json& required(const nlohmann::json& setup, const std::string& key, const std::string& path) {
-  if (!setup.contains(key)) throw Error(path + ": the setup has no '" + key + "'");
-  return setup.at(key);
-}
-
-double number_field(const nlohmann::json& setup, const std::string& key, const std::string& path) {
-  const auto& node = required(setup, key, path);
-  if (!node.is_number()) throw Error(path + ": '" + key + "' must be a number, not " + node.dump());
-  return node.get<double>();
-}
-
-// "15deg", "1mm", "293K": a quantity with its unit.
-double quantity_field(const nlohmann::json& setup, const std::string& key, QuantityKind kind, const std::string& path) {
-  const auto& node = required(setup, key, path);
-  if (!node.is_string())
-    throw Error(path + ": '" + key + "' must be a quantity with its unit, e.g. \"" + std::string(example_quantity(kind)) + "\"");
-  return parse_quantity(node.get<std::string>(), kind, path + ": '" + key + "'");
-}
-
-// A number (fixed) or [low, high] (uniform).
-ValueRange range_field(const nlohmann::json& setup, const std::string& key, const std::string& path) {
-  const auto& node = required(setup, key, path);
-  if (node.is_number()) return {node.get<double>(), node.get<double>()};
-  if (node.is_array() && node.size() == 2 && node[0].is_number() && node[1].is_number()) return {node[0].get<double>(), node[1].get<double>()};
-  throw Error(path + ": '" + key + "' must be a number or a range [low, high], not " + node.dump());
-}
-
-UncertaintyKind uncertainty_kind(const std::string& word, const std::string& path) {
-  if (word == "se") return UncertaintyKind::standard_error;
-  if (word == "sd") return UncertaintyKind::sd;
-  if (word == "2sd") return UncertaintyKind::two_sd;
-  throw Error(path + ": 'uncertainty' is '" + word + "'; it must be se (the mean's standard error), sd (the repeats' SD) or 2sd (twice it)");
-}
-
-std::string suffix_of(UncertaintyKind kind) {
-  switch (kind) {
-    case UncertaintyKind::standard_error: return "_se";
-    case UncertaintyKind::sd: return "_sd";
-    case UncertaintyKind::two_sd: return "_2sd";
-  }
-  return "_sd";
-}
-
-// The header cell's name of each role: the setup's "columns" or the role's own name.
-std::string column_of(const nlohmann::json& setup, const std::string& role, const std::string& fallback) {
-  if (setup.contains("columns") && setup["columns"].contains(role)) return setup["columns"][role].get<std::string>();
-  return fallback;
-}
-
-double force_scale(const CsvTable& table, const std::string& name) {
-  const std::string& unit = table.columns[table.column(name)].unit;
-  if (unit == "N") return 1.0;
-  if (unit == "kN") return 1e3;
-  throw Error(table.path + ": column '" + name + "' has unit '" + unit + "'; a force is in N or kN, e.g. '" + name + "[N]'");
-}
 
 std::vector<OrthogonalCut> read_cuts(const nlohmann::json& setup, const std::string& setup_path, const std::string& tests_path,
                                      std::string& group_header) {
-  const auto kind = uncertainty_kind(setup.value("uncertainty", std::string("sd")), setup_path);
-  const double repeats = kind == UncertaintyKind::standard_error ? 1.0 : number_field(setup, "repeats", setup_path);
-  if (!(repeats >= 1.0)) throw Error(setup_path + ": 'repeats' must be at least 1");
+  const Uncertainty errors = uncertainty_of(setup, setup_path);
+  const UncertaintyKind kind = errors.kind;
   const std::string speed = column_of(setup, "cutting_speed", "cutting_speed");
   const std::string thickness = column_of(setup, "uncut_chip_thickness", "uncut_chip_thickness");
   std::map<std::string, std::pair<std::string, std::string>> measured;  // role → (mean column, uncertainty column)
@@ -122,20 +50,12 @@ std::vector<OrthogonalCut> read_cuts(const nlohmann::json& setup, const std::str
   }
   const auto speeds = table.si_column(speed, QuantityKind::velocity);
   const auto thicknesses = table.si_column(thickness, QuantityKind::length);
-  auto error_of = [&](double cell) {
-    switch (kind) {
-      case UncertaintyKind::standard_error: return cell;
-      case UncertaintyKind::sd: return cell / std::sqrt(repeats);
-      case UncertaintyKind::two_sd: return cell / 2.0 / std::sqrt(repeats);
-    }
-    return cell;
-  };
   auto mean_of = [&](const std::string& role, size_t row) {
     const auto& [mean, uncertainty] = measured.at(role);
     const double scale = role == "chip_ratio" ? 1.0 : force_scale(table, mean);
     const double uncertainty_scale = role == "chip_ratio" ? 1.0 : force_scale(table, uncertainty);
     return MeasuredMean{scale * table.rows[row][table.column(mean)],
-                        error_of(uncertainty_scale * table.rows[row][table.column(uncertainty)])};
+                        errors.standard_error(uncertainty_scale * table.rows[row][table.column(uncertainty)])};
   };
   const std::string file = std::filesystem::path(tests_path).filename().string();
   std::vector<OrthogonalCut> cuts;
@@ -170,23 +90,10 @@ std::string joined_um(const std::vector<double>& thicknesses) {
   return text;
 }
 
-std::string comment_block(const std::vector<std::string>& lines) {
-  std::string text;
-  for (const auto& line : lines) text += "# " + line + "\n";
-  return text;
-}
-
 }  // namespace
 
 OrthogonalCutStudy read_orthogonal_cut_study(const std::string& setup_path) {
-  std::ifstream in(setup_path);
-  if (!in) throw Error(setup_path + ": cannot open (no such file or not readable)");
-  nlohmann::json setup;
-  try {
-    setup = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(setup_path + ": not JSON: " + e.what());
-  }
+  const nlohmann::json setup = read_setup(setup_path);
   OrthogonalCutStudy study;
   study.setup_path = setup_path;
   const auto folder = std::filesystem::path(setup_path).parent_path();
@@ -206,7 +113,7 @@ OrthogonalCutStudy read_orthogonal_cut_study(const std::string& setup_path) {
     study.group_label = setup["group"].value("label", study.group_header + " {}");
     for (const auto& g : setup["group"].value("calibrate", nlohmann::json::array())) study.calibration_groups.push_back(g.get<double>());
   }
-  for (const auto& line : setup.value("provenance", nlohmann::json::array())) study.provenance.push_back(line.get<std::string>());
+  study.provenance = provenance_of(setup);
   study.analysis_file = setup.value("analysis_file", study.analysis_file);
   study.calibration_file = setup.value("calibration_file", study.calibration_file);
   return study;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "surrogate/reduction/orthogonal_cutting.hpp"
+#include "surrogate/reduction/written_table.hpp"
 
 namespace mufric {
 
@@ -27,10 +28,7 @@ struct OrthogonalCutStudy {
 OrthogonalCutStudy read_orthogonal_cut_study(const std::string& setup_path);
 
 // The analysis table (every group, every intermediate) and the calibration table of each calibrated
-// group, as text: { file name, content }.
-struct WrittenTable {
-  std::string file_name, text;
-};
+// group.
 std::vector<WrittenTable> orthogonal_cut_tables(const OrthogonalCutStudy& study, const std::vector<RakeFaceEstimate>& results);
 
 // One line per speed for a person: μ, p, v, T with their SDs, l_c/h, the edge forces and Birge scales.

@@ -17,11 +17,6 @@ namespace {
 constexpr double kOxleyPsi = 0.9;
 constexpr double kBoothroydBranch = 10.0;
 
-McEstimate estimate(const Eigen::ArrayXd& draws) {
-  const double mean = draws.mean();
-  const double sd = draws.size() > 1 ? std::sqrt((draws - mean).square().sum() / static_cast<double>(draws.size() - 1)) : 0.0;
-  return {mean, sd};
-}
 
 // sqrt(χ²/dof) of the weighted least-squares line through (h, mean) with these standard errors.
 double birge_ratio(const Eigen::VectorXd& h, const Eigen::VectorXd& means, const Eigen::VectorXd& errors) {
@@ -162,20 +157,20 @@ RakeFaceEstimate analyse_speed(const std::vector<const OrthogonalCut*>& at, cons
   // A draw in the tail of the measured scatter can give μ ≤ 0 (the feed force's line sloping down):
   // kept, as the analysis this replaces kept it, and counted for the summary.
   out.nonpositive_mu_draws = static_cast<int>((mu <= 0.0).count());
-  out.mu = estimate(mu);
-  out.contact_pressure = estimate(pressure);
-  out.sliding_velocity = estimate(sliding_velocity);
-  out.temperature = estimate(temperatures.rowwise().mean());
-  out.temperature_thinnest = estimate(temperatures.col(0));
-  out.temperature_thickest = estimate(temperatures.col(n - 1));
-  out.chip_ratio = estimate(chip_ratio);
-  out.shear_angle = estimate(phi);
-  out.contact_length_per_h = estimate(contact_per_h);
-  out.oxley_c_neq = estimate(c_neq);
-  out.specific_cutting_force = estimate(k_c);
-  out.specific_feed_force = estimate(k_f);
-  out.edge_cutting_force = estimate(cutting.intercept);
-  out.edge_feed_force = estimate(feed.intercept);
+  out.mu = monte_carlo_estimate(mu);
+  out.contact_pressure = monte_carlo_estimate(pressure);
+  out.sliding_velocity = monte_carlo_estimate(sliding_velocity);
+  out.temperature = monte_carlo_estimate(temperatures.rowwise().mean());
+  out.temperature_thinnest = monte_carlo_estimate(temperatures.col(0));
+  out.temperature_thickest = monte_carlo_estimate(temperatures.col(n - 1));
+  out.chip_ratio = monte_carlo_estimate(chip_ratio);
+  out.shear_angle = monte_carlo_estimate(phi);
+  out.contact_length_per_h = monte_carlo_estimate(contact_per_h);
+  out.oxley_c_neq = monte_carlo_estimate(c_neq);
+  out.specific_cutting_force = monte_carlo_estimate(k_c);
+  out.specific_feed_force = monte_carlo_estimate(k_f);
+  out.edge_cutting_force = monte_carlo_estimate(cutting.intercept);
+  out.edge_feed_force = monte_carlo_estimate(feed.intercept);
   return out;
 }
 
@@ -197,6 +192,12 @@ void check_setup(const OrthogonalCutSetup& setup) {
 }
 
 }  // namespace
+
+McEstimate monte_carlo_estimate(const Eigen::ArrayXd& draws) {
+  const double mean = draws.mean();
+  const double sd = draws.size() > 1 ? std::sqrt((draws - mean).square().sum() / static_cast<double>(draws.size() - 1)) : 0.0;
+  return {mean, sd};
+}
 
 std::vector<RakeFaceEstimate> rake_face_from_orthogonal_cuts(const std::vector<OrthogonalCut>& cuts,
                                                              const OrthogonalCutSetup& setup) {

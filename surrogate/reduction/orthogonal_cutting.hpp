@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "common/numpy_random.hpp"
 
 namespace mufric {
@@ -60,6 +62,7 @@ struct OrthogonalCutSetup {
 struct McEstimate {
   double mean = 0.0, sd = 0.0;
 };
+McEstimate monte_carlo_estimate(const Eigen::ArrayXd& draws);
 
 // The rake face at one cutting speed of one group, SI (temperatures in K).
 struct RakeFaceEstimate {
