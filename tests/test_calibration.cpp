@@ -216,6 +216,18 @@ InputSpace synthetic_box() {
   return box;
 }
 
+// A campaign's GP as `mufric train` fits it: stochastic kriging of runs with their standard errors.
+std::shared_ptr<const GaussianProcess> stochastic_kriging_of(TrainingSet data) {
+  data.source_path = "synthetic";
+  GpTrainingOptions options;
+  options.sample_noise = true;
+  options.interval_of_mean = true;
+  options.estimate_mean = true;
+  options.noise_term = false;
+  options.threads = 1;
+  return std::make_shared<const GaussianProcess>(train_gaussian_process(data, options));
+}
+
 // The emulator: stochastic kriging of 60 noisy "runs" (standard error 0.003) over the 3-D box.
 std::shared_ptr<const GaussianProcess> synthetic_emulator() {
   static const std::shared_ptr<const GaussianProcess> emulator = [] {
@@ -234,14 +246,7 @@ std::shared_ptr<const GaussianProcess> synthetic_emulator() {
       }
       data.mu(i) = synthetic_simulator(data.x(i, 0), data.x(i, 1), data.x(i, 2)) + noise(random);
     }
-    data.source_path = "synthetic";
-    GpTrainingOptions options;
-    options.sample_noise = true;
-    options.interval_of_mean = true;
-    options.estimate_mean = true;
-    options.noise_term = false;
-    options.threads = 1;
-    return std::make_shared<const GaussianProcess>(train_gaussian_process(data, options));
+    return stochastic_kriging_of(std::move(data));
   }();
   return emulator;
 }
@@ -322,14 +327,7 @@ std::shared_ptr<const GaussianProcess> two_coefficient_emulator(double (*simulat
     }
     data.mu(i) = simulator(data.x(i, 0), data.x(i, 1), data.x(i, 2), data.x(i, 3)) + noise(random);
   }
-  data.source_path = "synthetic";
-  GpTrainingOptions options;
-  options.sample_noise = true;
-  options.interval_of_mean = true;
-  options.estimate_mean = true;
-  options.noise_term = false;
-  options.threads = 1;
-  return std::make_shared<const GaussianProcess>(train_gaussian_process(data, options));
+  return stochastic_kriging_of(std::move(data));
 }
 
 // Eight rows of SD 0.01 at random (p, v), from the simulator at (a*, m*); calibrated without δ.
