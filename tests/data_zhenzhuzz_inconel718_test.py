@@ -150,6 +150,29 @@ class MaterialPropertiesAgainstTheReadme(unittest.TestCase):
             self.assertEqual(sum(1 for k in table if k[:2] == (body, prop)), n)
 
 
+class SceneMaterialPartAgainstTheData(unittest.TestCase):
+    # scene_material.json (the micro-model's material for this pair, `mufric micro scene --with`) is
+    # typed from johnson_cook.csv and material_properties.csv: the Johnson-Cook set, E and nu at 20 C,
+    # the density, and the specific heat and conductivity at 600 C (README: the contact zone's).
+    def test_every_value_is_the_datas(self):
+        import json
+        part = json.loads((DATA / "scene_material.json").read_text())
+        material, thermal = part["material"], part["thermal"]
+        jc = {r["parameter"]: f(r, "value") for r in read_csv("johnson_cook.csv")}
+        table = {(r["body"], r["property"], r["temperature[degC]"]): f(r, "value") for r in read_csv("material_properties.csv")}
+        self.assertEqual(material["a"], f"{jc['A']:g}MPa")
+        self.assertEqual(material["b"], f"{jc['B']:g}MPa")
+        self.assertEqual((material["n"], material["c"], material["m"]), (jc["n"], jc["C"], jc["m"]))
+        self.assertEqual(material["reference_strain_rate"], jc["reference_strain_rate"])
+        self.assertEqual(material["transition_temperature"], f"{jc['T0']:g}C")
+        self.assertEqual(material["melting_temperature"], f"{jc['Tm']:g}C")
+        self.assertEqual(material["youngs_modulus"], f"{table[('workpiece', 'youngs_modulus', '20')]:g}GPa")
+        self.assertEqual(material["poisson_ratio"], table[("workpiece", "poissons_ratio", "20")])
+        self.assertEqual(material["density"], table[("workpiece", "density", "")])
+        self.assertEqual(material["specific_heat"], table[("workpiece", "specific_heat", "600")])
+        self.assertEqual(thermal["conductivity"], table[("workpiece", "thermal_conductivity", "600")])
+
+
 class KlockeFiguresAgainstTheText(unittest.TestCase):
     rows = read_csv("klocke2013_cutting_tests.csv")
 

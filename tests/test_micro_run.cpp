@@ -126,6 +126,38 @@ TEST(Scene, TheTi6Al4VSceneHoldsItsSourcesMaterialTable) {
   EXPECT_TRUE(scene.warnings.empty());
 }
 
+// A new pair's scene (issue 70): the Ti6Al4V scene with the Inconel 718 material part of
+// data/zhenzhuzz_inconel718_carbide merged over it and a --set after; every value as the part and
+// the override give it, the rest the base's, and the notes say which key came from where and that
+// the tool's surface is the base's synthetic one. A part's value without its unit is refused naming
+// the key.
+TEST(Scene, ANewPairsSceneIsTheBaseWithItsMaterialPartAndOverridesAndSaysWhereEachCameFrom) {
+  const std::string base = std::string(MUFRIC_SOURCE_DIR) + "/micro/scene/ti6al4v_tin.json";
+  const std::string part = std::string(MUFRIC_SOURCE_DIR) + "/data/zhenzhuzz_inconel718_carbide/scene_material.json";
+  const ComposedScene composed =
+      compose_scene(read_scene_json(base), base, {{part, read_scene_json(part)}}, {"contact.shear_factor=0.3"});
+  EXPECT_DOUBLE_EQ(composed.scene.material.a, 1485e6);
+  EXPECT_DOUBLE_EQ(composed.scene.material.b, 904e6);
+  EXPECT_DOUBLE_EQ(composed.scene.material.melting_temperature, 1297.0 + 273.15);
+  EXPECT_DOUBLE_EQ(composed.scene.thermal.conductivity, 21.0);
+  EXPECT_DOUBLE_EQ(composed.scene.material.heat_fraction, parse_scene(read_scene_json(base), base).material.heat_fraction);
+  EXPECT_EQ(composed.scene.contact.interface.law->name(), "childs");
+  std::string notes;
+  for (const auto& note : composed.notes) notes += note + "\n";
+  EXPECT_NE(notes.find("youngs_modulus from " + part + "; heat_fraction from " + base), std::string::npos) << notes;
+  EXPECT_NE(notes.find("shear_factor from --set"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("the tool's surface is synthetic (Ra 0.1um"), std::string::npos) << notes;
+  // Read back from its own JSON, it is the same scene.
+  EXPECT_DOUBLE_EQ(parse_scene(composed.json, "composed").material.n, 0.777);
+  nlohmann::json no_unit = nlohmann::json::parse(R"({"material": {"a": "1485"}})");
+  try {
+    compose_scene(read_scene_json(base), base, {{"part.json", no_unit}}, {});
+    FAIL() << "a yield stress without a unit was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("material.a"), std::string::npos) << e.what();
+  }
+}
+
 // Each known input with a scene key sets that key to its SI value to the last bit (the awkward
 // doubles too: %.17g reads back exactly), through the scene's own reader, so the key's checks apply
 // (a pressure above the physical range is refused naming the key); an input without a scene key is

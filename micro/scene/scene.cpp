@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <set>
 
@@ -301,6 +303,67 @@ Scene scene_with_overrides(nlohmann::json json, const std::vector<std::string>& 
                            const std::string& base_directory) {
   for (const auto& assignment : overrides) apply_override(json, assignment);
   return parse_scene(json, source, base_directory);
+}
+
+ComposedScene compose_scene(nlohmann::json base, const std::string& base_source, const std::vector<NamedPatch>& patches,
+                            const std::vector<std::string>& overrides, const std::string& base_directory) {
+  ComposedScene out;
+  // Where each leaf value ("/material/a") came from: the base, or the last part that set it.
+  std::map<std::string, std::string> leaf_source;
+  // (flatten() returns a new object: kept in a variable, since a range over a temporary's items()
+  // outlives it.)
+  const nlohmann::json base_leaves = base.flatten();
+  for (const auto& [pointer, value] : base_leaves.items()) leaf_source[pointer] = base_source;
+  out.json = std::move(base);
+  for (const NamedPatch& patch : patches) {
+    if (!patch.json.is_object()) throw Error(patch.source + ": a scene part must be a JSON object of sections, e.g. {\"material\": {...}}");
+    const nlohmann::json patch_leaves = patch.json.flatten();
+    for (const auto& [pointer, value] : patch_leaves.items()) leaf_source[pointer] = patch.source;
+    out.json.merge_patch(patch.json);
+  }
+  for (const auto& assignment : overrides) {
+    apply_override(out.json, assignment);
+    std::string pointer = "/" + assignment.substr(0, assignment.find('='));
+    std::replace(pointer.begin(), pointer.end(), '.', '/');
+    leaf_source[pointer] = "--set";
+  }
+  out.scene = parse_scene(out.json, patches.empty() ? base_source : patches.back().source, base_directory);
+  // Per section, its keys by source: "material: a, b, ... from PART; heat_fraction from BASE".
+  std::map<std::string, std::map<std::string, std::vector<std::string>>> keys_by_section;
+  const nlohmann::json leaves = out.json.flatten();
+  for (const auto& [pointer, value] : leaves.items()) {
+    const auto second = pointer.find('/', 1);
+    const std::string section = pointer.substr(1, second == std::string::npos ? std::string::npos : second - 1);
+    const std::string key = second == std::string::npos ? section : pointer.substr(second + 1);
+    const auto found = leaf_source.find(pointer);
+    keys_by_section[section][found == leaf_source.end() ? std::string("--set") : found->second].push_back(key);
+  }
+  for (const auto& [section, sources] : keys_by_section) {
+    std::string note = section + ":";
+    bool first = true;
+    for (const auto& [source, keys] : sources) {
+      note += first ? " " : "; ";
+      first = false;
+      if (sources.size() == 1) {
+        note += "from " + source;
+        continue;
+      }
+      for (size_t i = 0; i < keys.size(); ++i) {
+        if (i) note += ", ";
+        note += keys[i];
+      }
+      note += " from " + source;
+    }
+    out.notes.push_back(note);
+  }
+  const auto& tool = out.json["geometry"]["tool_surface"];
+  if (tool.contains("synthetic")) {
+    const auto& s = tool["synthetic"];
+    out.notes.push_back("the tool's surface is synthetic (Ra " + s.value("ra", std::string("?")) + ", correlation length " +
+                        s.value("correlation_length", std::string("?")) + ", from " + leaf_source["/geometry/tool_surface/synthetic/ra"] +
+                        "), not a measured profile: give one by geometry.tool_surface.csv (`mufric micro profile` fits it)");
+  }
+  return out;
 }
 
 const std::vector<SettableInput>& settable_inputs() {

@@ -190,4 +190,21 @@ Scene scene_with_values(const Scene& scene, const std::vector<SceneValue>& value
 // A scene file (or, for an empty path, the default scene) with "key=value" overrides applied.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides);
 
+// A new pair's scene from a base scene: partial scenes (e.g. the work material's Johnson–Cook and
+// thermal set: {"material": {...}, "thermal": {...}}) merged over it in order (RFC 7386 JSON merge
+// patch), then "key=value" overrides; checked by reading it (every unit and range). `notes` say
+// where each section came from and what stayed the base's default that a pair usually measures
+// (the tool's surface).
+struct NamedPatch {
+  std::string source;  // a file's path, for the notes and errors
+  nlohmann::json json;
+};
+struct ComposedScene {
+  nlohmann::json json;
+  Scene scene;
+  std::vector<std::string> notes;
+};
+ComposedScene compose_scene(nlohmann::json base, const std::string& base_source, const std::vector<NamedPatch>& patches,
+                            const std::vector<std::string>& overrides, const std::string& base_directory = ".");
+
 }  // namespace mufric::scene
