@@ -29,6 +29,7 @@
 #include "micro/run/dataset_sample.hpp"
 #include "micro/run/measurement.hpp"
 #include "surrogate/core/accuracy.hpp"
+#include "surrogate/calibration/measurements.hpp"
 #include "surrogate/core/sampling.hpp"
 
 namespace mufric::app {
@@ -67,7 +68,8 @@ void print_box(const InputSpace& box) {
 }
 
 struct PlanOptions {
-  std::string out, design = "sobol", scene_path;
+  std::string out, design = "sobol", scene_path, box_from;
+  double box_margin = 0.25;
   std::map<std::string, std::string> ranges;  // flag (--p, --v, --T) → range text
   std::vector<std::string> overrides;
   long long samples = 64;
@@ -77,6 +79,17 @@ struct PlanOptions {
 
 void plan_command(const PlanOptions& o) {
   InputSpace box = default_friction_box();
+  if (!o.box_from.empty()) {
+    // The measured rows' conditions set the box (a condition they do not give keeps seed 000's range);
+    // an explicit --p, --v or --T still wins.
+    const InputSpace measured = box_for_measurements(read_measurements(o.box_from), o.box_margin);
+    for (auto& input : box)
+      for (const InputSpec& m : measured)
+        if (m.name == input.name) std::tie(input.lo, input.hi) = std::pair{m.lo, m.hi};
+    std::printf("box from %s (each condition over its rows, +-%g SD where uncertain, widened by %g of its width on each side, "
+                "pressure and velocity in log):\n",
+                o.box_from.c_str(), kBoxSds, o.box_margin);
+  }
   for (auto& input : box) {
     const std::string flag(flag_of(input.name));
     const auto text = o.ranges.find(flag);
@@ -359,6 +372,14 @@ void add_dataset_commands(CLI::App& app) {
                          ") over lo:hi, e.g. 0.2:0.9, as an input after p, v, T (a calibration campaign); the scene's "
                          "law must read it");
   }
+  plan->add_option("--box-from", p->box_from,
+                   "A measurement file (the rows calibrate reads, e.g. mufric measurements' output): the p, v, T box is "
+                   "its conditions' range (+-2 SD where uncertain) widened by --box-margin; --p, --v, --T still override")
+      ->check(CLI::ExistingFile);
+  plan->add_option("--box-margin", p->box_margin, "With --box-from: the share of each condition's width added on each side "
+                                                  "(pressure and velocity in log)")
+      ->capture_default_str()
+      ->check(FiniteRange(0.0, 10.0));
   plan->add_option("--scene", p->scene_path, "Scene file (JSON) stored with the plan; default: the default dry scene")
       ->check(CLI::ExistingFile);
   plan->add_option("--set", p->overrides, "Override a scene value, e.g. --set time.duration=100ns (repeatable)");

@@ -510,6 +510,32 @@ TEST(Calibration, TwoDataSetsWithAKnownBiasRecoverTheCoefficientAndTheBias) {
   EXPECT_GT(naive.summary[0].lo95, m_star) << naive.summary[0].lo95;
 }
 
+// A pair's campaign box from its measurements (issue 70): each condition over its rows ± 2 SD,
+// widened by the margin of its width on each side, in log for p and v, linearly for T.
+TEST(Measurements, ACampaignsBoxIsTheRowsConditionsWithTheirSpreadAndAMargin) {
+  Measurements data;
+  data.condition_names = {"contact_pressure", "sliding_velocity", "temperature"};
+  data.conditions.resize(2, 3);
+  data.conditions << 1e9, 0.1, 700.0,  //
+      2e9, 0.5, 900.0;
+  data.condition_sd = Eigen::MatrixXd::Zero(2, 3);
+  data.condition_sd(0, 0) = 0.1e9;  // the first row's pressure ± 2 SD: 0.8-1.2 GPa
+  data.condition_sd(1, 2) = 50.0;   // the second row's temperature: 800-1000 K
+  data.mu = Eigen::VectorXd::Constant(2, 0.4);
+  data.mu_sd = Eigen::VectorXd::Constant(2, 0.05);
+  const InputSpace box = box_for_measurements(data, 0.25);
+  ASSERT_EQ(box.size(), 3u);
+  const double p_widen = std::pow(2e9 / 0.8e9, 0.25), v_widen = std::pow(5.0, 0.25);
+  EXPECT_NEAR(box[0].lo, 0.8e9 / p_widen, 1.0);
+  EXPECT_NEAR(box[0].hi, 2e9 * p_widen, 1.0);
+  EXPECT_NEAR(box[1].lo, 0.1 / v_widen, 1e-12);
+  EXPECT_NEAR(box[1].hi, 0.5 * v_widen, 1e-12);
+  EXPECT_NEAR(box[2].lo, 700.0 - 0.25 * 300.0, 1e-9);
+  EXPECT_NEAR(box[2].hi, 1000.0 + 0.25 * 300.0, 1e-9);
+  EXPECT_EQ(box[2].unit, "K");
+  EXPECT_THROW(box_for_measurements(data, -0.1), Error);
+}
+
 TEST(Measurements, AFilesUncertainConditionsAndItsDataSetAreRead) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("mufric-measurements-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

@@ -90,6 +90,39 @@ Measurements combine_measurement_sets(const std::vector<Measurements>& sets) {
   return all;
 }
 
+InputSpace box_for_measurements(const Measurements& data, double margin) {
+  if (!(margin >= 0.0)) throw Error("the box's margin must be 0 or more (a share of each condition's width)");
+  const Measurements full = completed(data);
+  InputSpace box;
+  for (Eigen::Index c = 0; c < static_cast<Eigen::Index>(full.condition_names.size()); ++c) {
+    const std::string& name = full.condition_names[static_cast<size_t>(c)];
+    const QuantityKind kind = kind_of_input(name);
+    const bool logarithmic = kind == QuantityKind::pressure || kind == QuantityKind::velocity;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (Eigen::Index i = 0; i < full.rows(); ++i) {
+      const double spread = std::max(kBoxSds * full.condition_sd(i, c), full.condition_half_width(i, c));
+      double low = full.conditions(i, c) - spread, high = full.conditions(i, c) + spread;
+      // A log box cannot reach 0: an SD as large as the value keeps the value's own decade below it.
+      if (logarithmic && !(low > 0.0)) low = full.conditions(i, c) / 10.0;
+      lo = std::min(lo, low);
+      hi = std::max(hi, high);
+    }
+    if (logarithmic) {
+      if (!(lo > 0.0)) throw Error("measurements: " + name + " must be positive to set a campaign's box");
+      const double widen = margin * std::log(hi / lo);
+      lo *= std::exp(-widen), hi *= std::exp(widen);
+      if (widen == 0.0) lo /= 1.1, hi *= 1.1;  // one value: a box around it
+    } else {
+      const double widen = margin * (hi - lo);
+      lo -= widen, hi += widen;
+      if (widen == 0.0) lo -= 0.1 * std::abs(lo), hi += 0.1 * std::abs(hi);
+      if (kind == QuantityKind::temperature) lo = std::max(lo, kLowestBoxTemperature);
+    }
+    box.push_back({name, std::string(si_unit(kind)), lo, hi});
+  }
+  return box;
+}
+
 Measurements read_measurements(const std::string& path) {
   const CsvTable table = read_csv_table(path);
   table.column("mu");

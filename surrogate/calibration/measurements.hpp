@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "common/input_space.hpp"
 #include "surrogate/calibration/priors.hpp"
 
 namespace mufric {
@@ -44,5 +45,14 @@ Measurements combine_measurement_sets(const std::vector<Measurements>& sets);
 // then be left out). Rows are named "FILE line N"; the file is one data set, named by its stem.
 // Errors name the file, line and column.
 Measurements read_measurements(const std::string& path);
+
+// The box a pair's campaign needs for these measurements: each condition over the rows (an uncertain
+// one's value ± kBoxSds SDs, or its range), widened by `margin` of its width on each side, in
+// log for the pressure and the velocity (positive, spanning decades), linearly for the temperature,
+// which stays above kLowestBoxTemperature. In the order of condition_names. Throws Error for a
+// negative margin or a condition that is not a model input.
+inline constexpr double kBoxSds = 2.0;
+inline constexpr double kLowestBoxTemperature = 250.0;  // K
+InputSpace box_for_measurements(const Measurements& data, double margin);
 
 }  // namespace mufric
