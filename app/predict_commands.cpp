@@ -9,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "app/input_flags.hpp"
+#include "client/friction_client.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "common/units.hpp"

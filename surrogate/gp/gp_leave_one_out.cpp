@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "common/error.hpp"
+#include "surrogate/core/accuracy.hpp"
 #include "surrogate/core/cholesky.hpp"
 
 // Exact leave-one-out predictions of a fitted GP in closed form (R&W eq. 5.12) and the accuracy figures
