@@ -206,6 +206,14 @@ CsvTable numeric_table(const std::string& path, const CsvCells& cells, const std
 
 }  // namespace
 
+std::vector<double> CsvTable::si_difference_column(const std::string& name, QuantityKind kind) const {
+  std::vector<double> values = si_column(name, kind);
+  const std::string& unit = columns[column(name)].unit;
+  const double offset = unit.empty() ? 0.0 : unit_to_si(unit, kind).offset;
+  for (double& x : values) x -= offset;
+  return values;
+}
+
 CsvTable read_csv_table(const std::string& path) {
   const CsvCells cells = read_cells(path);
   std::vector<size_t> every(cells.columns.size());

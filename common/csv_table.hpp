@@ -28,6 +28,9 @@ struct CsvTable {
   // The same for a column that must carry a unit of `kind` (a profile's x and height: lengths),
   // whatever its name says.
   std::vector<double> si_column(const std::string& name, QuantityKind kind) const;
+  // A column of differences (an SD, a half-width) in SI: scaled like si_column but without the
+  // unit's offset, so a temperature SD in °C is the same number of kelvin.
+  std::vector<double> si_difference_column(const std::string& name, QuantityKind kind) const;
 };
 
 // Parses `path`; every cell must be a finite number. Throws Error naming line and column.

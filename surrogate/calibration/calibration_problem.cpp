@@ -12,6 +12,16 @@
 #include "common/units.hpp"
 
 namespace mufric {
+
+const InputSpec& input_of(const GaussianProcess& model, const std::string& name) {
+  std::string names;
+  for (const InputSpec& input : model.inputs()) {
+    if (input.name == name) return input;
+    if (!names.empty()) names += ", ";
+    names += input.name;
+  }
+  throw Error("calibration: the model has no input '" + name + "' (its inputs: " + names + ")");
+}
 namespace {
 
 // Attempts per walker at drawing a start of finite posterior density from the prior.

@@ -16,6 +16,9 @@
 
 namespace mufric {
 
+// The emulator's input called `name`; Error naming the inputs it has when there is none.
+const InputSpec& input_of(const GaussianProcess& model, const std::string& name);
+
 // One point of the posterior in natural units: θ, δ's hyper-parameters, each data set's bias (0 for
 // a set without one) and the measured rows' true conditions (the stated values where exact).
 struct PosteriorPoint {

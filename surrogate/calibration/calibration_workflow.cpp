@@ -34,13 +34,6 @@ std::vector<std::string> input_names(const GaussianProcess& model) {
   return names;
 }
 
-const InputSpec& input_of(const GaussianProcess& model, const std::string& name) {
-  for (const InputSpec& input : model.inputs()) {
-    if (input.name == name) return input;
-  }
-  throw Error("calibration: the model has no input '" + name + "' (its inputs: " + joined(input_names(model)) + ")");
-}
-
 std::string box_text(const InputSpec& input) {
   return format_human(input.lo, input.kind()) + " – " + format_human(input.hi, input.kind());
 }

@@ -23,12 +23,6 @@ double prior_sd_within(const Prior& prior, double lo, double hi) {
   return std::sqrt(std::max(0.0, second / mass - mean * mean));
 }
 
-const InputSpec& input_named(const GaussianProcess& model, const std::string& name) {
-  for (const InputSpec& input : model.inputs())
-    if (input.name == name) return input;
-  return model.inputs().front();  // the problem's coefficients are the emulator's inputs (checked when it was set up)
-}
-
 std::string verdict(const CoefficientEvidence& e, const std::vector<CoefficientEvidence>& all) {
   if (e.determination != Determination::determined && e.partner >= 0) return "only with " + all[static_cast<size_t>(e.partner)].name;
   switch (e.determination) {
@@ -58,7 +52,7 @@ std::vector<CoefficientEvidence> coefficient_evidence(const CalibrationProblem& 
   for (Eigen::Index j = 0; j < n; ++j) {
     CoefficientEvidence e;
     e.name = problem.parameters()[static_cast<size_t>(j)];
-    const InputSpec& input = input_named(problem.emulator(), e.name);
+    const InputSpec& input = input_of(problem.emulator(), e.name);
     e.prior_sd = prior_sd_within(problem.prior_of(j), input.lo, input.hi);
     e.posterior_sd = result.summary[static_cast<size_t>(j)].sd;
     e.share = e.prior_sd > 0.0 ? e.posterior_sd / e.prior_sd : 0.0;
@@ -105,7 +99,7 @@ std::vector<std::string> evidence_warnings(const CalibrationProblem& problem, co
     const auto& e = evidence[j];
     // One seen only with a partner is the pair's warning below.
     if (e.determination == Determination::not_determined && e.partner < 0) {
-      const InputSpec& input = input_named(problem.emulator(), e.name);
+      const InputSpec& input = input_of(problem.emulator(), e.name);
       warnings.push_back(e.name + ": its posterior SD is " + text_printf("%.0f %%", 100.0 * e.share) + " of its prior's (" +
                          problem.prior_of(static_cast<Eigen::Index>(j)).describe(input.kind()) +
                          " within the box): the measurements hardly inform it, the result is mostly the prior");

@@ -178,11 +178,7 @@ Measurements read_measurements(const std::string& path) {
     }
     // An SD is a difference: a temperature SD in °C is the same number of kelvin.
     if (has_sd) {
-      sd = table.si_column(name + "_sd", kind);
-      if (kind == QuantityKind::temperature) {
-        const double offset = unit_to_si(table.columns[table.column(name + "_sd")].unit).offset;
-        for (double& x : sd) x -= offset;
-      }
+      sd = table.si_difference_column(name + "_sd", kind);
     }
     for (size_t i = 0; i < static_cast<size_t>(n); ++i) {
       const auto r = static_cast<Eigen::Index>(i);

@@ -22,7 +22,7 @@ namespace {
 
 
 std::vector<OrthogonalCut> read_cuts(const nlohmann::json& setup, const std::string& setup_path, const std::string& tests_path,
-                                     std::string& group_header) {
+                                     TestGroups& groups) {
   const Uncertainty errors = uncertainty_of(setup, setup_path);
   const UncertaintyKind kind = errors.kind;
   const std::string speed = column_of(setup, "cutting_speed", "cutting_speed");
@@ -32,10 +32,9 @@ std::vector<OrthogonalCut> read_cuts(const nlohmann::json& setup, const std::str
     const std::string mean = column_of(setup, role, role);
     measured[role] = {mean, column_of(setup, role + "_uncertainty", role + suffix_of(kind))};
   }
-  const std::string group = setup.contains("group") ? setup["group"].value("column", std::string()) : std::string();
   std::vector<std::string> names{speed, thickness};
   for (const auto& [role, columns] : measured) names.insert(names.end(), {columns.first, columns.second});
-  if (!group.empty()) names.push_back(group);
+  if (!groups.column.empty()) names.push_back(groups.column);
   CsvTable table;
   try {
     table = read_csv_columns(tests_path, names);
@@ -44,10 +43,7 @@ std::vector<OrthogonalCut> read_cuts(const nlohmann::json& setup, const std::str
                 " names them in \"columns\" (roles: cutting_speed, uncut_chip_thickness, cutting_force, feed_force, "
                 "chip_ratio, each also with _uncertainty)");
   }
-  if (!group.empty()) {
-    const auto& column = table.columns[table.column(group)];
-    group_header = column.unit.empty() ? column.name : column.name + "[" + column.unit + "]";
-  }
+  name_groups(groups, table, setup);
   const auto speeds = table.si_column(speed, QuantityKind::velocity);
   const auto thicknesses = table.si_column(thickness, QuantityKind::length);
   auto mean_of = [&](const std::string& role, size_t row) {
@@ -61,7 +57,7 @@ std::vector<OrthogonalCut> read_cuts(const nlohmann::json& setup, const std::str
   std::vector<OrthogonalCut> cuts;
   for (size_t i = 0; i < table.rows.size(); ++i) {
     OrthogonalCut cut;
-    cut.group = group.empty() ? 0.0 : table.rows[i][table.column(group)];
+    cut.group = group_of_row(groups, table, i);
     cut.cutting_speed = speeds[i];
     cut.uncut_chip_thickness = thicknesses[i];
     cut.cutting_force = mean_of("cutting_force", i);
@@ -96,8 +92,7 @@ OrthogonalCutStudy read_orthogonal_cut_study(const std::string& setup_path) {
   const nlohmann::json setup = read_setup(setup_path);
   OrthogonalCutStudy study;
   study.setup_path = setup_path;
-  const auto folder = std::filesystem::path(setup_path).parent_path();
-  study.tests_path = (folder / required(setup, "tests", setup_path).get<std::string>()).string();
+  study.tests_path = tests_path_of(setup, setup_path);
   OrthogonalCutSetup& s = study.setup;
   s.rake_angle = quantity_field(setup, "rake_angle", QuantityKind::angle, setup_path);
   s.cut_width = quantity_field(setup, "cut_width", QuantityKind::length, setup_path);
@@ -106,13 +101,9 @@ OrthogonalCutStudy read_orthogonal_cut_study(const std::string& setup_path) {
   s.conductivity = range_field(setup, "conductivity_W_per_m_K", setup_path);
   s.specific_heat = range_field(setup, "specific_heat_J_per_kg_K", setup_path);
   if (setup.contains("secondary_zone_ratio")) s.secondary_zone_ratio = range_field(setup, "secondary_zone_ratio", setup_path);
-  s.draws = setup.value("draws", s.draws);
-  s.seed = setup.value("seed", s.seed);
-  study.cuts = read_cuts(setup, setup_path, study.tests_path, study.group_header);
-  if (setup.contains("group")) {
-    study.group_label = setup["group"].value("label", study.group_header + " {}");
-    for (const auto& g : setup["group"].value("calibrate", nlohmann::json::array())) study.calibration_groups.push_back(g.get<double>());
-  }
+  read_draws(setup, s);
+  study.groups = groups_of(setup);
+  study.cuts = read_cuts(setup, setup_path, study.tests_path, study.groups);
   study.provenance = provenance_of(setup);
   study.analysis_file = setup.value("analysis_file", study.analysis_file);
   study.calibration_file = setup.value("calibration_file", study.calibration_file);
@@ -148,14 +139,13 @@ std::vector<WrittenTable> orthogonal_cut_tables(const OrthogonalCutStudy& study,
   auto cell_pair = [](const McEstimate& e, double scale, double offset) {
     return g_text(e.mean * scale - offset, 6) + "," + g_text(e.sd * std::abs(scale), 4);
   };
-  const std::string draws = std::to_string(s.draws) + " draws, seed " + std::to_string(s.seed) + ".";
+  const std::string draws = draws_sentence(s.draws, s.seed);
   std::string analysis = comment_block(study.provenance);
   analysis += "# " + draws + " Temperatures in C (the mean over h = " +
               (thicknesses ? joined_um(*thicknesses) + " um and at " + g_text(thicknesses->front() * 1e6, 6) + " and " +
                                  g_text(thicknesses->back() * 1e6, 6) + " um)."
                            : "each speed's thicknesses and at its thinnest and thickest).") + "\n";
-  std::string header = study.group_header.empty() ? "" : study.group_header + ",";
-  header += "cutting_speed[m/min]";
+  std::string header = study.groups.header_cell() + "cutting_speed[m/min]";
   for (const auto& c : columns) {
     const std::string unit = c.unit.empty() ? "" : "[" + c.unit + "]";
     header += "," + c.name + unit + "," + c.name + "_sd" + unit;
@@ -163,7 +153,7 @@ std::vector<WrittenTable> orthogonal_cut_tables(const OrthogonalCutStudy& study,
   header += ",birge_ratio_cutting_force,birge_ratio_cutting_force_sd,birge_ratio_feed_force,birge_ratio_feed_force_sd";
   analysis += header + "\n";
   for (const auto& r : results) {
-    std::string line = study.group_header.empty() ? "" : g_text(r.group, 6) + ",";
+    std::string line = study.groups.header.empty() ? "" : g_text(r.group, 6) + ",";
     line += g_text(r.cutting_speed * 60.0, 6);
     for (const auto& c : columns) line += "," + cell_pair(r.*(c.estimate), c.scale, c.offset);
     line += "," + g_text(r.birge_cutting, 6) + ",0," + g_text(r.birge_feed, 6) + ",0";
@@ -171,13 +161,8 @@ std::vector<WrittenTable> orthogonal_cut_tables(const OrthogonalCutStudy& study,
   }
   std::vector<WrittenTable> out{{study.analysis_file, analysis}};
 
-  std::vector<double> groups;
-  for (const auto& r : results)
-    if (groups.empty() || groups.back() != r.group) groups.push_back(r.group);
-  for (double group : groups) {
-    if (!study.calibration_groups.empty() &&
-        std::find(study.calibration_groups.begin(), study.calibration_groups.end(), group) == study.calibration_groups.end())
-      continue;
+  for (double group : groups_in_order(results)) {
+    if (!study.groups.calibrates(group)) continue;
     std::string speeds, rows;
     for (const auto& r : results) {
       if (r.group != group) continue;
@@ -187,7 +172,7 @@ std::vector<WrittenTable> orthogonal_cut_tables(const OrthogonalCutStudy& study,
               cell_pair(r.temperature, 1.0, kCelsiusOffset) + "," + cell_pair(r.mu, 1.0, 0.0) + "\n";
     }
     std::string text = comment_block(study.provenance);
-    text += "# " + with_value(study.group_label, group) + "; one row per cutting speed (" + speeds + " m/min, in that order). " +
+    text += "# " + with_value(study.groups.label, group) + "; one row per cutting speed (" + speeds + " m/min, in that order). " +
             draws + "\n";
     text += "contact_pressure[MPa],contact_pressure_sd[MPa],sliding_velocity[m/min],sliding_velocity_sd[m/min],temperature[C],"
             "temperature_sd[C],mu,mu_sd\n" + rows;
@@ -201,7 +186,7 @@ std::string orthogonal_cut_summary(const OrthogonalCutStudy& study, const std::v
   for (const auto& r : results) {
     text += text_printf("%s, %5g m/min: mu %.3f +- %.3f, p %5.0f +- %4.0f MPa, v_chip %5.2f m/min, T %4.0f +- %3.0f C, l_c/h %.2f, "
                         "edges %.1f / %.1f N, Birge %.2f / %.2f\n",
-                        with_value(study.group_label, r.group).c_str(), r.cutting_speed * 60.0, r.mu.mean, r.mu.sd,
+                        with_value(study.groups.label, r.group).c_str(), r.cutting_speed * 60.0, r.mu.mean, r.mu.sd,
                         r.contact_pressure.mean * 1e-6, r.contact_pressure.sd * 1e-6, r.sliding_velocity.mean * 60.0,
                         r.temperature.mean - kCelsiusOffset, r.temperature.sd, r.contact_length_per_h.mean,
                         r.edge_cutting_force.mean, r.edge_feed_force.mean, r.birge_cutting, r.birge_feed);

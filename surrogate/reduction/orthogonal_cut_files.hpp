@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "surrogate/reduction/orthogonal_cutting.hpp"
+#include "surrogate/reduction/test_groups.hpp"
 #include "surrogate/reduction/written_table.hpp"
 
 namespace mufric {
@@ -15,9 +16,7 @@ struct OrthogonalCutStudy {
   OrthogonalCutSetup setup;
   std::vector<OrthogonalCut> cuts;
   std::string setup_path, tests_path;
-  std::string group_header;                // the group column's header cell ("inclination_angle[deg]"); empty: none
-  std::string group_label = "All tests";   // "Inclination {} deg": {} is the group's value as the file gives it
-  std::vector<double> calibration_groups;  // the groups whose rows go to calibrate (empty: every group)
+  TestGroups groups;
   std::vector<std::string> provenance;     // the outputs' first comment lines, without "# "
   std::string analysis_file = "rake_face_analysis.csv";
   std::string calibration_file = "rake_face_mu.csv";  // "{}" is the group's value

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "common/error.hpp"
@@ -123,6 +124,33 @@ std::vector<std::string> provenance_of(const nlohmann::json& setup) {
   std::vector<std::string> lines;
   for (const auto& line : setup.value("provenance", nlohmann::json::array())) lines.push_back(line.get<std::string>());
   return lines;
+}
+
+std::string tests_path_of(const nlohmann::json& setup, const std::string& setup_path) {
+  return (std::filesystem::path(setup_path).parent_path() / required(setup, "tests", setup_path).get<std::string>()).string();
+}
+
+TestGroups groups_of(const nlohmann::json& setup) {
+  TestGroups groups;
+  if (!setup.contains("group")) return groups;
+  groups.column = setup["group"].value("column", std::string());
+  for (const auto& g : setup["group"].value("calibrate", nlohmann::json::array())) groups.calibrated.push_back(g.get<double>());
+  return groups;
+}
+
+void name_groups(TestGroups& groups, const CsvTable& table, const nlohmann::json& setup) {
+  if (groups.column.empty()) return;
+  const auto& column = table.columns[table.column(groups.column)];
+  groups.header = column.unit.empty() ? column.name : column.name + "[" + column.unit + "]";
+  groups.label = setup["group"].value("label", groups.header + " {}");
+}
+
+double group_of_row(const TestGroups& groups, const CsvTable& table, size_t row) {
+  return groups.column.empty() ? 0.0 : table.rows[row][table.column(groups.column)];
+}
+
+std::string draws_sentence(int draws, std::uint32_t seed) {
+  return std::to_string(draws) + " draws, seed " + std::to_string(seed) + ".";
 }
 
 }  // namespace mufric::reduction_setup

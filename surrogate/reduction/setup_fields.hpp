@@ -10,6 +10,7 @@
 #include "common/csv_table.hpp"
 #include "common/units.hpp"
 #include "surrogate/reduction/orthogonal_cutting.hpp"  // ValueRange
+#include "surrogate/reduction/test_groups.hpp"
 
 namespace mufric::reduction_setup {
 
@@ -55,5 +56,23 @@ std::string with_value(const std::string& pattern, double value);
 std::string comment_block(const std::vector<std::string>& lines);
 // The setup's "provenance" lines.
 std::vector<std::string> provenance_of(const nlohmann::json& setup);
+
+// The setup's "tests" CSV, relative to the setup's folder.
+std::string tests_path_of(const nlohmann::json& setup, const std::string& setup_path);
+// The setup's "group": its column and calibrated groups (the header and label need the table).
+TestGroups groups_of(const nlohmann::json& setup);
+// The group column's header cell from the read table, and the label (default "HEADER {}").
+void name_groups(TestGroups& groups, const CsvTable& table, const nlohmann::json& setup);
+// A row's group (0 without a group column).
+double group_of_row(const TestGroups& groups, const CsvTable& table, size_t row);
+
+// The Monte Carlo's "draws" and "seed", where the setup gives them.
+template <typename MonteCarloSetup>
+void read_draws(const nlohmann::json& setup, MonteCarloSetup& s) {
+  s.draws = setup.value("draws", s.draws);
+  s.seed = setup.value("seed", s.seed);
+}
+// "20000 draws, seed 2026.", as the outputs' comment says it.
+std::string draws_sentence(int draws, std::uint32_t seed);
 
 }  // namespace mufric::reduction_setup

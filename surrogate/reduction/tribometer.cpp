@@ -14,11 +14,6 @@
 
 namespace mufric {
 using namespace reduction_setup;
-namespace {
-
-std::string row_words(const TribometerTest& t) { return t.row_name; }
-
-}  // namespace
 
 double sphere_ploughing_coefficient(double x) {
   if (!(x > 0.0 && x <= 1.0)) throw Error("sphere_ploughing_coefficient: a/R must lie in (0, 1]");
@@ -32,21 +27,21 @@ std::vector<TribometerEstimate> friction_from_tribometer(const std::vector<Tribo
   NumpyRandom rng(setup.seed);
   std::vector<TribometerEstimate> out;
   for (const auto& test : tests) {
-    if (!(test.normal_force > 0.0)) throw Error(row_words(test) + ": the normal force must be positive");
-    if (!(test.sliding_velocity > 0.0)) throw Error(row_words(test) + ": the sliding velocity must be positive");
+    if (!(test.normal_force > 0.0)) throw Error(test.row_name + ": the normal force must be positive");
+    if (!(test.sliding_velocity > 0.0)) throw Error(test.row_name + ": the sliding velocity must be positive");
     if (!(test.mu_apparent.mean > 0.0) || !(test.mu_apparent.standard_error > 0.0))
-      throw Error(row_words(test) + ": the apparent friction coefficient and its uncertainty must be positive");
+      throw Error(test.row_name + ": the apparent friction coefficient and its uncertainty must be positive");
     const ValueRange pressure_range =
         test.contact_pressure ? ValueRange{*test.contact_pressure, *test.contact_pressure} : setup.flow_pressure;
     if (!(pressure_range.low > 0.0) || pressure_range.high < pressure_range.low)
-      throw Error(row_words(test) + ": no contact pressure: give the setup's flow_pressure or a contact_pressure column");
+      throw Error(test.row_name + ": no contact pressure: give the setup's flow_pressure or a contact_pressure column");
     Eigen::ArrayXd mu_apparent(setup.draws), pressure(setup.draws);
     for (int d = 0; d < setup.draws; ++d) mu_apparent(d) = test.mu_apparent.mean + test.mu_apparent.standard_error * rng.standard_normal();
     for (int d = 0; d < setup.draws; ++d) pressure(d) = rng.uniform(pressure_range.low, pressure_range.high);
     // F_n = p π a² / 2: the front half of the contact circle carries the load (Goddard & Wilman).
     const Eigen::ArrayXd radius = (2.0 * test.normal_force / (std::numbers::pi * pressure)).sqrt();
     if (radius.maxCoeff() >= setup.pin_radius)
-      throw Error(row_words(test) + text_printf(": the contact's radius (%.3g mm at the lowest pressure) reaches the pin's "
+      throw Error(test.row_name + text_printf(": the contact's radius (%.3g mm at the lowest pressure) reaches the pin's "
                                                 "(%.3g mm): the pin would sink in up to its equator; check the force, the "
                                                 "pin_radius and the flow_pressure",
                                                 radius.maxCoeff() * 1e3, setup.pin_radius * 1e3));
@@ -64,7 +59,7 @@ std::vector<TribometerEstimate> friction_from_tribometer(const std::vector<Tribo
     e.temperature = test.temperature;
     e.row_name = test.row_name;
     if (!(e.mu.mean > 0.0))
-      throw Error(row_words(test) + text_printf(": the pin's ploughing (%.3f) takes all of the apparent friction (%.3f): the "
+      throw Error(test.row_name + text_printf(": the pin's ploughing (%.3f) takes all of the apparent friction (%.3f): the "
                                                 "pin's radius or the flow pressure is wrong, or the test measured ploughing",
                                                 e.mu_ploughing.mean, e.mu_apparent.mean));
     out.push_back(e);
@@ -76,7 +71,7 @@ TribometerStudy read_tribometer_study(const std::string& setup_path) {
   const nlohmann::json setup = read_setup(setup_path);
   TribometerStudy study;
   study.setup_path = setup_path;
-  study.tests_path = (std::filesystem::path(setup_path).parent_path() / required(setup, "tests", setup_path).get<std::string>()).string();
+  study.tests_path = tests_path_of(setup, setup_path);
   TribometerSetup& s = study.setup;
   s.pin_radius = quantity_field(setup, "pin_radius", QuantityKind::length, setup_path);
   const std::string ploughing = setup.value("ploughing", std::string("goddard-wilman"));
@@ -89,8 +84,7 @@ TribometerStudy read_tribometer_study(const std::string& setup_path) {
                 "out) or none (the rows keep the apparent mu, ploughing included)");
   }
   if (setup.contains("flow_pressure")) s.flow_pressure = quantity_range_field(setup, "flow_pressure", QuantityKind::pressure, setup_path);
-  s.draws = setup.value("draws", s.draws);
-  s.seed = setup.value("seed", s.seed);
+  read_draws(setup, s);
   study.provenance = provenance_of(setup);
   study.analysis_file = setup.value("analysis_file", study.analysis_file);
   study.calibration_file = setup.value("calibration_file", study.calibration_file);
@@ -106,8 +100,8 @@ TribometerStudy read_tribometer_study(const std::string& setup_path) {
   };
   const std::string pressure = optional_column("contact_pressure"), temperature = optional_column("temperature"),
                     temperature_sd = optional_column("temperature_sd");
-  const std::string group = setup.contains("group") ? setup["group"].value("column", std::string()) : std::string();
-  for (const auto& name : {pressure, temperature, temperature_sd, group})
+  study.groups = groups_of(setup);
+  for (const auto& name : {pressure, temperature, temperature_sd, study.groups.column})
     if (!name.empty()) names.push_back(name);
   const CsvTable table = read_csv_columns(study.tests_path, names);
   const auto velocities = table.si_column(velocity, QuantityKind::velocity);
@@ -115,22 +109,12 @@ TribometerStudy read_tribometer_study(const std::string& setup_path) {
   std::vector<double> pressures, temperatures, temperature_sds;
   if (!pressure.empty()) pressures = table.si_column(pressure, QuantityKind::pressure);
   if (!temperature.empty()) temperatures = table.si_column(temperature, QuantityKind::temperature);
-  if (!temperature_sd.empty()) {
-    temperature_sds = table.si_column(temperature_sd, QuantityKind::temperature);
-    const auto& unit = table.columns[table.column(temperature_sd)].unit;
-    if (unit == "C" || unit == "degC" || unit == "°C")
-      for (auto& v : temperature_sds) v -= kCelsiusOffset;  // an SD in °C is a difference: no offset
-  }
-  if (!group.empty()) {
-    const auto& column = table.columns[table.column(group)];
-    study.group_header = column.unit.empty() ? column.name : column.name + "[" + column.unit + "]";
-    study.group_label = setup["group"].value("label", study.group_header + " {}");
-    for (const auto& g : setup["group"].value("calibrate", nlohmann::json::array())) study.calibration_groups.push_back(g.get<double>());
-  }
+  if (!temperature_sd.empty()) temperature_sds = table.si_difference_column(temperature_sd, QuantityKind::temperature);
+  name_groups(study.groups, table, setup);
   const std::string file = std::filesystem::path(study.tests_path).filename().string();
   for (size_t i = 0; i < table.rows.size(); ++i) {
     TribometerTest t;
-    t.group = group.empty() ? 0.0 : table.rows[i][table.column(group)];
+    t.group = group_of_row(study.groups, table, i);
     t.sliding_velocity = velocities[i];
     t.normal_force = force_unit * table.rows[i][table.column(force)];
     t.mu_apparent = {table.rows[i][table.column(mu)], errors.standard_error(table.rows[i][table.column(mu_uncertainty)])};
@@ -146,31 +130,26 @@ TribometerStudy read_tribometer_study(const std::string& setup_path) {
 }
 
 std::vector<WrittenTable> tribometer_tables(const TribometerStudy& study, const std::vector<TribometerEstimate>& results) {
-  const std::string draws = std::to_string(study.setup.draws) + " draws, seed " + std::to_string(study.setup.seed) + ".";
+  const std::string draws = draws_sentence(study.setup.draws, study.setup.seed);
   const bool corrected = study.setup.ploughing == PloughingCorrection::goddard_wilman;
   const bool temperatures = !results.empty() && results.front().temperature.has_value();
   auto pair = [](const McEstimate& e, double scale) { return g_text(e.mean * scale, 6) + "," + g_text(e.sd * scale, 4); };
   std::string analysis = comment_block(study.provenance);
   analysis += "# " + draws + (corrected ? " mu: the apparent mu less the pin's ploughing (Goddard & Wilman 1962)."
                                         : " No ploughing correction: mu is the apparent mu, the pin's ploughing included.") + "\n";
-  analysis += (study.group_header.empty() ? "" : study.group_header + ",") +
+  analysis += study.groups.header_cell() +
               std::string("row,sliding_velocity[m/min],mu_apparent,mu_apparent_sd,mu_ploughing,mu_ploughing_sd,mu,mu_sd,"
                           "contact_pressure[MPa],contact_pressure_sd[MPa],contact_radius[um],contact_radius_sd[um]\n");
   for (const auto& r : results) {
-    analysis += (study.group_header.empty() ? "" : g_text(r.group, 6) + ",") + "\"" + r.row_name + "\"," +
+    analysis += (study.groups.header.empty() ? "" : g_text(r.group, 6) + ",") + "\"" + r.row_name + "\"," +
                 g_text(r.sliding_velocity * 60.0, 6) + "," + pair(r.mu_apparent, 1.0) + "," + pair(r.mu_ploughing, 1.0) + "," +
                 pair(r.mu, 1.0) + "," + pair(r.contact_pressure, 1e-6) + "," + pair(r.contact_radius, 1e6) + "\n";
   }
   std::vector<WrittenTable> out{{study.analysis_file, analysis}};
-  std::vector<double> groups;
-  for (const auto& r : results)
-    if (std::find(groups.begin(), groups.end(), r.group) == groups.end()) groups.push_back(r.group);
-  for (double group : groups) {
-    if (!study.calibration_groups.empty() &&
-        std::find(study.calibration_groups.begin(), study.calibration_groups.end(), group) == study.calibration_groups.end())
-      continue;
+  for (double group : groups_in_order(results)) {
+    if (!study.groups.calibrates(group)) continue;
     std::string text = comment_block(study.provenance);
-    text += "# " + with_value(study.group_label, group) + "; one row per test. " + draws +
+    text += "# " + with_value(study.groups.label, group) + "; one row per test. " + draws +
             (corrected ? " mu less the pin's ploughing." : " mu apparent (ploughing included).") + "\n";
     text += std::string("contact_pressure[MPa],contact_pressure_sd[MPa],sliding_velocity[m/min],") +
             (temperatures ? "temperature[C],temperature_sd[C]," : "") + "mu,mu_sd\n";
@@ -189,7 +168,7 @@ std::string tribometer_summary(const TribometerStudy& study, const std::vector<T
   std::string text;
   for (const auto& r : results)
     text += text_printf("%s, %s: v %6.3g m/min, mu apparent %.3f +- %.3f, ploughing %.3f, mu %.3f +- %.3f, p %5.0f MPa, a %.3g um\n",
-                        with_value(study.group_label, r.group).c_str(), r.row_name.c_str(), r.sliding_velocity * 60.0,
+                        with_value(study.groups.label, r.group).c_str(), r.row_name.c_str(), r.sliding_velocity * 60.0,
                         r.mu_apparent.mean, r.mu_apparent.sd, r.mu_ploughing.mean, r.mu.mean, r.mu.sd,
                         r.contact_pressure.mean * 1e-6, r.contact_radius.mean * 1e6);
   return text;

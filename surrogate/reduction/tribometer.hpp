@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "surrogate/reduction/orthogonal_cutting.hpp"  // MeasuredMean, ValueRange, McEstimate
+#include "surrogate/reduction/test_groups.hpp"
 #include "surrogate/reduction/written_table.hpp"
 
 namespace mufric {
@@ -57,9 +58,8 @@ std::vector<TribometerEstimate> friction_from_tribometer(const std::vector<Tribo
 struct TribometerStudy {
   TribometerSetup setup;
   std::vector<TribometerTest> tests;
-  std::string setup_path, tests_path, group_header;
-  std::string group_label = "All tests";
-  std::vector<double> calibration_groups;
+  std::string setup_path, tests_path;
+  TestGroups groups;
   std::vector<std::string> provenance;
   std::string analysis_file = "tribometer_analysis.csv";
   std::string calibration_file = "tribometer_mu.csv";
